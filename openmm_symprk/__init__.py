@@ -1,0 +1,6 @@
+"""openmm_symprk: symplectic partitioned Runge-Kutta integrators for OpenMM."""
+from .catalogue import UnknownMethodError, get_method, methods
+from .splitting import Splitting, compose
+from .tableau import PRKTableau, TableauError
+
+__version__ = "0.1.0"
