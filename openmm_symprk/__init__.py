@@ -1,5 +1,6 @@
 """openmm_symprk: symplectic partitioned Runge-Kutta integrators for OpenMM."""
 from .catalogue import UnknownMethodError, get_method, methods
+from .integrators import PRKIntegrator, SimulationBlowUpError, SymplecticIntegrator, step_size_in_ps
 from .splitting import Splitting, compose
 from .tableau import PRKTableau, TableauError
 

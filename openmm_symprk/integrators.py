@@ -1,0 +1,176 @@
+"""The drop-in integrators: openmm.CustomIntegrator subclasses built by :mod:`openmm_symprk.program`.
+
+    from openmm_symprk import SymplecticIntegrator
+    integrator = SymplecticIntegrator(2*unit.femtoseconds, method="yoshida-4", system=system)
+
+Both classes are plain CustomIntegrators to OpenMM, so Simulation, reporters, checkpoints and
+XmlSerializer work.  Deserialising the XML gives a plain ``openmm.CustomIntegrator`` with the same
+program (the Python conveniences -- method name, blow-up check on ``step`` -- are not in the XML).
+"""
+from __future__ import annotations
+
+import math
+import warnings
+
+import openmm as mm
+import openmm.unit as unit
+
+from . import program
+from .catalogue import Method, get_method
+from .splitting import Splitting
+from .systemcheck import has_constraints, warn_conservation
+from .tableau import PRKTableau, TableauError
+
+
+class SimulationBlowUpError(RuntimeError):
+    """The velocities stopped being finite (the step size is beyond the method's stability limit)."""
+
+
+class ConvergenceWarning(RuntimeWarning):
+    """An implicit method's fixed-point iteration hit its iteration cap on some steps."""
+
+
+def step_size_in_ps(step_size) -> float:
+    """Validate a step size: a positive time Quantity, or a positive number taken as picoseconds."""
+    if unit.is_quantity(step_size):
+        if not step_size.unit.is_compatible(unit.picoseconds):
+            raise TypeError(f"step size {step_size} is not a time: give it in time units, e.g. "
+                            f"2*unit.femtoseconds (a plain number is taken as picoseconds)")
+        value = step_size.value_in_unit(unit.picoseconds)
+    else:
+        value = step_size
+    try:
+        value = float(value)
+    except (TypeError, ValueError):
+        raise TypeError(f"step size {step_size!r} is not a time: give e.g. 2*unit.femtoseconds "
+                        f"or a number of picoseconds") from None
+    if not math.isfinite(value) or value <= 0:
+        raise ValueError(f"step size must be positive and finite, got {step_size} "
+                         f"(e.g. 2*unit.femtoseconds or 0.002 ps)")
+    return value
+
+
+class PRKIntegrator(mm.CustomIntegrator):
+    """A CustomIntegrator running any PRK tableau pair or kick/drift splitting.
+
+    Parameters
+    ----------
+    stepSize : time Quantity or float (ps)
+    tableau : PRKTableau, Splitting, or catalogue Method
+    system : openmm.System, optional
+        The system the integrator will run.  It decides whether RATTLE constraint steps are compiled
+        (a system with constraints needs them; without ``system`` they are included, which is correct
+        for any system and costs one constraint solve per drift) and is checked for anything that breaks
+        conservation (CMMotionRemover, periodic box, thermostats: one warning each).
+    constraints : bool, optional
+        Override the constraint decision (``True``/``False``); default: from ``system``.
+    allow_nonsymplectic : bool
+        Accept a tableau that fails Reich's condition (6) (e.g. rk4 as a reference).
+    exact_momentum : bool
+        Project the forces of every kick onto zero net force and torque, so that linear and angular
+        momentum are conserved to double round-off even where forces are summed in single precision.
+    check_finite : bool
+        Record the first step whose velocities are not finite; ``step`` raises SimulationBlowUpError.
+    tolerance, max_iterations : implicit methods only: fixed-point tolerance (nm) and iteration cap.
+    """
+
+    def __init__(self, stepSize, tableau, system: mm.System | None = None, constraints: bool | None = None,
+                 allow_nonsymplectic: bool = False, exact_momentum: bool = False, check_finite: bool = True,
+                 tolerance: float = 1e-12, max_iterations: int = 60, name: str | None = None):
+        dt = step_size_in_ps(stepSize)
+        method = self._resolve(tableau)
+        tab = method.tableau() if isinstance(method, Method) else (
+            PRKTableau.from_splitting(method, name=name) if isinstance(method, Splitting) else method)
+        self.method_name = name or getattr(method, "name", None) or "user tableau"
+        tab.check_symplectic(allow_nonsymplectic)
+        if tolerance <= 0 or not math.isfinite(tolerance):
+            raise ValueError(f"tolerance must be a positive number of nm, got {tolerance!r}")
+        if int(max_iterations) < 1:
+            raise ValueError(f"max_iterations must be at least 1, got {max_iterations!r}")
+        if system is not None and not isinstance(system, mm.System):
+            raise TypeError(f"system must be an openmm.System, got {type(system).__name__}")
+        if constraints is None:
+            constraints = True if system is None else has_constraints(system)
+        if system is not None:
+            warn_conservation(system, context=f"{type(self).__name__}({self.method_name})")
+            if exact_momentum and system.usesPeriodicBoundaryConditions():
+                raise ValueError(
+                    "exact_momentum=True removes the net torque of the forces, which is only correct for a "
+                    "non-periodic (isolated) system; this System is periodic. Use exact_momentum=False.")
+        super().__init__(dt)
+        self.tableau = tab
+        try:
+            self.program_info = program.compile_program(
+                self, method, bool(constraints), exact_momentum=exact_momentum, check_finite=check_finite,
+                tolerance=tolerance, max_iterations=int(max_iterations))
+        except program.ConstraintSupportError as exc:
+            raise program.ConstraintSupportError(str(exc).replace("user tableau", self.method_name)) from None
+        self.check_finite = check_finite
+        self._nonconverged_seen = 0
+
+    @staticmethod
+    def _resolve(tableau):
+        if isinstance(tableau, (PRKTableau, Splitting, Method)):
+            return tableau
+        if isinstance(tableau, str):
+            return get_method(tableau)
+        raise TypeError(f"expected a PRKTableau, Splitting or catalogue method, got {tableau!r}")
+
+    # -- OpenMM overrides ---------------------------------------------------------------
+    def setStepSize(self, size):
+        return super().setStepSize(step_size_in_ps(size))
+
+    def step(self, steps):
+        """Advance ``steps`` steps; raise SimulationBlowUpError if the simulation blew up."""
+        result = super().step(steps)
+        if self.check_finite:
+            bad = self.getGlobalVariableByName(program.BAD_VAR)
+            if bad:
+                raise SimulationBlowUpError(
+                    f"the simulation blew up at integrator step {int(bad)} with method {self.method_name!r} "
+                    f"at step size {self.getStepSize()}: velocities became NaN or infinite. Reduce the step "
+                    f"size (largest stable h*omega for this method: {self._stability()}), or minimize the "
+                    f"energy first. The Context still holds the non-finite state; reload a checkpoint or "
+                    f"positions saved before this call.")
+        if self.program_info.kind == "implicit":
+            n = int(self.getGlobalVariableByName(program.NONCONV_VAR))
+            if n > self._nonconverged_seen:
+                warnings.warn(
+                    f"{self.method_name}: the implicit stage iteration reached its cap on {n - self._nonconverged_seen} "
+                    f"step(s) (total {n}); results are less accurate there. Reduce the step size or raise "
+                    f"max_iterations/tolerance.", ConvergenceWarning, stacklevel=2)
+                self._nonconverged_seen = n
+        return result
+
+    def _stability(self):
+        try:
+            st = get_method(self.method_name).stability
+        except Exception:
+            return "unknown"
+        return "unbounded" if st is None or math.isinf(st) else f"{st:.4f}"
+
+    # -- conveniences -------------------------------------------------------------------
+    @property
+    def steps_taken(self) -> int:
+        return int(self.getGlobalVariableByName(program.STEP_VAR))
+
+    def describe(self) -> str:
+        info = self.program_info
+        lines = [f"{type(self).__name__}: {self.method_name}, step {self.getStepSize()}",
+                 f"  program: {info.kind}, {info.stages} stages, constraints={'RATTLE' if info.constraints else 'none'}, "
+                 f"force evaluations per step: {info.force_evals}, exact momentum: {info.exact_momentum}",
+                 f"  {self.tableau.summary()}"]
+        lines += [f"  {n}" for n in info.notes]
+        return "\n".join(lines)
+
+
+class SymplecticIntegrator(PRKIntegrator):
+    """A catalogue method by name (``openmm_symprk.methods``), e.g. "verlet", "yoshida-4", "kahan-li-8".
+
+    See :class:`PRKIntegrator` for the options.  Names are case-insensitive and accept aliases
+    (velocity-verlet, forest-ruth, ...); an unknown name raises UnknownMethodError with close names."""
+
+    def __init__(self, stepSize, method: str = "verlet", system: mm.System | None = None, **options):
+        m = get_method(method)
+        super().__init__(stepSize, m, system=system, name=m.name, **options)
+        self.method = m
