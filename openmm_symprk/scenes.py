@@ -196,3 +196,38 @@ def constrained_molecule(seed: int = 3) -> Scene:
     vel = _constrain_velocities(system, sc.positions, sc.velocities)
     return Scene("constrained-molecule", system, sc.topology, sc.positions, vel,
                  "4-atom chain with 3 distance constraints, angle and 1-4 terms (nonlinear, constrained)")
+
+
+def _openmm_data(name):
+    import os
+
+    return os.path.join(os.path.dirname(app.__file__), "data", name)
+
+
+def protein_vacuum(constraints=app.HBonds, temperature: float = 300.0, angular_velocity=(0.0, 0.0, 0.5),
+                   seed: int = 5, minimize: bool = True) -> Scene:
+    """The villin headpiece from OpenMM's bundled test.pdb, solvent removed, in vacuum (amber14, no
+    cutoff, no CMMotionRemover), HBonds constrained by default: a real protein whose conservation
+    exercises CCMA constraints, with no periodic box to break rotational symmetry."""
+    pdb = app.PDBFile(_openmm_data("test.pdb"))
+    mod = app.Modeller(pdb.topology, pdb.positions)
+    mod.deleteWater()
+    mod.delete([r for r in mod.topology.residues() if len(r) == 1])  # counter-ions
+    ff = app.ForceField("amber14-all.xml")
+    system = ff.createSystem(mod.topology, nonbondedMethod=app.NoCutoff, constraints=constraints,
+                             removeCMMotion=False)
+    pos = np.array(mod.positions.value_in_unit(unit.nanometer))
+    if minimize:
+        ctx = mm.Context(system, mm.VerletIntegrator(0.001), mm.Platform.getPlatformByName("Reference"))
+        ctx.setPositions(pos)
+        ctx.applyConstraints(1e-10)
+        mm.LocalEnergyMinimizer.minimize(ctx, 10.0, 200)
+        pos = ctx.getState(getPositions=True).getPositions(asNumpy=True).value_in_unit(unit.nanometer)
+    rng = np.random.default_rng(seed)
+    masses = np.array([system.getParticleMass(i).value_in_unit(unit.dalton) for i in range(system.getNumParticles())])
+    vel = _spin_velocities(pos, masses, temperature, angular_velocity, rng)
+    if system.getNumConstraints():
+        vel = _constrain_velocities(system, pos, vel)
+    return Scene("villin-vacuum", system, mod.topology, np.array(pos), vel,
+                 f"villin headpiece (test.pdb, {system.getNumParticles()} atoms) in vacuum, amber14, "
+                 f"{system.getNumConstraints()} constraints")
