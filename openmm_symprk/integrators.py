@@ -90,7 +90,17 @@ class PRKIntegrator(mm.CustomIntegrator):
         if system is not None and not isinstance(system, mm.System):
             raise TypeError(f"system must be an openmm.System, got {type(system).__name__}")
         if constraints is None:
-            constraints = True if system is None else has_constraints(system)
+            if system is not None:
+                constraints = has_constraints(system)
+            elif isinstance(method, Splitting) or (isinstance(method, Method) and method.is_splitting) or (
+                    isinstance(method, PRKTableau) and _is_splitting(method)):
+                constraints = True  # RATTLE steps are harmless (and cheap) on a system without constraints
+            else:
+                constraints = False
+                warnings.warn(
+                    f"{self.method_name} is a general PRK tableau, which cannot keep constraints, and no "
+                    f"system= was given to check against: it will ignore any constraints of the system it runs. "
+                    f"Pass system= to have this checked.", UserWarning, stacklevel=3)
         if system is not None:
             warn_conservation(system, context=f"{type(self).__name__}({self.method_name})")
             if exact_momentum and system.usesPeriodicBoundaryConditions():
@@ -122,16 +132,16 @@ class PRKIntegrator(mm.CustomIntegrator):
 
     def step(self, steps):
         """Advance ``steps`` steps; raise SimulationBlowUpError if the simulation blew up."""
-        result = super().step(steps)
+        try:
+            result = super().step(steps)
+        except mm.OpenMMException as exc:  # CPU/CUDA check coordinates themselves
+            if "NaN" not in str(exc):
+                raise
+            raise self._blow_up(int(self.getGlobalVariableByName(program.STEP_VAR)) + 1, "positions became NaN") from exc
         if self.check_finite:
             bad = self.getGlobalVariableByName(program.BAD_VAR)
             if bad:
-                raise SimulationBlowUpError(
-                    f"the simulation blew up at integrator step {int(bad)} with method {self.method_name!r} "
-                    f"at step size {self.getStepSize()}: velocities became NaN or infinite. Reduce the step "
-                    f"size (largest stable h*omega for this method: {self._stability()}), or minimize the "
-                    f"energy first. The Context still holds the non-finite state; reload a checkpoint or "
-                    f"positions saved before this call.")
+                raise self._blow_up(int(bad), "velocities became NaN, infinite or faster than 1e5 nm/ps")
         if self.program_info.kind == "implicit":
             n = int(self.getGlobalVariableByName(program.NONCONV_VAR))
             if n > self._nonconverged_seen:
@@ -141,6 +151,13 @@ class PRKIntegrator(mm.CustomIntegrator):
                     f"max_iterations/tolerance.", ConvergenceWarning, stacklevel=2)
                 self._nonconverged_seen = n
         return result
+
+    def _blow_up(self, step: int, what: str) -> SimulationBlowUpError:
+        return SimulationBlowUpError(
+            f"the simulation blew up at integrator step {step} with method {self.method_name!r} at step size "
+            f"{self.getStepSize()}: {what}. Reduce the step size (largest stable "
+            f"h*omega for this method: {self._stability()}), or minimize the energy first. The Context "
+            f"still holds the non-finite state; reload a checkpoint or positions saved before this call.")
 
     def _stability(self):
         try:
@@ -162,6 +179,14 @@ class PRKIntegrator(mm.CustomIntegrator):
                  f"  {self.tableau.summary()}"]
         lines += [f"  {n}" for n in info.notes]
         return "\n".join(lines)
+
+
+def _is_splitting(tab: PRKTableau) -> bool:
+    try:
+        tab.to_splitting()
+        return True
+    except TableauError:
+        return False
 
 
 class SymplecticIntegrator(PRKIntegrator):
