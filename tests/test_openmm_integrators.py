@@ -215,3 +215,33 @@ def test_works_in_simulation_with_reporters(water8, tmp_path):
     sim.saveCheckpoint(str(tmp_path / "chk"))
     sim.loadCheckpoint(str(tmp_path / "chk"))
     assert sim.currentStep == 50
+
+
+def _step_types(ig):
+    return [ig.getComputationStep(i)[0] for i in range(ig.getNumComputations())]
+
+
+def test_no_constraint_steps_without_constraints(morse, water8):
+    free = SymplecticIntegrator(1 * unit.femtoseconds, "yoshida-4", system=morse.system)
+    rattle = SymplecticIntegrator(1 * unit.femtoseconds, "yoshida-4", system=water8.system)
+    cp, cv = mm.CustomIntegrator.ConstrainPositions, mm.CustomIntegrator.ConstrainVelocities
+    assert cp not in _step_types(free) and cv not in _step_types(free)
+    # one position projection per drift, one velocity projection per step
+    assert _step_types(rattle).count(cp) == methods["yoshida-4"].splitting.count("drift")
+    assert _step_types(rattle).count(cv) == 1
+
+
+def test_implicit_non_convergence_is_reported(morse):
+    from openmm_symprk.integrators import ConvergenceWarning
+
+    ig = SymplecticIntegrator(2 * unit.femtoseconds, "gauss-2", system=morse.system, max_iterations=2)
+    ctx = morse.context(ig)
+    with pytest.warns(ConvergenceWarning, match=r"gauss-2: the implicit stage iteration reached its cap on 5 step"):
+        ig.step(5)
+    ig2 = SymplecticIntegrator(2 * unit.femtoseconds, "gauss-2", system=morse.system)
+    ctx2 = morse.context(ig2)
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", ConvergenceWarning)
+        ig2.step(5)
