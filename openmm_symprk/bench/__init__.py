@@ -1,0 +1,24 @@
+"""``symprk bench``: speed against accuracy, and where each method stops being stable.
+
+Modules: :mod:`.toys` (analytic oscillators with exact solutions), :mod:`.scenes` (the scene registry
+and user systems), :mod:`.measure` (observables), :mod:`.runs` (one run), :mod:`.stability` (largest
+stable step by bisection), :mod:`.store` (finished runs on disk), :mod:`.presets` (quick and full
+sweeps), :mod:`.sweep` (scenes x methods x steps in parallel, resumable), :mod:`.charts` (figures) and
+:mod:`.cli` (the command line).  Python use::
+
+    from openmm_symprk.bench import run_sweep, presets
+    results = run_sweep(presets.quick(), out="bench-results/quick", workers=2)
+"""
+from __future__ import annotations
+
+
+def __getattr__(name):  # keep ``import openmm_symprk.bench`` light: load on first use
+    if name == "run_sweep":
+        from .sweep import run_sweep
+
+        return run_sweep
+    if name == "presets":
+        from . import presets
+
+        return presets
+    raise AttributeError(name)

@@ -1,0 +1,264 @@
+"""One run of the bench: one method at one step size on one scene, from the scene's shared state.
+
+:class:`RunSpec` names the run; :func:`execute` turns (spec, scene payload) into a plain-dict record and
+never raises for a failing integrator (blow-up, NaN, unsupported method, OpenMM error): the failure is
+the record.  What a record holds (units nm, ps, Da, kJ/mol):
+
+* ``energy_error``: max |E - E0| over the samples; ``energy_error_per_dof`` divides it by the degrees of
+  freedom; ``drift_per_ns_per_dof``: slope of a least-squares line through E(t) - E0, per ns, per DOF.
+* ``dP``: max |P - P0|; ``dL_rel``: max |L - L0| / |L0| (about the origin) -- only where the scene has
+  that invariant (None otherwise).
+* ``constraint_error``: max relative bond-length error max |r - d| / d.
+* ``traj_error``: RMS position error (nm) at the final time against the exact solution (toys); for the
+  molecular scenes the sweep fills it in against the reference run (see :mod:`.sweep`).
+* ``force_evals_per_step`` (from ``integrator.program_info.force_evals``; OpenMM's integrators: 1) and
+  ``force_evals_per_ps``; ``wall_per_step`` and ``wall_per_ps`` (seconds) from a separate, uninterrupted
+  ``step(n)`` call after the measured segment (sampling clears OpenMM's force cache, so it is not timed).
+* ``failed`` / ``failure``: blow-up ("blow-up: ..."), energy error above the scene's threshold, or a
+  constraint error above 1e-3 (see :mod:`.stability`); ``status`` is "ok", "failed", "unsupported"
+  (the method cannot run this system, e.g. an implicit tableau with constraints) or "error".
+
+The comparison rows ``openmm-verlet`` (VerletIntegrator) and ``openmm-langevin``
+(LangevinMiddleIntegrator, 1/ps, the scene temperature, seed 1) are leapfrog integrators whose state
+velocities lag half a step: they start from v(-h/2) = v0 - (h/2) F(x0)/m (then constrained), which
+gives them the same position trajectory as velocity Verlet from (x0, v0).
+"""
+from __future__ import annotations
+
+import math
+import time
+import traceback
+import warnings
+from dataclasses import asdict, dataclass
+
+import numpy as np
+import openmm as mm
+import openmm.unit as unit
+
+from . import measure
+from .scenes import BenchScene
+
+#: The comparison rows: OpenMM's own integrators.
+OPENMM_ROWS = ("openmm-verlet", "openmm-langevin")
+#: Constraint tolerance for every run (SETTLE ignores it; CCMA iterates to it).
+CONSTRAINT_TOLERANCE = 1e-10
+#: Failure thresholds (see stability.py for their rationale).
+KT300 = 0.0083144626 * 300.0
+ENERGY_THRESHOLD_KT = 0.1  # kT(300 K) per degree of freedom
+CONSTRAINT_THRESHOLD = 1e-3  # relative bond-length error
+SPEED_LIMIT = 1e5  # nm/ps: a velocity above this is a blow-up
+
+
+@dataclass(frozen=True)
+class RunSpec:
+    scene: str
+    method: str
+    step_fs: float
+    n_steps: int
+    n_samples: int = 50
+    role: str = "run"  # "run", "reference", "probe" (stability: stop at the first failure), "linear-probe"
+    platform: str | None = None  # None: the scene's platform
+    timing_s: float = 0.0  # seconds of uninterrupted stepping to time (0: no timing)
+    threads: int = 1  # CPU platform threads
+    seed: int = 1
+
+    @property
+    def h_ps(self) -> float:
+        return self.step_fs * 1e-3
+
+    @property
+    def length_ps(self) -> float:
+        return self.n_steps * self.h_ps
+
+    def to_dict(self) -> dict:
+        return asdict(self)
+
+
+def label(method: str) -> str:
+    return {"openmm-verlet": "OpenMM Verlet", "openmm-langevin": "OpenMM Langevin"}.get(method, method)
+
+
+def platform_properties(name: str, threads: int) -> dict:
+    if name == "CPU":
+        return {"Threads": str(threads)}
+    if name in ("OpenCL", "CUDA", "HIP"):
+        return {"Precision": "double" if name == "OpenCL" else "mixed"}
+    return {}
+
+
+class Unsupported(Exception):
+    """The method cannot run on this system."""
+
+
+def make_integrator(method: str, h_ps: float, scene: BenchScene, seed: int = 1, temperature=None):
+    """(integrator, force evaluations per step, leapfrog?) for a row name."""
+    if method == "openmm-verlet":
+        ig, evals, leapfrog = mm.VerletIntegrator(h_ps), 1, True
+    elif method == "openmm-langevin":
+        t = scene.temperature if temperature is None else temperature
+        ig = mm.LangevinMiddleIntegrator(t * unit.kelvin, 1.0 / unit.picosecond, h_ps)
+        ig.setRandomNumberSeed(seed)
+        evals, leapfrog = 1, True
+    else:
+        from ..catalogue import get_method
+        from ..integrators import SymplecticIntegrator
+        from ..program import ConstraintSupportError
+
+        m = get_method(method)
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                ig = SymplecticIntegrator(h_ps, m.name, system=scene.system, allow_nonsymplectic=True)
+        except ConstraintSupportError as exc:
+            raise Unsupported(str(exc)) from None
+        evals, leapfrog = ig.program_info.force_evals, False
+    ig.setConstraintTolerance(CONSTRAINT_TOLERANCE)
+    return ig, evals, leapfrog
+
+
+def make_context(scene: BenchScene, integrator, platform: str, threads: int = 1):
+    plat = mm.Platform.getPlatformByName(platform)
+    return mm.Context(scene.system, integrator, plat, platform_properties(platform, threads))
+
+
+def set_initial_state(ctx, scene: BenchScene, x0, v0, h_ps: float, leapfrog: bool):
+    ctx.setPositions(x0)
+    if leapfrog:
+        f = ctx.getState(getForces=True).getForces(asNumpy=True).value_in_unit(
+            unit.kilojoule_per_mole / unit.nanometer)
+        m = scene.masses()
+        inv = np.where(m > 0, 1.0 / np.where(m > 0, m, 1.0), 0.0)
+        v0 = v0 - 0.5 * h_ps * np.asarray(f) * inv[:, None]
+    ctx.setVelocities(v0)
+    if leapfrog and scene.system.getNumConstraints():
+        ctx.applyVelocityConstraints(CONSTRAINT_TOLERANCE)
+
+
+def _base_record(spec: RunSpec, scene: BenchScene, platform: str) -> dict:
+    rec = spec.to_dict()
+    rec.update(label=label(spec.method), platform=platform, length_ps=spec.length_ps, n_atoms=scene.n_atoms,
+               n_dof=scene.n_dof, status="ok", failed=False, failure=None, fail_time_ps=None, steps_done=0,
+               force_evals_per_step=None, force_evals_per_ps=None, energy_error=None, energy_error_per_dof=None,
+               drift_per_ns_per_dof=None, dP=None, dL_rel=None, constraint_error=None, traj_error=None,
+               wall_per_step=None, wall_per_ps=None, timing_steps=0, trace_t=[], trace_de_per_dof=[],
+               E0=None, setup_s=None)
+    return rec
+
+
+def _failure(rec, reason, t):
+    if not rec["failed"]:
+        rec.update(failed=True, failure=reason, fail_time_ps=t, status="failed")
+
+
+def execute(spec: RunSpec, scene: BenchScene) -> tuple[dict, dict]:
+    """Run ``spec`` on ``scene``; returns (record, arrays).  ``arrays`` holds the final positions of
+    molecular accuracy runs (for the trajectory error against the reference), else it is empty."""
+    if spec.role == "linear-probe":
+        from .stability import linear_probe
+
+        return linear_probe(spec, scene), {}
+    platform = spec.platform or scene.platform
+    rec = _base_record(spec, scene, platform)
+    arrays = {}
+    t_setup = time.perf_counter()
+    try:
+        ig, evals, leapfrog = make_integrator(spec.method, spec.h_ps, scene, spec.seed)
+        rec["force_evals_per_step"] = evals
+        rec["force_evals_per_ps"] = evals / spec.h_ps
+        ctx = make_context(scene, ig, platform, spec.threads)
+        set_initial_state(ctx, scene, scene.positions, scene.velocities, spec.h_ps, leapfrog)
+    except Unsupported as exc:
+        rec.update(status="unsupported", failure=str(exc).split(". ")[0])
+        return rec, arrays
+    except Exception as exc:  # a broken run is a record, never a crashed sweep
+        rec.update(status="error", failure=f"{type(exc).__name__}: {exc}", traceback=traceback.format_exc())
+        return rec, arrays
+    rec["setup_s"] = time.perf_counter() - t_setup
+    try:
+        _measure(spec, scene, ctx, ig, rec, arrays)
+    except Exception as exc:
+        if _is_blowup(exc):
+            _failure(rec, f"blow-up: {_short(exc)}", rec["steps_done"] * spec.h_ps)
+        else:
+            rec.update(status="error", failure=f"{type(exc).__name__}: {exc}", traceback=traceback.format_exc())
+    finally:
+        del ctx
+    return rec, arrays
+
+
+def _is_blowup(exc) -> bool:
+    from ..integrators import SimulationBlowUpError
+
+    return isinstance(exc, (SimulationBlowUpError, FloatingPointError)) or (
+        isinstance(exc, mm.OpenMMException) and "nan" in str(exc).lower())
+
+
+def _short(exc) -> str:
+    return str(exc).split(":")[-1 if isinstance(exc, mm.OpenMMException) else 0].split(".")[0].strip()[:120]
+
+
+def _measure(spec, scene, ctx, ig, rec, arrays):
+    m = scene.masses()
+    cons = scene.constraints()
+    n_dof = scene.n_dof
+    inv = set(scene.invariants)
+    x, v, e0 = measure.read_state(ctx)
+    p0, l0 = measure.momentum(v, m), measure.angular_momentum(x, v, m)
+    rec["E0"] = e0
+    threshold = ENERGY_THRESHOLD_KT * KT300 * n_dof
+    stop_early = spec.role == "probe"
+    ts, des = [0.0], [0.0]
+    worst_e = worst_p = worst_l = worst_c = 0.0
+    marks = sorted({max(1, round(k * spec.n_steps / spec.n_samples)) for k in range(1, spec.n_samples + 1)})
+    done = 0
+    t_loop = time.perf_counter()
+    for mark in marks:
+        ig.step(mark - done)
+        done = mark
+        rec["steps_done"] = done
+        t = done * spec.h_ps
+        x, v, e = measure.read_state(ctx)
+        if not measure.finite(x, v, e) or np.max(np.abs(v)) > SPEED_LIMIT:
+            _failure(rec, "blow-up: non-finite or runaway state", t)
+            break
+        de = e - e0
+        ts.append(t)
+        des.append(de / n_dof)
+        worst_e = max(worst_e, abs(de))
+        if "momentum" in inv:
+            worst_p = max(worst_p, float(np.linalg.norm(measure.momentum(v, m) - p0)))
+        if "angular_momentum" in inv:
+            worst_l = max(worst_l, float(np.linalg.norm(measure.angular_momentum(x, v, m) - l0) / np.linalg.norm(l0)))
+        worst_c = max(worst_c, measure.constraint_error(x, cons))
+        if spec.method != "openmm-langevin" and "energy" in inv and abs(de) > threshold:
+            _failure(rec, f"energy error above {ENERGY_THRESHOLD_KT:g} kT per DOF", t)
+        if worst_c > CONSTRAINT_THRESHOLD:
+            _failure(rec, f"constraint error above {CONSTRAINT_THRESHOLD:g}", t)
+        if rec["failed"] and stop_early:
+            break
+    loop_s = time.perf_counter() - t_loop
+    rec.update(energy_error=worst_e, energy_error_per_dof=worst_e / n_dof,
+               drift_per_ns_per_dof=measure.drift_rate(ts, des) * 1e3,
+               dP=worst_p if "momentum" in inv else None,
+               dL_rel=worst_l if "angular_momentum" in inv else None,
+               constraint_error=worst_c, trace_t=ts, trace_de_per_dof=des)
+    completed = done == spec.n_steps and not (rec["failure"] or "").startswith("blow-up")
+    if completed:
+        if scene.exact is not None:
+            from .toys import exact_state
+
+            xe, _ = exact_state(scene.exact, spec.length_ps)
+            rec["traj_error"] = measure.rms_deviation(x, xe)
+        elif scene.purpose == "accuracy" and spec.role in ("run", "reference"):
+            arrays["positions"] = x
+    if spec.timing_s > 0 and completed and done:
+        per_step = loop_s / done
+        n_time = int(min(max(10, math.ceil(spec.timing_s / max(per_step, 1e-9))), max(10, spec.n_steps)))
+        try:
+            t0 = time.perf_counter()
+            ig.step(n_time)
+            wall = time.perf_counter() - t0
+            rec.update(wall_per_step=wall / n_time, wall_per_ps=wall / n_time / spec.h_ps, timing_steps=n_time)
+        except Exception as exc:
+            if not _is_blowup(exc):
+                raise
