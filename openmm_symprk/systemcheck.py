@@ -41,8 +41,8 @@ def conservation_issues(system: mm.System) -> list:
                        "the System has virtual sites: OpenMM's CustomIntegrator (8.6) moves them only at the "
                        "end of each step, so forces evaluated inside a step (every kick after a drift) see "
                        "virtual sites one drift behind. Energy and momenta are then conserved only to the "
-                       "size of that lag (measured: 55% change of L in 400 steps for a charged site). Models "
-                       "without virtual sites (TIP3P, SPC/E) are not affected."))
+                       "size of that lag (measured: |dL|/|L| ~ 3e-2 after 400 steps of 8 TIP4P-Ew waters). "
+                       "Models without virtual sites (TIP3P, SPC/E) are not affected."))
     if system.usesPeriodicBoundaryConditions():
         issues.append(("periodic",
                        "the System is periodic: periodic boundary conditions break rotational symmetry, "
