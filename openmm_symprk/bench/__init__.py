@@ -13,12 +13,10 @@ from __future__ import annotations
 
 
 def __getattr__(name):  # keep ``import openmm_symprk.bench`` light: load on first use
+    import importlib
+
     if name == "run_sweep":
-        from .sweep import run_sweep
-
-        return run_sweep
+        return importlib.import_module(".sweep", __name__).run_sweep
     if name == "presets":
-        from . import presets
-
-        return presets
+        return importlib.import_module(".presets", __name__)
     raise AttributeError(name)

@@ -141,13 +141,16 @@ def _base_record(spec: RunSpec, scene: BenchScene, platform: str) -> dict:
                force_evals_per_step=None, force_evals_per_ps=None, energy_error=None, energy_error_per_dof=None,
                drift_per_ns_per_dof=None, dP=None, dL_rel=None, constraint_error=None, traj_error=None,
                wall_per_step=None, wall_per_ps=None, timing_steps=0, trace_t=[], trace_de_per_dof=[],
-               E0=None, setup_s=None)
+               E0=None, setup_s=None, blew_up=False)
     return rec
 
 
 def _failure(rec, reason, t):
+    """Record the first failure; a later blow-up is appended to it."""
     if not rec["failed"]:
         rec.update(failed=True, failure=reason, fail_time_ps=t, status="failed")
+    elif reason.startswith("blow-up") and "blow-up" not in rec["failure"]:
+        rec["failure"] += f"; then {reason} at {t:.4g} ps"
 
 
 def execute(spec: RunSpec, scene: BenchScene) -> tuple[dict, dict]:
@@ -177,8 +180,9 @@ def execute(spec: RunSpec, scene: BenchScene) -> tuple[dict, dict]:
     try:
         _measure(spec, scene, ctx, ig, rec, arrays)
     except Exception as exc:
-        if _is_blowup(exc):
-            _failure(rec, f"blow-up: {_short(exc)}", rec["steps_done"] * spec.h_ps)
+        if _is_blowup(exc):  # e.g. in the timing segment
+            rec["blew_up"] = True
+            _failure(rec, _blowup_reason(exc), rec["steps_done"] * spec.h_ps)
         else:
             rec.update(status="error", failure=f"{type(exc).__name__}: {exc}", traceback=traceback.format_exc())
     finally:
@@ -193,8 +197,15 @@ def _is_blowup(exc) -> bool:
         isinstance(exc, mm.OpenMMException) and "nan" in str(exc).lower())
 
 
-def _short(exc) -> str:
-    return str(exc).split(":")[-1 if isinstance(exc, mm.OpenMMException) else 0].split(".")[0].strip()[:120]
+def _blowup_reason(exc) -> str:
+    import re
+
+    msg = str(exc)
+    if isinstance(exc, mm.OpenMMException):
+        return "blow-up: OpenMM reports NaN coordinates"
+    what = re.search(r": (velocities[^.]*?|positions[^.]*?)\. ", msg)
+    step = re.search(r"step (\d+)", msg)
+    return f"blow-up: {what.group(1) if what else 'non-finite state'}" + (f" (step {step.group(1)})" if step else "")
 
 
 def _measure(spec, scene, ctx, ig, rec, arrays):
@@ -213,12 +224,20 @@ def _measure(spec, scene, ctx, ig, rec, arrays):
     done = 0
     t_loop = time.perf_counter()
     for mark in marks:
-        ig.step(mark - done)
+        try:
+            ig.step(mark - done)
+        except Exception as exc:
+            if not _is_blowup(exc):
+                raise
+            rec["blew_up"] = True
+            _failure(rec, _blowup_reason(exc), (done + 1) * spec.h_ps)
+            break
         done = mark
         rec["steps_done"] = done
         t = done * spec.h_ps
         x, v, e = measure.read_state(ctx)
         if not measure.finite(x, v, e) or np.max(np.abs(v)) > SPEED_LIMIT:
+            rec["blew_up"] = True
             _failure(rec, "blow-up: non-finite or runaway state", t)
             break
         de = e - e0
@@ -242,7 +261,10 @@ def _measure(spec, scene, ctx, ig, rec, arrays):
                dP=worst_p if "momentum" in inv else None,
                dL_rel=worst_l if "angular_momentum" in inv else None,
                constraint_error=worst_c, trace_t=ts, trace_de_per_dof=des)
-    completed = done == spec.n_steps and not (rec["failure"] or "").startswith("blow-up")
+    if rec.get("blew_up"):
+        # the measured maxima only cover the samples before the blow-up: do not report them as errors
+        rec.update(energy_error=None, energy_error_per_dof=None, drift_per_ns_per_dof=None, dP=None, dL_rel=None)
+    completed = done == spec.n_steps and not rec.get("blew_up")
     if completed:
         if scene.exact is not None:
             from .toys import exact_state

@@ -215,3 +215,19 @@ def linear_settings(omega_max: float, rel_tol: float = 1e-4) -> dict:
 
 def finite_or_none(x):
     return x if x is not None and math.isfinite(x) else None
+
+
+def largest_stable_step(scene, method: str, settings: dict, platform=None) -> dict:
+    """Run one stability search in this process (no sweep, nothing stored); returns its summary.
+
+    ``settings`` as for :func:`driver`, e.g. ``linear_settings(700.0)`` on the harmonic scene."""
+    from .runs import execute
+
+    gen = driver(scene.name, method, settings, platform=platform)
+    spec = next(gen)
+    while True:
+        rec, _ = execute(spec, scene)
+        try:
+            spec = gen.send(rec)
+        except StopIteration as stop:
+            return stop.value

@@ -1,0 +1,166 @@
+"""From stored records to results: trajectory errors against the reference, wall-time ratios to
+OpenMM's VerletIntegrator, the cheapest method per accuracy, and the summary tables.
+
+* ``traj_error`` of a molecular run: RMS position difference (nm) at the final time from the reference
+  run (``reference.method`` at the smallest step / ``reference.factor``, same initial state).
+  ``reference_floor``: the same measure for the most accurate swept run of the reference method
+  itself, an upper bound of the reference's own error.
+* ``wall_vs_verlet``: wall time per ps divided by OpenMM VerletIntegrator's at the same step size, i.e.
+  wall time per step over the median per-step time of the ``openmm-verlet`` runs of the same scene in
+  the same sweep (so a failed Verlet run at one step size does not leave the others without a ratio).
+"""
+from __future__ import annotations
+
+import math
+import platform as _platform
+from statistics import median
+
+import numpy as np
+
+from .measure import rms_deviation
+from .runs import label
+
+#: Accuracy targets for "which method is cheapest": RMS trajectory error (nm).
+TRAJ_TARGETS = (1e-3, 1e-5, 1e-7)
+
+
+def aggregate(config, scenes, jobs, store) -> dict:
+    runs = [j.result for j in jobs if j.kind == "run" and j.result]
+    refs = {j.scene: j.result for j in jobs if j.kind == "reference" and j.result}
+    stab = [j.result for j in jobs if j.kind == "stability" and j.result]
+    for name, ref in refs.items():
+        ref_x = (store.arrays(ref["key"]) or {}).get("positions")
+        ref["ref_ok"] = ref_x is not None and ref.get("status") == "ok"
+        for r in runs:
+            if r["scene"] == name and r.get("has_arrays") and ref_x is not None:
+                x = (store.arrays(r["key"]) or {}).get("positions")
+                if x is not None:
+                    r["traj_error"] = rms_deviation(x, ref_x)
+    for name in {r["scene"] for r in runs}:
+        verlet = [r["wall_per_step"] for r in runs if r["scene"] == name and r["method"] == "openmm-verlet"
+                  and r.get("wall_per_step")]
+        base = median(verlet) if verlet else None
+        for r in runs:
+            if r["scene"] == name:
+                r["wall_vs_verlet"] = (r["wall_per_step"] / base) if (base and r.get("wall_per_step")) else None
+    for name, ref in refs.items():
+        own = [r["traj_error"] for r in runs if r["scene"] == name and r["method"] == ref["method"]
+               and r.get("traj_error") is not None]
+        ref["reference_floor"] = min(own) if own else None
+    scene_info = {}
+    for name, sc in scenes.items():
+        scene_info[name] = {"description": sc.description, "why": sc.why, "n_atoms": sc.n_atoms, "n_dof": sc.n_dof,
+                            "constraints": sc.system.getNumConstraints(), "platform": sc.platform,
+                            "purpose": sc.purpose, "invariants": list(sc.invariants),
+                            "exact": sc.exact is not None, "omega_max": (sc.linear or {}).get("omega_max"),
+                            "settings": {k: v for k, v in config["scenes"][name].items() if k != "params"}}
+    import openmm
+
+    return {"config": config, "machine": {"python": _platform.python_version(), "openmm": openmm.__version__,
+                                          "cpu": _platform.processor() or _platform.machine(),
+                                          "cores": _cores()},
+            "scenes": scene_info, "runs": runs, "references": list(refs.values()), "stability": stab,
+            "best": best_at_accuracy(runs)}
+
+
+def _cores():
+    import os
+
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:
+        return os.cpu_count()
+
+
+def usable(r) -> bool:
+    """A run whose error counts: it finished and did not fail."""
+    return r.get("status") == "ok" and not r.get("failed")
+
+
+def best_at_accuracy(runs, targets=TRAJ_TARGETS) -> dict:
+    """Per scene and target: the cheapest usable run (force evaluations per ps) reaching the target."""
+    out = {}
+    for name in sorted({r["scene"] for r in runs}):
+        rows = [r for r in runs if r["scene"] == name and usable(r) and r.get("traj_error") is not None
+                and r["method"] != "openmm-langevin"]
+        per = {}
+        for t in targets:
+            ok = [r for r in rows if r["traj_error"] <= t]
+            if ok:
+                b = min(ok, key=lambda r: (r["force_evals_per_ps"], r["wall_per_ps"] or math.inf))
+                per[f"{t:g}"] = {"method": b["method"], "step_fs": b["step_fs"],
+                                 "force_evals_per_ps": b["force_evals_per_ps"], "traj_error": b["traj_error"]}
+            else:
+                per[f"{t:g}"] = None
+        out[name] = per
+    return out
+
+
+def _fmt(x, spec=".2e"):
+    if x is None or (isinstance(x, float) and not math.isfinite(x)):
+        return "-"
+    return format(x, spec)
+
+
+def format_runs(results, scene) -> str:
+    rows = [r for r in results["runs"] if r["scene"] == scene]
+    head = (f"{'method':22s} {'h/fs':>5s} {'f/ps':>8s} {'wall s/ps':>9s} {'xVerlet':>7s} {'traj err':>9s} "
+            f"{'max|dE|/dof':>11s} {'drift/ns/dof':>12s} {'|dL|/|L|':>9s} {'|dP|':>9s} {'constr':>8s}  status")
+    lines = [head, "-" * len(head)]
+    for r in sorted(rows, key=lambda r: (r["step_fs"], r["force_evals_per_ps"] or 0, r["method"])):
+        status = r["status"] if not r.get("failed") else f"FAILED: {r['failure']}"
+        if r["status"] in ("unsupported", "error"):
+            status = f"{r['status']}: {r['failure']}"
+        lines.append(
+            f"{label(r['method']):22s} {r['step_fs']:5g} {_fmt(r.get('force_evals_per_ps'), '8.0f'):>8s} "
+            f"{_fmt(r.get('wall_per_ps'), '9.3g'):>9s} {_fmt(r.get('wall_vs_verlet'), '7.2f'):>7s} "
+            f"{_fmt(r.get('traj_error')):>9s} {_fmt(r.get('energy_error_per_dof')):>11s} "
+            f"{_fmt(r.get('drift_per_ns_per_dof'), '12.2e'):>12s} {_fmt(r.get('dL_rel')):>9s} {_fmt(r.get('dP')):>9s} "
+            f"{_fmt(r.get('constraint_error'), '8.1e'):>8s}  {status}")
+    return "\n".join(lines)
+
+
+def format_stability(results) -> str:
+    rows = results["stability"]
+    if not rows:
+        return "(no stability searches)"
+    head = (f"{'scene':15s} {'method':22s} {'stable h/fs':>11s} {'fails at':>9s} {'f/step':>6s} "
+            f"{'h/f (fs)':>8s} {'h*w':>8s} {'catalogue':>9s}  failure")
+    lines = [head, "-" * len(head)]
+    for s in rows:
+        lines.append(f"{s['scene']:15s} {label(s['method']):22s} {_fmt(s['h_stable_fs'], '11.4f'):>11s} "
+                     f"{_fmt(s['h_fail_fs'], '9.4f'):>9s} {_fmt(s.get('force_evals_per_step'), '6d'):>6s} "
+                     f"{_fmt(s.get('stable_fs_per_eval'), '8.3f'):>8s} {_fmt(s.get('x_stable'), '8.4f'):>8s} "
+                     f"{_fmt(s.get('catalogue'), '9.4f'):>9s}  {s['failure'] or ''}")
+    return "\n".join(lines)
+
+
+def format_best(results) -> str:
+    lines = [f"Cheapest run (force evaluations per ps) reaching an RMS trajectory error at the final time:"]
+    for scene, per in results["best"].items():
+        parts = []
+        for t, b in per.items():
+            parts.append(f"<= {t} nm: " + (f"{b['method']} at {b['step_fs']:g} fs ({b['force_evals_per_ps']:.0f}/ps)"
+                                          if b else "none"))
+        lines.append(f"  {scene:15s} " + "; ".join(parts))
+    return "\n".join(lines)
+
+
+def format_summary(results) -> str:
+    out = [f"symprk bench ({results['config']['mode']}): OpenMM {results['machine']['openmm']}, "
+           f"{results['machine']['cores']} cores"]
+    for name, info in results["scenes"].items():
+        ref = next((r for r in results["references"] if r["scene"] == name), None)
+        src = "exact solution" if info["exact"] else (
+            f"reference {ref['method']} at {ref['step_fs']:.4g} fs (floor {_fmt(ref.get('reference_floor'))} nm)"
+            if ref else "no trajectory reference")
+        out += ["", f"== {name}: {info['description']} [{info['platform']}; errors vs {src}]",
+                format_runs(results, name)]
+    out += ["", "== largest stable step", format_stability(results), "", format_best(results)]
+    return "\n".join(out)
+
+
+def traces(results, scene, step_fs):
+    """{label: (t, dE per dof)} of the runs of ``scene`` at ``step_fs``."""
+    return {label(r["method"]): (np.array(r["trace_t"]), np.array(r["trace_de_per_dof"]))
+            for r in results["runs"] if r["scene"] == scene and r["step_fs"] == step_fs and r.get("trace_t")}
