@@ -174,7 +174,7 @@ class PRKIntegrator(mm.CustomIntegrator):
     def describe(self) -> str:
         info = self.program_info
         lines = [f"{type(self).__name__}: {self.method_name}, step {self.getStepSize()}",
-                 f"  program: {info.kind}, {info.stages} stages, constraints={'RATTLE' if info.constraints else 'none'}, "
+                 f"  program: {info.kind}, {info.stages} {'kicks and drifts' if info.kind == 'splitting' else 'stages'}, constraints={'RATTLE' if info.constraints else 'none'}, "
                  f"force evaluations per step: {info.force_evals}, exact momentum: {info.exact_momentum}",
                  f"  {self.tableau.summary()}"]
         lines += [f"  {n}" for n in info.notes]
