@@ -1,0 +1,186 @@
+/* openmm_symprk native plugin: the Common compute framework SymPRKIntegrator kernel. */
+
+#include "CommonSymPRKKernels.h"
+#include "openmm/common/ContextSelector.h"
+#include "openmm/common/IntegrationUtilities.h"
+#include "openmm/OpenMMException.h"
+#include "openmm/internal/ContextImpl.h"
+#include <algorithm>
+#include <climits>
+#include <map>
+
+using namespace OpenMM;
+using namespace std;
+
+void CommonIntegrateSymPRKStepKernel::initialize(const System& system, const SymPRKIntegrator& integrator) {
+    cc.initializeContexts();
+    ContextSelector selector(cc);
+    hasConstraints = (system.getNumConstraints() > 0);
+    projectionBlockSize = 1;
+    while (projectionBlockSize*2 <= min(256, cc.getMaxThreadBlockSize()))
+        projectionBlockSize *= 2;
+    map<string, string> defines;
+    defines["NUM_ATOMS"] = cc.intToString(cc.getNumAtoms());
+    defines["PADDED_NUM_ATOMS"] = cc.intToString(cc.getPaddedNumAtoms());
+    defines["WORK_GROUP_SIZE"] = cc.intToString(projectionBlockSize);
+    ComputeProgram program = cc.compileProgram(CommonSymPRKKernelSources::symprk, defines);
+    kickKernel = program->createKernel("symprkKick");
+    kickProjectedKernel = program->createKernel("symprkKickProjected");
+    driftKernel = program->createKernel("symprkDrift");
+    driftDeltaKernel = program->createKernel("symprkDriftDelta");
+    driftApplyKernel = program->createKernel("symprkDriftApply");
+    projectionKernel = program->createKernel("symprkProjection");
+    bool useDouble = (cc.getUseDoublePrecision() || cc.getUseMixedPrecision());
+    projection.initialize(cc, 9, useDouble ? sizeof(double) : sizeof(float), "symprkProjection");
+    badStep.initialize<int>(cc, 1, "symprkBadStep");
+    int zero = 0;
+    badStep.upload(&zero);
+    if (blowUpStep != 0)
+        setBlowUpStep(*cc.getContextImpl(), blowUpStep);
+}
+
+void CommonIntegrateSymPRKStepKernel::setMixedArg(ComputeKernel& kernel, int index, double value) {
+    if (cc.getUseDoublePrecision() || cc.getUseMixedPrecision())
+        kernel->setArg(index, value);
+    else
+        kernel->setArg(index, (float) value);
+}
+
+void CommonIntegrateSymPRKStepKernel::execute(ContextImpl& context, const SymPRKIntegrator& integrator, bool& forcesAreValid, long long stepIndex) {
+    ContextSelector selector(cc);
+    IntegrationUtilities& integration = cc.getIntegrationUtilities();
+    const int numAtoms = cc.getNumAtoms();
+    const bool mixed = cc.getUseMixedPrecision();
+    if (!hasInitializedKernels) {
+        hasInitializedKernels = true;
+        // Arguments set per sub-step: the coefficient (index 0) and the check step.
+        kickKernel->addArg();
+        kickKernel->addArg(cc.getVelm());
+        kickKernel->addArg(cc.getLongForceBuffer());
+        kickKernel->addArg(0);
+        kickKernel->addArg(badStep);
+        kickProjectedKernel->addArg();
+        kickProjectedKernel->addArg(cc.getVelm());
+        kickProjectedKernel->addArg(cc.getLongForceBuffer());
+        kickProjectedKernel->addArg(cc.getPosq());
+        if (mixed)
+            kickProjectedKernel->addArg(cc.getPosqCorrection());
+        else
+            kickProjectedKernel->addArg(nullptr);
+        kickProjectedKernel->addArg(projection);
+        kickProjectedKernel->addArg(0);
+        kickProjectedKernel->addArg(badStep);
+        driftKernel->addArg();
+        driftKernel->addArg(cc.getPosq());
+        if (mixed)
+            driftKernel->addArg(cc.getPosqCorrection());
+        else
+            driftKernel->addArg(nullptr);
+        driftKernel->addArg(cc.getVelm());
+        driftDeltaKernel->addArg();
+        driftDeltaKernel->addArg(cc.getVelm());
+        driftDeltaKernel->addArg(integration.getPosDelta());
+        driftApplyKernel->addArg();
+        driftApplyKernel->addArg(cc.getPosq());
+        if (mixed)
+            driftApplyKernel->addArg(cc.getPosqCorrection());
+        else
+            driftApplyKernel->addArg(nullptr);
+        driftApplyKernel->addArg(cc.getVelm());
+        driftApplyKernel->addArg(integration.getPosDelta());
+        driftApplyKernel->addArg(0);
+        driftApplyKernel->addArg(badStep);
+        projectionKernel->addArg(cc.getPosq());
+        if (mixed)
+            projectionKernel->addArg(cc.getPosqCorrection());
+        else
+            projectionKernel->addArg(nullptr);
+        projectionKernel->addArg(cc.getVelm());
+        projectionKernel->addArg(cc.getLongForceBuffer());
+        projectionKernel->addArg(projection);
+    }
+    const double dt = integrator.getStepSize();
+    const double tol = integrator.getConstraintTolerance();
+    const int groups = integrator.getIntegrationForceGroups();
+    const bool exact = integrator.getExactMomentum();
+    const int numSubsteps = integrator.getNumSubsteps();
+    integration.setNextStepSize(dt);
+
+    // The velocities are checked for a blow-up in the last sub-step that changes them.
+    int lastVelocityStep = -1;
+    for (int s = 0; s < numSubsteps; s++)
+        if (integrator.getSubstepKind(s) == SymPRKIntegrator::Kick || hasConstraints)
+            lastVelocityStep = s;
+    const int check = (int) min(stepIndex, (long long) INT_MAX);
+
+    if (context.updateContextState())
+        forcesAreValid = false;
+    for (int s = 0; s < numSubsteps; s++) {
+        const double cdt = integrator.getSubstepCoefficient(s)*dt;
+        const int checkStep = (s == lastVelocityStep && blowUpStep == 0 ? check : 0);
+        if (integrator.getSubstepKind(s) == SymPRKIntegrator::Kick) {
+            if (!forcesAreValid || context.getLastForceGroups() != groups) {
+                ContextDeselector deselector(cc);
+                context.calcForcesAndEnergy(true, false, groups);
+                forcesAreValid = true;
+            }
+            if (exact) {
+                projectionKernel->execute(projectionBlockSize, projectionBlockSize);
+                setMixedArg(kickProjectedKernel, 0, cdt);
+                kickProjectedKernel->setArg(6, checkStep);
+                kickProjectedKernel->execute(numAtoms);
+            }
+            else {
+                setMixedArg(kickKernel, 0, cdt);
+                kickKernel->setArg(3, checkStep);
+                kickKernel->execute(numAtoms);
+            }
+        }
+        else {
+            if (hasConstraints) {
+                setMixedArg(driftDeltaKernel, 0, cdt);
+                driftDeltaKernel->execute(numAtoms);
+                integration.applyConstraints(tol);
+                setMixedArg(driftApplyKernel, 0, cdt);
+                driftApplyKernel->setArg(5, checkStep);
+                driftApplyKernel->execute(numAtoms);
+            }
+            else {
+                setMixedArg(driftKernel, 0, cdt);
+                driftKernel->execute(numAtoms);
+            }
+            integration.computeVirtualSites();
+            forcesAreValid = false;
+        }
+    }
+    if (hasConstraints)
+        integration.applyVelocityConstraints(tol);
+    cc.setTime(cc.getTime()+dt);
+    cc.setStepCount(cc.getStepCount()+1);
+    cc.reorderAtoms();
+    if (cc.getAtomsWereReordered())
+        forcesAreValid = false;
+}
+
+double CommonIntegrateSymPRKStepKernel::computeKineticEnergy(ContextImpl& context, const SymPRKIntegrator& integrator) {
+    return cc.getIntegrationUtilities().computeKineticEnergy(0.0);
+}
+
+long long CommonIntegrateSymPRKStepKernel::getBlowUpStep(ContextImpl& context) {
+    if (blowUpStep == 0 && badStep.isInitialized()) {
+        ContextSelector selector(cc);
+        int value;
+        badStep.download(&value);
+        blowUpStep = value;
+    }
+    return blowUpStep;
+}
+
+void CommonIntegrateSymPRKStepKernel::setBlowUpStep(ContextImpl& context, long long step) {
+    blowUpStep = step;
+    if (badStep.isInitialized()) {
+        ContextSelector selector(cc);
+        int value = (int) min(step, (long long) INT_MAX);
+        badStep.upload(&value);
+    }
+}

@@ -1,0 +1,243 @@
+/**
+ * openmm_symprk native plugin: device code of the SymPRKIntegrator step, written in OpenMM's common compute
+ * language (compiled at run time for OpenCL, CUDA or HIP).
+ *
+ * Host defines: NUM_ATOMS, PADDED_NUM_ATOMS, WORK_GROUP_SIZE (the projection reduction's block size).
+ * velm.w is the inverse mass (0 for massless particles, which are never moved).  Forces are the
+ * platform's 64-bit fixed-point accumulators (scaled by 2^32).  In mixed precision a position is
+ * posq + posqCorrection, rebuilt and split again around every update, as OpenMM's own integrators do.
+ */
+
+inline DEVICE mixed4 symprkLoadPos(GLOBAL const real4* RESTRICT posq, GLOBAL const real4* RESTRICT posqCorrection, int index) {
+#ifdef USE_MIXED_PRECISION
+    real4 p1 = posq[index];
+    real4 p2 = posqCorrection[index];
+    return make_mixed4(p1.x+(mixed) p2.x, p1.y+(mixed) p2.y, p1.z+(mixed) p2.z, p1.w);
+#else
+    return posq[index];
+#endif
+}
+
+inline DEVICE void symprkStorePos(GLOBAL real4* RESTRICT posq, GLOBAL real4* RESTRICT posqCorrection, int index, mixed4 pos) {
+#ifdef USE_MIXED_PRECISION
+    posq[index] = make_real4((real) pos.x, (real) pos.y, (real) pos.z, (real) pos.w);
+    posqCorrection[index] = make_real4(pos.x-(real) pos.x, pos.y-(real) pos.y, pos.z-(real) pos.z, 0);
+#else
+    posq[index] = pos;
+#endif
+}
+
+/** Record the step in *badStep if a velocity is NaN, infinite or beyond 1e5 nm/ps (NaN fails every <=). */
+inline DEVICE void symprkCheckVelocity(mixed4 v, int checkStep, GLOBAL int* RESTRICT badStep) {
+    if (checkStep > 0 && !(v.x*v.x+v.y*v.y+v.z*v.z <= (mixed) 1e10) && badStep[0] == 0)
+        badStep[0] = checkStep;
+}
+
+/** kick: v += (c*dt)*F/m. */
+KERNEL void symprkKick(mixed cdt, GLOBAL mixed4* RESTRICT velm, GLOBAL const mm_long* RESTRICT force,
+        int checkStep, GLOBAL int* RESTRICT badStep) {
+    const mixed scale = cdt/(mixed) 0x100000000;
+    for (int index = GLOBAL_ID; index < NUM_ATOMS; index += GLOBAL_SIZE) {
+        mixed4 v = velm[index];
+        if (v.w != 0) {
+            v.x += scale*force[index]*v.w;
+            v.y += scale*force[index+PADDED_NUM_ATOMS]*v.w;
+            v.z += scale*force[index+2*PADDED_NUM_ATOMS]*v.w;
+            velm[index] = v;
+            symprkCheckVelocity(v, checkStep, badStep);
+        }
+    }
+}
+
+/** kick with the exact-momentum projection: v += (c*dt)*(F/m - a_cm - alpha x (r - r_cm)). */
+KERNEL void symprkKickProjected(mixed cdt, GLOBAL mixed4* RESTRICT velm, GLOBAL const mm_long* RESTRICT force,
+        GLOBAL const real4* RESTRICT posq, GLOBAL const real4* RESTRICT posqCorrection, GLOBAL const mixed* RESTRICT projection,
+        int checkStep, GLOBAL int* RESTRICT badStep) {
+    const mixed fscale = 1/(mixed) 0x100000000;
+    const mixed3 com = make_mixed3(projection[0], projection[1], projection[2]);
+    const mixed3 acm = make_mixed3(projection[3], projection[4], projection[5]);
+    const mixed3 alpha = make_mixed3(projection[6], projection[7], projection[8]);
+    for (int index = GLOBAL_ID; index < NUM_ATOMS; index += GLOBAL_SIZE) {
+        mixed4 v = velm[index];
+        if (v.w != 0) {
+            mixed4 p = symprkLoadPos(posq, posqCorrection, index);
+            mixed3 r = make_mixed3(p.x-com.x, p.y-com.y, p.z-com.z);
+            mixed ax = fscale*force[index]*v.w - acm.x - (alpha.y*r.z - alpha.z*r.y);
+            mixed ay = fscale*force[index+PADDED_NUM_ATOMS]*v.w - acm.y - (alpha.z*r.x - alpha.x*r.z);
+            mixed az = fscale*force[index+2*PADDED_NUM_ATOMS]*v.w - acm.z - (alpha.x*r.y - alpha.y*r.x);
+            v.x += cdt*ax;
+            v.y += cdt*ay;
+            v.z += cdt*az;
+            velm[index] = v;
+            symprkCheckVelocity(v, checkStep, badStep);
+        }
+    }
+}
+
+/** drift without constraints: x += (c*dt)*v. */
+KERNEL void symprkDrift(mixed cdt, GLOBAL real4* RESTRICT posq, GLOBAL real4* RESTRICT posqCorrection, GLOBAL const mixed4* RESTRICT velm) {
+    for (int index = GLOBAL_ID; index < NUM_ATOMS; index += GLOBAL_SIZE) {
+        mixed4 v = velm[index];
+        if (v.w != 0) {
+            mixed4 p = symprkLoadPos(posq, posqCorrection, index);
+            p.x += cdt*v.x;
+            p.y += cdt*v.y;
+            p.z += cdt*v.z;
+            symprkStorePos(posq, posqCorrection, index, p);
+        }
+    }
+}
+
+/** drift with constraints, part 1: the unconstrained displacement (c*dt)*v, which the constraint algorithms
+ * then correct with the current (pre-drift) positions as reference. */
+KERNEL void symprkDriftDelta(mixed cdt, GLOBAL const mixed4* RESTRICT velm, GLOBAL mixed4* RESTRICT posDelta) {
+    for (int index = GLOBAL_ID; index < NUM_ATOMS; index += GLOBAL_SIZE) {
+        mixed4 v = velm[index];
+        if (v.w != 0)
+            posDelta[index] = make_mixed4(cdt*v.x, cdt*v.y, cdt*v.z, 0);
+        else
+            posDelta[index] = make_mixed4(0, 0, 0, 0);
+    }
+}
+
+/** drift with constraints, part 2: x += constrained displacement, v += (x - x_unconstrained)/(c*dt). */
+KERNEL void symprkDriftApply(mixed cdt, GLOBAL real4* RESTRICT posq, GLOBAL real4* RESTRICT posqCorrection,
+        GLOBAL mixed4* RESTRICT velm, GLOBAL const mixed4* RESTRICT posDelta, int checkStep, GLOBAL int* RESTRICT badStep) {
+#ifdef SUPPORTS_DOUBLE_PRECISION
+    const double invCdt = 1.0/(double) cdt;
+#else
+    const float invCdt = 1.0f/cdt;
+#endif
+    for (int index = GLOBAL_ID; index < NUM_ATOMS; index += GLOBAL_SIZE) {
+        mixed4 v = velm[index];
+        if (v.w != 0) {
+            mixed4 p = symprkLoadPos(posq, posqCorrection, index);
+            mixed4 d = posDelta[index];
+            p.x += d.x;
+            p.y += d.y;
+            p.z += d.z;
+            v.x += (mixed) ((d.x-cdt*v.x)*invCdt);
+            v.y += (mixed) ((d.y-cdt*v.y)*invCdt);
+            v.z += (mixed) ((d.z-cdt*v.z)*invCdt);
+            symprkStorePos(posq, posqCorrection, index, p);
+            velm[index] = v;
+            symprkCheckVelocity(v, checkStep, badStep);
+        }
+    }
+}
+
+/** Velocity check alone (used when the step ends with the velocity projection). */
+KERNEL void symprkCheck(GLOBAL const mixed4* RESTRICT velm, int checkStep, GLOBAL int* RESTRICT badStep) {
+    for (int index = GLOBAL_ID; index < NUM_ATOMS; index += GLOBAL_SIZE) {
+        mixed4 v = velm[index];
+        if (v.w != 0)
+            symprkCheckVelocity(v, checkStep, badStep);
+    }
+}
+
+DEVICE mixed symprkReduce(mixed value, LOCAL_ARG mixed* temp) {
+    SYNC_THREADS;
+    temp[LOCAL_ID] = value;
+    for (int i = 1; i < WORK_GROUP_SIZE; i *= 2) {
+        SYNC_THREADS;
+        if (LOCAL_ID%(i*2) == 0 && LOCAL_ID+i < WORK_GROUP_SIZE)
+            temp[LOCAL_ID] += temp[LOCAL_ID+i];
+    }
+    SYNC_THREADS;
+    return temp[0];
+}
+
+/**
+ * The exact-momentum projection, run as one block of WORK_GROUP_SIZE threads: centre of mass r_cm, net force,
+ * torque about r_cm and the inertia tensor about r_cm (sums in the mixed type: double in mixed and double
+ * precision), then projection[0..2] = r_cm, [3..5] = a_cm = F/M, [6..8] = alpha = I^-1 tau (I regularised by
+ * 1e-12 of its trace).  Massless particles are excluded.
+ */
+KERNEL void symprkProjection(GLOBAL const real4* RESTRICT posq, GLOBAL const real4* RESTRICT posqCorrection,
+        GLOBAL const mixed4* RESTRICT velm, GLOBAL const mm_long* RESTRICT force, GLOBAL mixed* RESTRICT projection) {
+    LOCAL mixed temp[WORK_GROUP_SIZE];
+    const mixed fscale = 1/(mixed) 0x100000000;
+    mixed m = 0, mx = 0, my = 0, mz = 0, fx = 0, fy = 0, fz = 0;
+    for (int index = LOCAL_ID; index < NUM_ATOMS; index += LOCAL_SIZE) {
+        mixed4 v = velm[index];
+        if (v.w != 0) {
+            mixed mass = 1/v.w;
+            mixed4 p = symprkLoadPos(posq, posqCorrection, index);
+            m += mass;
+            mx += mass*p.x;
+            my += mass*p.y;
+            mz += mass*p.z;
+            fx += fscale*force[index];
+            fy += fscale*force[index+PADDED_NUM_ATOMS];
+            fz += fscale*force[index+2*PADDED_NUM_ATOMS];
+        }
+    }
+    m = symprkReduce(m, temp);
+    mx = symprkReduce(mx, temp);
+    my = symprkReduce(my, temp);
+    mz = symprkReduce(mz, temp);
+    fx = symprkReduce(fx, temp);
+    fy = symprkReduce(fy, temp);
+    fz = symprkReduce(fz, temp);
+    if (m == 0) {
+        if (LOCAL_ID < 9)
+            projection[LOCAL_ID] = 0;
+        return;
+    }
+    const mixed cx = mx/m, cy = my/m, cz = mz/m;
+    mixed tx = 0, ty = 0, tz = 0, dxx = 0, dyy = 0, dzz = 0, oxy = 0, oxz = 0, oyz = 0;
+    for (int index = LOCAL_ID; index < NUM_ATOMS; index += LOCAL_SIZE) {
+        mixed4 v = velm[index];
+        if (v.w != 0) {
+            mixed mass = 1/v.w;
+            mixed4 p = symprkLoadPos(posq, posqCorrection, index);
+            mixed rx = p.x-cx, ry = p.y-cy, rz = p.z-cz;
+            mixed gx = fscale*force[index], gy = fscale*force[index+PADDED_NUM_ATOMS], gz = fscale*force[index+2*PADDED_NUM_ATOMS];
+            tx += ry*gz-rz*gy;
+            ty += rz*gx-rx*gz;
+            tz += rx*gy-ry*gx;
+            dxx += mass*rx*rx;
+            dyy += mass*ry*ry;
+            dzz += mass*rz*rz;
+            oxy += mass*rx*ry;
+            oxz += mass*rx*rz;
+            oyz += mass*ry*rz;
+        }
+    }
+    tx = symprkReduce(tx, temp);
+    ty = symprkReduce(ty, temp);
+    tz = symprkReduce(tz, temp);
+    dxx = symprkReduce(dxx, temp);
+    dyy = symprkReduce(dyy, temp);
+    dzz = symprkReduce(dzz, temp);
+    oxy = symprkReduce(oxy, temp);
+    oxz = symprkReduce(oxz, temp);
+    oyz = symprkReduce(oyz, temp);
+    if (LOCAL_ID == 0) {
+        mixed Ixx = dyy+dzz, Iyy = dxx+dzz, Izz = dxx+dyy;
+        mixed Ixy = -oxy, Ixz = -oxz, Iyz = -oyz;
+        mixed shift = (mixed) 1e-12*(Ixx+Iyy+Izz);
+        Ixx += shift;
+        Iyy += shift;
+        Izz += shift;
+        mixed axx = Iyy*Izz-Iyz*Iyz, ayy = Ixx*Izz-Ixz*Ixz, azz = Ixx*Iyy-Ixy*Ixy;
+        mixed axy = Ixz*Iyz-Izz*Ixy, axz = Ixy*Iyz-Iyy*Ixz, ayz = Ixy*Ixz-Ixx*Iyz;
+        mixed det = Ixx*axx+Ixy*axy+Ixz*axz;
+        projection[0] = cx;
+        projection[1] = cy;
+        projection[2] = cz;
+        projection[3] = fx/m;
+        projection[4] = fy/m;
+        projection[5] = fz/m;
+        if (det != 0) {
+            projection[6] = (axx*tx+axy*ty+axz*tz)/det;
+            projection[7] = (axy*tx+ayy*ty+ayz*tz)/det;
+            projection[8] = (axz*tx+ayz*ty+azz*tz)/det;
+        }
+        else {
+            projection[6] = 0;
+            projection[7] = 0;
+            projection[8] = 0;
+        }
+    }
+}

@@ -1,0 +1,108 @@
+#ifndef OPENMM_SYMPRK_INTEGRATOR_H_
+#define OPENMM_SYMPRK_INTEGRATOR_H_
+
+/* openmm_symprk native plugin: an Integrator that runs any explicit kick/drift splitting.
+ *
+ * One step is a sequence of sub-steps, each a kind and a coefficient c:
+ *   kick  (Kick = 0):  v += c*dt*F/m               (F/m projected when exact momentum is on)
+ *   drift (Drift = 1): x += c*dt*v                  (RATTLE when the System has constraints:
+ *                      positions constrained with the pre-drift positions as reference, then
+ *                      v += (x - x_unconstrained)/(c*dt))
+ * and, with constraints, one velocity projection at the end of the step.  Massless particles are
+ * never moved; virtual sites are placed before every force evaluation and at the end of the step.
+ * The forces of a closing kick stay valid and serve the next step's opening kick, so a step costs
+ * getForceEvaluationsPerStep() force evaluations in steady state.
+ *
+ * This is the same program openmm_symprk/program.py compiles into a CustomIntegrator, without the
+ * per-degree-of-freedom interpreter.
+ */
+
+#include "openmm/Integrator.h"
+#include "openmm/Kernel.h"
+#include "openmm/internal/windowsExport.h"
+#include <string>
+#include <vector>
+
+namespace OpenMM {
+
+class OPENMM_EXPORT SymPRKIntegrator : public Integrator {
+public:
+    enum SubstepKind {
+        Kick = 0,
+        Drift = 1
+    };
+    /**
+     * Create an integrator.  Without coefficients it is velocity Verlet (kick 1/2, drift 1, kick 1/2).
+     *
+     * @param stepSize  the step size (ps)
+     */
+    explicit SymPRKIntegrator(double stepSize);
+    /**
+     * Create an integrator running a given sub-step sequence (see setSubsteps()).
+     */
+    SymPRKIntegrator(double stepSize, const std::vector<int>& kinds, const std::vector<double>& coefficients);
+    /**
+     * Set the sub-step sequence: kinds[i] is Kick (0) or Drift (1), coefficients[i] the fraction of the
+     * step size.  Adjacent sub-steps of the same kind are merged and zero coefficients dropped.  Cannot
+     * be called once the integrator is bound to a Context.
+     */
+    void setSubsteps(const std::vector<int>& kinds, const std::vector<double>& coefficients);
+    int getNumSubsteps() const {
+        return kinds.size();
+    }
+    int getSubstepKind(int index) const;
+    double getSubstepCoefficient(int index) const;
+    /** Force evaluations per step in a long run (a closing kick's forces serve the next opening kick). */
+    int getForceEvaluationsPerStep() const;
+    /**
+     * Project the forces of every kick onto zero net force and zero net torque about the centre of mass
+     * (mass weighted, massless particles excluded), so that linear and angular momentum are conserved to
+     * round-off even where forces are summed in single precision.  Only meaningful for isolated systems.
+     */
+    bool getExactMomentum() const {
+        return exactMomentum;
+    }
+    void setExactMomentum(bool exact);
+    /** A free-form name (the catalogue method), kept in XML. */
+    const std::string& getMethodName() const {
+        return methodName;
+    }
+    void setMethodName(const std::string& name) {
+        methodName = name;
+    }
+    /** Steps taken since the integrator was bound to its Context (kept in checkpoints). */
+    long long getStepsTaken() const {
+        return stepsTaken;
+    }
+    /**
+     * The first step (1-based, counted like getStepsTaken()) at whose end some velocity was NaN, infinite
+     * or faster than 1e5 nm/ps; 0 if none.  Checked on the device at the end of every step.
+     */
+    long long getBlowUpStep() const;
+    void step(int steps);
+
+protected:
+    void initialize(ContextImpl& context);
+    void cleanup();
+    std::vector<std::string> getKernelNames();
+    void stateChanged(State::DataType changed);
+    double computeKineticEnergy();
+    bool kineticEnergyRequiresForce() const {
+        return false;
+    }
+    void createCheckpoint(std::ostream& stream) const;
+    void loadCheckpoint(std::istream& stream);
+
+private:
+    std::vector<int> kinds;
+    std::vector<double> coefficients;
+    bool exactMomentum, forcesAreValid;
+    std::string methodName;
+    long long stepsTaken;
+    mutable long long blowUpStep;
+    Kernel kernel;
+};
+
+} // namespace OpenMM
+
+#endif /*OPENMM_SYMPRK_INTEGRATOR_H_*/

@@ -1,0 +1,104 @@
+/* SWIG interface of the openmm_symprk native plugin (needs SWIG >= 4.4, like the openmm wheel's own). */
+%module(package="openmm_symprk.native") symprk_swig
+
+%import(module="openmm") "swig/OpenMMSwigHeaders.i"
+%include "swig/typemaps.i"
+%include "std_string.i"
+%include "std_vector.i"
+
+namespace std {
+  %template(vectori) vector<int>;
+  %template(vectord) vector<double>;
+};
+
+%{
+#include "OpenMM.h"
+#include "OpenMMAmoeba.h"
+#include "OpenMMDrude.h"
+#include "openmm/RPMDIntegrator.h"
+#include "openmm/RPMDMonteCarloBarostat.h"
+#include "openmm/SymPRKIntegrator.h"
+#include <exception>
+#include <string>
+
+/* Raise openmm.OpenMMException (what the openmm module raises) with the C++ message. */
+static void symprk_set_python_error(const char* what) {
+    PyObject* mod = PyImport_ImportModule("openmm");
+    PyObject* cls = (mod == NULL ? NULL : PyObject_GetAttrString(mod, "OpenMMException"));
+    if (cls == NULL) {
+        PyErr_Clear();
+        PyErr_SetString(PyExc_RuntimeError, what);
+    }
+    else
+        PyErr_SetString(cls, what);
+    Py_XDECREF(cls);
+    Py_XDECREF(mod);
+}
+%}
+
+%exception {
+    try {
+        $action
+    }
+    catch (std::exception& e) {
+        symprk_set_python_error(e.what());
+        SWIG_fail;
+    }
+}
+
+/* step() releases the GIL (a PythonForce re-acquires it for its callback). */
+%exception OpenMM::SymPRKIntegrator::step {
+    std::string symprk_error;
+    bool symprk_failed = false;
+    Py_BEGIN_ALLOW_THREADS
+    try {
+        $action
+    }
+    catch (std::exception& e) {
+        symprk_failed = true;
+        symprk_error = e.what();
+    }
+    Py_END_ALLOW_THREADS
+    if (symprk_failed) {
+        symprk_set_python_error(symprk_error.c_str());
+        SWIG_fail;
+    }
+}
+
+namespace OpenMM {
+
+class SymPRKIntegrator : public Integrator {
+public:
+    enum SubstepKind {
+        Kick = 0,
+        Drift = 1
+    };
+    explicit SymPRKIntegrator(double stepSize);
+    SymPRKIntegrator(double stepSize, const std::vector<int>& kinds, const std::vector<double>& coefficients);
+    void setSubsteps(const std::vector<int>& kinds, const std::vector<double>& coefficients);
+    int getNumSubsteps() const;
+    int getSubstepKind(int index) const;
+    double getSubstepCoefficient(int index) const;
+    int getForceEvaluationsPerStep() const;
+    bool getExactMomentum() const;
+    void setExactMomentum(bool exact);
+    const std::string& getMethodName() const;
+    void setMethodName(const std::string& name);
+    long long getStepsTaken() const;
+    long long getBlowUpStep() const;
+    void step(int steps);
+    %extend {
+        /** The same integrator seen as a SymPRKIntegrator (e.g. after XmlSerializer.deserialize). */
+        static OpenMM::SymPRKIntegrator& cast(OpenMM::Integrator& integrator) {
+            OpenMM::SymPRKIntegrator* p = dynamic_cast<OpenMM::SymPRKIntegrator*>(&integrator);
+            if (p == NULL)
+                throw OpenMM::OpenMMException("the integrator is not a SymPRKIntegrator");
+            return *p;
+        }
+        static bool isinstance(OpenMM::Integrator& integrator) {
+            return dynamic_cast<OpenMM::SymPRKIntegrator*>(&integrator) != NULL;
+        }
+    }
+};
+
+}

@@ -1,0 +1,232 @@
+/* openmm_symprk native plugin: the Reference (and CPU) SymPRKIntegrator kernel.
+ *
+ * Arithmetic follows the CustomIntegrator program of openmm_symprk/program.py operation by operation, so
+ * that on Reference both give the same trajectory to round-off:
+ *   kick   v = v + (c*dt)*f/m
+ *   drift  x_ref = x;  x = x + (c*dt)*v;  [constraints] x_u = x;  constrain x against x_ref;
+ *          v = v + (x - x_u)/(c*dt)
+ *   end    [constraints] velocity projection against the final positions
+ */
+
+#include "ReferenceSymPRKKernels.h"
+#include "ReferenceConstraints.h"
+#include "ReferenceVirtualSites.h"
+#include "openmm/OpenMMException.h"
+#include "openmm/internal/ContextImpl.h"
+#include "openmm/internal/ThreadPool.h"
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+
+using namespace OpenMM;
+using namespace std;
+
+// Below this many particles the per-atom loops run on the calling thread: a loop over a few thousand atoms
+// takes microseconds, about what a hand-off to the pool costs.  SYMPRK_THREAD_MIN_ATOMS overrides it.
+static int threadThreshold() {
+    const char* env = getenv("SYMPRK_THREAD_MIN_ATOMS");
+    if (env != NULL)
+        return atoi(env);
+    return 8192;
+}
+
+void ReferenceIntegrateSymPRKStepKernel::initialize(const System& sys, const SymPRKIntegrator& integrator) {
+    system = &sys;
+    numParticles = sys.getNumParticles();
+    masses.resize(numParticles);
+    inverseMasses.resize(numParticles);
+    hasVirtualSites = false;
+    for (int i = 0; i < numParticles; i++) {
+        masses[i] = sys.getParticleMass(i);
+        inverseMasses[i] = (masses[i] == 0.0 ? 0.0 : 1.0/masses[i]);
+        if (sys.isVirtualSite(i))
+            hasVirtualSites = true;
+    }
+    hasConstraints = (sys.getNumConstraints() > 0);
+    xRef.resize(numParticles);
+    xUnconstrained.resize(numParticles);
+    int numThreads = data.threads.getNumThreads();
+    useThreads = (numThreads > 1 && numParticles >= threadThreshold());
+    int chunks = (useThreads ? numThreads : 1);
+    threadStart.resize(chunks+1);
+    for (int t = 0; t <= chunks; t++)
+        threadStart[t] = (int) (((long long) numParticles*t)/chunks);
+}
+
+void ReferenceIntegrateSymPRKStepKernel::parallelFor(const function<void(int, int, int)>& task) {
+    if (!useThreads) {
+        task(0, 0, numParticles);
+        return;
+    }
+    int chunks = threadStart.size()-1;
+    data.threads.execute([&] (ThreadPool& pool, int thread) {
+        if (thread < chunks)
+            task(thread, threadStart[thread], threadStart[thread+1]);
+    });
+    data.threads.waitForThreads();
+}
+
+void ReferenceIntegrateSymPRKStepKernel::computeProjection(const vector<Vec3>& pos, const vector<Vec3>& force) {
+    // Sums in double, in a fixed order (per-chunk partial sums added in chunk order): deterministic.
+    int chunks = threadStart.size()-1;
+    vector<double> mass(chunks, 0.0);
+    vector<Vec3> mx(chunks), fsum(chunks);
+    parallelFor([&] (int t, int start, int end) {
+        double m = 0;
+        Vec3 a, b;
+        for (int i = start; i < end; i++)
+            if (masses[i] != 0.0) {
+                m += masses[i];
+                a += pos[i]*masses[i];
+                b += force[i];
+            }
+        mass[t] = m;
+        mx[t] = a;
+        fsum[t] = b;
+    });
+    double totalMass = 0;
+    Vec3 moment, netForce;
+    for (int t = 0; t < chunks; t++) {
+        totalMass += mass[t];
+        moment += mx[t];
+        netForce += fsum[t];
+    }
+    if (totalMass == 0.0) {
+        com = acm = alpha = Vec3();
+        return;
+    }
+    com = moment/totalMass;
+    acm = netForce/totalMass;
+    vector<Vec3> torque(chunks), diag(chunks), offdiag(chunks);
+    parallelFor([&] (int t, int start, int end) {
+        Vec3 tau, d, o;
+        for (int i = start; i < end; i++)
+            if (masses[i] != 0.0) {
+                Vec3 r = pos[i]-com;
+                tau += r.cross(force[i]);
+                double m = masses[i];
+                d += Vec3(m*r[0]*r[0], m*r[1]*r[1], m*r[2]*r[2]);
+                o += Vec3(m*r[0]*r[1], m*r[0]*r[2], m*r[1]*r[2]);
+            }
+        torque[t] = tau;
+        diag[t] = d;
+        offdiag[t] = o;
+    });
+    Vec3 tau, d, o;
+    for (int t = 0; t < chunks; t++) {
+        tau += torque[t];
+        d += diag[t];
+        o += offdiag[t];
+    }
+    // Inertia tensor about the centre of mass, regularised by 1e-12 of its trace (a linear molecule or a single
+    // particle then gives a finite alpha; the shift changes a round-off-sized torque by 1e-12 of itself).
+    double Ixx = d[1]+d[2], Iyy = d[0]+d[2], Izz = d[0]+d[1];
+    double Ixy = -o[0], Ixz = -o[1], Iyz = -o[2];
+    double shift = 1e-12*(Ixx+Iyy+Izz);
+    Ixx += shift;
+    Iyy += shift;
+    Izz += shift;
+    double axx = Iyy*Izz-Iyz*Iyz, ayy = Ixx*Izz-Ixz*Ixz, azz = Ixx*Iyy-Ixy*Ixy;
+    double axy = Ixz*Iyz-Izz*Ixy, axz = Ixy*Iyz-Iyy*Ixz, ayz = Ixy*Ixz-Ixx*Iyz;
+    double det = Ixx*axx+Ixy*axy+Ixz*axz;
+    if (det == 0.0 || !std::isfinite(det))
+        alpha = Vec3();
+    else
+        alpha = Vec3(axx*tau[0]+axy*tau[1]+axz*tau[2], axy*tau[0]+ayy*tau[1]+ayz*tau[2], axz*tau[0]+ayz*tau[1]+azz*tau[2])/det;
+}
+
+void ReferenceIntegrateSymPRKStepKernel::execute(ContextImpl& context, const SymPRKIntegrator& integrator, bool& forcesAreValid, long long stepIndex) {
+    vector<Vec3>& pos = *data.positions;
+    vector<Vec3>& vel = *data.velocities;
+    vector<Vec3>& force = *data.forces;
+    const double dt = integrator.getStepSize();
+    const double tol = integrator.getConstraintTolerance();
+    const int groups = integrator.getIntegrationForceGroups();
+    const bool exact = integrator.getExactMomentum();
+    ReferenceConstraintAlgorithm& constraints = *data.constraints;
+    const ReferenceVirtualSites& vsites = *data.virtualSites;
+
+    if (context.updateContextState())
+        forcesAreValid = false;
+    const int numSubsteps = integrator.getNumSubsteps();
+    for (int s = 0; s < numSubsteps; s++) {
+        const double cdt = integrator.getSubstepCoefficient(s)*dt;
+        if (integrator.getSubstepKind(s) == SymPRKIntegrator::Kick) {
+            if (!forcesAreValid || context.getLastForceGroups() != groups) {
+                context.calcForcesAndEnergy(true, false, groups);
+                forcesAreValid = true;
+            }
+            if (exact) {
+                computeProjection(pos, force);
+                parallelFor([&] (int t, int start, int end) {
+                    for (int i = start; i < end; i++)
+                        if (masses[i] != 0.0) {
+                            Vec3 a = force[i]/masses[i] - acm - alpha.cross(pos[i]-com);
+                            vel[i] = vel[i] + a*cdt;
+                        }
+                });
+            }
+            else {
+                parallelFor([&] (int t, int start, int end) {
+                    for (int i = start; i < end; i++)
+                        if (masses[i] != 0.0)
+                            for (int j = 0; j < 3; j++)
+                                vel[i][j] = vel[i][j] + cdt*force[i][j]/masses[i];
+                });
+            }
+        }
+        else {
+            if (hasConstraints) {
+                parallelFor([&] (int t, int start, int end) {
+                    for (int i = start; i < end; i++) {
+                        xRef[i] = pos[i];
+                        if (masses[i] != 0.0)
+                            for (int j = 0; j < 3; j++)
+                                pos[i][j] = pos[i][j] + cdt*vel[i][j];
+                        xUnconstrained[i] = pos[i];
+                    }
+                });
+                constraints.apply(xRef, pos, inverseMasses, tol);
+                parallelFor([&] (int t, int start, int end) {
+                    for (int i = start; i < end; i++)
+                        if (masses[i] != 0.0)
+                            for (int j = 0; j < 3; j++)
+                                vel[i][j] = vel[i][j] + (pos[i][j]-xUnconstrained[i][j])/cdt;
+                });
+            }
+            else {
+                parallelFor([&] (int t, int start, int end) {
+                    for (int i = start; i < end; i++)
+                        if (masses[i] != 0.0)
+                            for (int j = 0; j < 3; j++)
+                                pos[i][j] = pos[i][j] + cdt*vel[i][j];
+                });
+            }
+            if (hasVirtualSites)
+                vsites.computePositions(*system, pos, data.periodicBoxVectors);
+            forcesAreValid = false;
+        }
+    }
+    if (hasConstraints)
+        constraints.applyToVelocities(pos, vel, inverseMasses, tol);
+
+    // Record the first step that leaves a velocity NaN, infinite or beyond 1e5 nm/ps (NaN fails every <=).
+    if (blowUpStep == 0) {
+        for (int i = 0; i < numParticles; i++)
+            if (!(vel[i].dot(vel[i]) <= 1e10)) {
+                blowUpStep = stepIndex;
+                break;
+            }
+    }
+    data.time += dt;
+    data.stepCount++;
+}
+
+double ReferenceIntegrateSymPRKStepKernel::computeKineticEnergy(ContextImpl& context, const SymPRKIntegrator& integrator) {
+    const vector<Vec3>& vel = *data.velocities;
+    double energy = 0.0;
+    for (int i = 0; i < numParticles; i++)
+        if (masses[i] != 0.0)
+            energy += masses[i]*vel[i].dot(vel[i]);
+    return 0.5*energy;
+}

@@ -1,0 +1,63 @@
+/* openmm_symprk native plugin: XML serialization of SymPRKIntegrator. */
+
+#include "openmm/serialization/SymPRKIntegratorProxy.h"
+#include "openmm/serialization/SerializationNode.h"
+#include "openmm/SymPRKIntegrator.h"
+#include "openmm/OpenMMException.h"
+#include <typeinfo>
+#include <vector>
+
+using namespace OpenMM;
+using namespace std;
+
+SymPRKIntegratorProxy::SymPRKIntegratorProxy() : SerializationProxy("SymPRKIntegrator") {
+}
+
+void SymPRKIntegratorProxy::serialize(const void* object, SerializationNode& node) const {
+    const SymPRKIntegrator& integrator = *reinterpret_cast<const SymPRKIntegrator*>(object);
+    node.setIntProperty("version", 1);
+    node.setDoubleProperty("stepSize", integrator.getStepSize());
+    node.setDoubleProperty("constraintTolerance", integrator.getConstraintTolerance());
+    node.setIntProperty("integrationForceGroups", integrator.getIntegrationForceGroups());
+    node.setBoolProperty("exactMomentum", integrator.getExactMomentum());
+    node.setStringProperty("method", integrator.getMethodName());
+    SerializationNode& substeps = node.createChildNode("Substeps");
+    for (int i = 0; i < integrator.getNumSubsteps(); i++) {
+        SerializationNode& s = substeps.createChildNode("Substep");
+        s.setStringProperty("kind", integrator.getSubstepKind(i) == SymPRKIntegrator::Kick ? "kick" : "drift");
+        s.setDoubleProperty("c", integrator.getSubstepCoefficient(i));
+    }
+}
+
+void* SymPRKIntegratorProxy::deserialize(const SerializationNode& node) const {
+    if (node.getIntProperty("version") != 1)
+        throw OpenMMException("SymPRKIntegrator: unsupported serialization version");
+    vector<int> kinds;
+    vector<double> coefficients;
+    for (const SerializationNode& s : node.getChildNode("Substeps").getChildren()) {
+        string kind = s.getStringProperty("kind");
+        if (kind == "kick")
+            kinds.push_back(SymPRKIntegrator::Kick);
+        else if (kind == "drift")
+            kinds.push_back(SymPRKIntegrator::Drift);
+        else
+            throw OpenMMException("SymPRKIntegrator: unknown sub-step kind '"+kind+"' in XML");
+        coefficients.push_back(s.getDoubleProperty("c"));
+    }
+    SymPRKIntegrator* integrator = new SymPRKIntegrator(node.getDoubleProperty("stepSize"), kinds, coefficients);
+    integrator->setConstraintTolerance(node.getDoubleProperty("constraintTolerance"));
+    integrator->setIntegrationForceGroups(node.getIntProperty("integrationForceGroups", 0xFFFFFFFF));
+    integrator->setExactMomentum(node.getBoolProperty("exactMomentum", false));
+    integrator->setMethodName(node.getStringProperty("method", ""));
+    return integrator;
+}
+
+#if defined(WIN32)
+    extern "C" __declspec(dllexport) void registerSymPRKSerializationProxies();
+#else
+    extern "C" void __attribute__((constructor)) registerSymPRKSerializationProxies();
+#endif
+
+extern "C" void registerSymPRKSerializationProxies() {
+    SerializationProxy::registerProxy(typeid(SymPRKIntegrator), new SymPRKIntegratorProxy());
+}
