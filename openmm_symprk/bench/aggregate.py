@@ -6,8 +6,10 @@ OpenMM's VerletIntegrator, the cheapest method per accuracy, and the summary tab
   ``reference_floor``: the same measure for the most accurate swept run of the reference method
   itself, an upper bound of the reference's own error.
 * ``wall_vs_verlet``: wall time per ps divided by OpenMM VerletIntegrator's at the same step size, i.e.
-  wall time per step over the median per-step time of the ``openmm-verlet`` runs of the same scene in
-  the same sweep (so a failed Verlet run at one step size does not leave the others without a ratio).
+  the ratio of per-step wall times.  Each run times itself and a VerletIntegrator on the same scene in
+  alternating calls (``wall_vs_verlet_paired``, see :func:`.runs._time`): that is the ratio reported.
+  Runs without it (older records) fall back to the median per-step time of the ``openmm-verlet`` runs
+  of the scene in the same sweep.
 """
 from __future__ import annotations
 
@@ -42,7 +44,8 @@ def aggregate(config, scenes, jobs, store) -> dict:
         base = median(verlet) if verlet else None
         for r in runs:
             if r["scene"] == name:
-                r["wall_vs_verlet"] = (r["wall_per_step"] / base) if (base and r.get("wall_per_step")) else None
+                r["wall_vs_verlet"] = r.get("wall_vs_verlet_paired") or (
+                    (r["wall_per_step"] / base) if (base and r.get("wall_per_step")) else None)
     for name, ref in refs.items():
         own = [r["traj_error"] for r in runs if r["scene"] == name and r["method"] == ref["method"]
                and r.get("traj_error") is not None]

@@ -12,8 +12,10 @@ the record.  What a record holds (units nm, ps, Da, kJ/mol):
 * ``traj_error``: RMS position error (nm) at the final time against the exact solution (toys); for the
   molecular scenes the sweep fills it in against the reference run (see :mod:`.sweep`).
 * ``force_evals_per_step`` (from ``integrator.program_info.force_evals``; OpenMM's integrators: 1) and
-  ``force_evals_per_ps``; ``wall_per_step`` and ``wall_per_ps`` (seconds) from a separate, uninterrupted
-  ``step(n)`` call after the measured segment (sampling clears OpenMM's force cache, so it is not timed).
+  ``force_evals_per_ps``; ``wall_per_step`` and ``wall_per_ps`` (seconds) from uninterrupted ``step(n)``
+  calls after the measured segment (sampling clears OpenMM's force cache, so it is not timed), alternated
+  with the same calls of OpenMM's VerletIntegrator on the same scene: ``wall_vs_verlet_paired`` is the
+  ratio of the two minima (see :func:`_time`).
 * ``failed`` / ``failure``: blow-up ("blow-up: ..."), energy error above the scene's threshold, or a
   constraint error above 1e-3 (see :mod:`.stability`); ``status`` is "ok", "failed", "unsupported"
   (the method cannot run this system, e.g. an implicit tableau with constraints) or "error".
@@ -274,13 +276,50 @@ def _measure(spec, scene, ctx, ig, rec, arrays):
         elif scene.purpose == "accuracy" and spec.role in ("run", "reference"):
             arrays["positions"] = x
     if spec.timing_s > 0 and completed and done:
-        per_step = loop_s / done
-        n_time = int(min(max(10, math.ceil(spec.timing_s / max(per_step, 1e-9))), max(10, spec.n_steps)))
-        try:
+        _time(spec, scene, ig, rec, loop_s / done)
+
+
+#: Timing: rounds of (this integrator, then OpenMM's VerletIntegrator); the minimum of each is kept.
+TIMING_ROUNDS = 2
+#: Step of the paired VerletIntegrator timing (its cost per step does not depend on the step size).
+VERLET_TIMING_STEP_FS = 0.5
+
+
+def _steps_for(seconds, per_step):
+    return int(min(100_000, max(10, math.ceil(seconds / max(per_step, 1e-9)))))
+
+
+def _time(spec, scene, ig, rec, per_step_estimate):
+    """Wall time per step of ``ig`` (continuing from where the measured run ended) and of a fresh OpenMM
+    VerletIntegrator on the same scene and platform, in alternating uninterrupted ``step(n)`` calls: the
+    minimum over TIMING_ROUNDS rounds of each is kept, so that load from other processes between the
+    calls cancels out of the ratio as far as it can."""
+    n_time = _steps_for(spec.timing_s / (2 * TIMING_ROUNDS), per_step_estimate)
+    platform = spec.platform or scene.platform
+    v_ig, _, _ = make_integrator("openmm-verlet", VERLET_TIMING_STEP_FS * 1e-3, scene)
+    v_ctx = make_context(scene, v_ig, platform, spec.threads)
+    set_initial_state(v_ctx, scene, scene.positions, scene.velocities, VERLET_TIMING_STEP_FS * 1e-3, True)
+    v_ig.step(2)  # warm up (kernels, force cache)
+    n_verlet = None
+    own, verlet = [], []
+    try:
+        for _ in range(TIMING_ROUNDS):
             t0 = time.perf_counter()
             ig.step(n_time)
-            wall = time.perf_counter() - t0
-            rec.update(wall_per_step=wall / n_time, wall_per_ps=wall / n_time / spec.h_ps, timing_steps=n_time)
-        except Exception as exc:
-            if not _is_blowup(exc):
-                raise
+            own.append((time.perf_counter() - t0) / n_time)
+            if n_verlet is None:
+                t0 = time.perf_counter()
+                v_ig.step(10)
+                n_verlet = _steps_for(spec.timing_s / (2 * TIMING_ROUNDS), (time.perf_counter() - t0) / 10)
+            t0 = time.perf_counter()
+            v_ig.step(n_verlet)
+            verlet.append((time.perf_counter() - t0) / n_verlet)
+    except Exception as exc:
+        if not _is_blowup(exc):
+            raise
+        return  # the run blew up while being timed: no timing
+    finally:
+        del v_ctx
+    best = min(own)
+    rec.update(wall_per_step=best, wall_per_ps=best / spec.h_ps, timing_steps=n_time * TIMING_ROUNDS,
+               verlet_wall_per_step=min(verlet), wall_vs_verlet_paired=best / min(verlet))
