@@ -13,6 +13,21 @@ orthogonal projection of F/m onto the complement of the rigid-body motions: it r
 net force and the net torque, and nothing else.  For forces with zero net force and torque it is the
 identity, so on Reference (double) the trajectory is unchanged to round-off.
 
+Constraint steps
+----------------
+On OpenCL/CUDA the SHAKE kernel for hydrogen clusters (HBonds constraints) moves the central and the
+peripheral atoms with inverse masses rounded to float, so its impulses do not cancel: P and L change
+by ~1e-8 relative per step even in double precision (measured on the villin scene).  In exact
+arithmetic a RATTLE drift (x += h v, SHAKE, v += (x - x_u)/h) changes P by sum m (x - x_u)/h and L by
+sum m x_old x (x - x_u)/h with x_old = x - h v, both zero.  :func:`emit_drift_restoration` removes
+their round-off values with a rigid-body velocity correction w + gamma x (r - r_cm) (which keeps every
+distance-constraint velocity condition, since (r_i - r_j).(gamma x (r_i - r_j)) = 0), and
+:func:`emit_constrain_velocities` does the same for the velocity projection at the end of a step.
+:func:`emit_projected_acceleration` applies the drift restoration by itself when the computation just
+before it is the compiler's RATTLE velocity correction ``v + (x - symprk_xu)/(c*dt)``; the
+end-of-step velocity projection needs the compiler to call :func:`emit_constrain_velocities` instead
+of ``addConstrainVelocities`` (a hook that :mod:`openmm_symprk.program` does not have yet).
+
 Precision
 ---------
 Exactness needs the net force and the torque summed precisely, from the same forces and masses the
@@ -27,16 +42,20 @@ therefore uses a per-DOF variable ``proj_mass`` holding the System's masses in d
 :func:`set_masses` (called with the System before the Context is created; the integrator keeps the
 values, and they survive XmlSerializer and checkpoints).  Where it is not filled (or disagrees with
 ``m`` by more than 1e-5 relative, e.g. after a mass change) the kick falls back to ``m``: still exact on
-Reference, CPU and OpenCL/CUDA double, but limited to ~1e-9 relative in P and L on mixed precision.
+Reference, CPU and OpenCL/CUDA double, but limited to ~1e-6 relative in L on mixed precision.
 
 Cost
 ----
 ``addComputeSum`` adds all three components of a per-DOF expression.  Components are selected by
-constant per-DOF selector vectors ``proj_ex/ey/ez`` = (1,0,0), (0,1,0), (0,0,1), so 15 of the 16 sums
-are plain scalar expressions (the CPU and Reference platforms evaluate vector functions such as
-``_x``, ``cross`` and ``vector`` on a slow interpreted path, ~4x a scalar pass); only the torque
-density, the permuted coordinates and the final acceleration use vector functions.  A full projection
-is 5 per-DOF passes and 16 sums (on OpenCL each sum is a kernel pair plus a download, ~30 us on PoCL).
+constant per-DOF selector vectors ``proj_ex/ey/ez`` = (1,0,0), (0,1,0), (0,0,1), and cross products are
+written with two cyclically permuted copies of x (xp = (y, z, x), xpp = (z, x, y)): (a x b) =
+a_p * b_pp - a_pp * b_p componentwise.  So every sum and every correction is a plain scalar
+expression; the CPU and Reference platforms evaluate vector functions (``_x``, ``cross``,
+``vector``) on a slow interpreted path, 4-10x a scalar pass, and only the two permutations (once per
+set of positions) and the drift torque use them.  A kick projection costs 6 sums, plus 10 sums for
+the geometry (total mass, centre of mass, second moments) when the positions changed since the last
+correction; on OpenCL each sum is a kernel pair plus a download (~30 us on PoCL), on CPU/Reference each
+pass costs ~40 ns per degree of freedom.
 
 Kick-drift-kick splittings evaluate their opening kick at the positions and forces of the previous
 step's closing kick.  The first projection of the program therefore checks (one sum) whether
@@ -54,6 +73,8 @@ centre of mass is not zero for the exact forces and removing it changes the dyna
 """
 from __future__ import annotations
 
+import re
+
 import openmm as mm
 
 PREFIX = "proj_"
@@ -69,15 +90,18 @@ MASS_TOLERANCE = 1e-5
 _AXES = ("x", "y", "z")
 _PAIRS = ("xx", "yy", "zz", "xy", "yz", "zx")
 
-#: Global variables, all prefixed ``proj_``: raw sums (3x the value for M3, see the module docstring)
-#: then derived quantities.
+#: Global variables, all prefixed ``proj_``: raw sums, then derived quantities.
 GLOBALS = tuple(
-    ["chg", "M3"] + [f"mx{a}" for a in _AXES] + [f"f{a}" for a in _AXES] + [f"t{a}" for a in _AXES]
-    + [f"q{p}" for p in _PAIRS]
-    + ["M"] + [f"c{a}" for a in _AXES] + [f"acm{a}" for a in _AXES] + [f"tau{a}" for a in _AXES]
-    + [f"I{p}" for p in _PAIRS] + [f"adj{p}" for p in _PAIRS] + ["det"] + [f"al{a}" for a in _AXES])
-#: Per-DOF variables: selectors, masses, masked force, torque density, permuted x, cache.
-PER_DOF = ("ex", "ey", "ez", "mass", "fm", "t", "xp", "xref", "aref", "raw")
+    ["chg", "M3"] + [f"mx{a}" for a in _AXES] + [f"q{p}" for p in _PAIRS]
+    + [f"f{a}" for a in _AXES] + [f"t{a}" for a in _AXES]
+    + ["M"] + [f"c{a}" for a in _AXES] + [f"I{p}" for p in _PAIRS] + [f"adj{p}" for p in _PAIRS] + ["det"]
+    + [f"acm{a}" for a in _AXES] + [f"tau{a}" for a in _AXES] + [f"al{a}" for a in _AXES]
+    + [f"k{a}" for a in _AXES])
+#: Per-DOF variables: selectors, masses, force/impulse, torque density, permuted x, cache, saved v.
+PER_DOF = ("ex", "ey", "ez", "mass", "fm", "t", "xp", "xpp", "xref", "aref", "raw", "vb")
+
+#: The compiler's RATTLE velocity correction (program._Emitter.drift), recognised before a kick.
+_RATTLE_CORRECTION = re.compile(r"^v \+ \(x - (\w+)\)/\((.+)\)$")
 
 
 def _g(name: str) -> str:
@@ -113,90 +137,82 @@ def set_masses(integrator: mm.CustomIntegrator, system: mm.System) -> None:
     """Store the System's masses (double) in the integrator's ``proj_mass`` variable.
 
     Call it before the Context is created (or any time after: the values are then uploaded at once).
-    Needed for exact momentum on mixed precision (see the module docstring); harmless elsewhere."""
+    Needed for exact momentum on single/mixed precision OpenCL/CUDA (see the module docstring);
+    harmless elsewhere."""
     if _g("mass") not in _names(integrator):
         raise ValueError("this integrator has no exact-momentum projection (compile with exact_momentum=True)")
-    ms = [system.getParticleMass(i) for i in range(system.getNumParticles())]
-    ms = [m._value if hasattr(m, "_value") else float(m) for m in ms]  # dalton
+    ms = []
+    for i in range(system.getNumParticles()):
+        m = system.getParticleMass(i)
+        ms.append(float(m._value) if hasattr(m, "_value") else float(m))  # dalton
     integrator.setPerDofVariableByName(_g("mass"), [mm.Vec3(m, m, m) for m in ms])
 
 
-def _first_call(integrator) -> tuple:
-    """(first projection in this program?, inside an open block?) from the computations so far."""
-    first = True
+# -- static analysis of the program emitted so far -------------------------------------------------
+_BLOCKS = (mm.CustomIntegrator.IfBlockStart, mm.CustomIntegrator.WhileBlockStart)
+
+
+def _steps(ig):
+    return [ig.getComputationStep(i) for i in range(ig.getNumComputations())]
+
+
+def _first_call(steps) -> tuple:
+    """(no projection emitted yet in this program?, inside an open block?)."""
+    first = not any(var.startswith(PREFIX) for _, var, _ in steps)
     depth = 0
-    for i in range(integrator.getNumComputations()):
-        kind, var, _ = integrator.getComputationStep(i)
-        if var.startswith(PREFIX):
-            first = False
-        if kind in (mm.CustomIntegrator.IfBlockStart, mm.CustomIntegrator.WhileBlockStart):
+    for kind, _, _ in steps:
+        if kind in _BLOCKS:
             depth += 1
         elif kind == mm.CustomIntegrator.BlockEnd:
             depth -= 1
     return first, depth > 0
 
 
-def emit_projected_acceleration(integrator: mm.CustomIntegrator, target: str, reuse: bool | None = None) -> None:
-    """Append the computations that set per-DOF ``target`` to the projected acceleration.
+def _geometry_current(steps) -> bool:
+    """True if the centre of mass and inertia were computed since x last changed (same block level)."""
+    for kind, var, _ in reversed(steps):
+        if kind == mm.CustomIntegrator.ComputeGlobal and var == _g("det"):
+            return True
+        if kind in _BLOCKS or kind in (mm.CustomIntegrator.BlockEnd, mm.CustomIntegrator.ConstrainPositions,
+                                       mm.CustomIntegrator.UpdateContextState):
+            return False
+        if kind == mm.CustomIntegrator.ComputePerDof and var == "x":
+            return False
+    return False
 
-    References only ``f`` (all force groups), ``m`` and ``x``: one force evaluation if the forces are
-    not cached, as for a plain ``f/m`` kick.  ``target`` must already be a per-DOF variable.
-    ``reuse`` (default: the first call of a program outside any block) emits the cache check."""
-    ig = integrator
-    g = _g
-    first, in_block = _first_call(ig)
-    if reuse is None:
-        reuse = first and not in_block
-    mass, fm = g("mass"), g("fm")
-    # Exact masses where they were provided and still agree with OpenMM's (else m); 0 for virtual sites.
+
+def _mass_current(steps) -> bool:
+    return any(k == mm.CustomIntegrator.ComputePerDof and v == _g("mass") for k, v, _ in steps)
+
+
+# -- building blocks --------------------------------------------------------------------------------
+def _emit_mass(ig):
+    """proj_mass: the exact masses where provided and still agreeing with OpenMM's m, else m."""
+    mass = _g("mass")
     ig.addComputePerDof(mass, f"select(step({MASS_TOLERANCE!r}*m - abs({mass} - m)), {mass}, m)")
-    ig.addComputePerDof(fm, f"select({mass}, f, 0)")
-    raw = f"select({mass}, {fm}/{mass}, 0)"
-    if reuse:
-        ig.addComputeSum(g("chg"), f"(x - {g('xref')})^2 + ({raw} - {g('raw')})^2")
-        ig.beginIfBlock(f"{g('chg')} != 0")
-    _emit_full(ig, target)
-    if reuse:
-        ig.endBlock()
-        ig.addComputePerDof(target, f"select({g('chg')}, {target}, {g('aref')})")
-    # Remember where and from what this acceleration was computed, for the next step's first kick.
-    ig.addComputePerDof(g("xref"), "x")
-    ig.addComputePerDof(g("raw"), raw)
-    ig.addComputePerDof(g("aref"), target)
 
 
-def _emit_full(ig, target):
+def _emit_geometry(ig):
+    """Centre of mass, inertia tensor about it and its regularised adjugate/determinant, at x."""
     g = _g
-    mass, fm = g("mass"), g("fm")
+    mass = g("mass")
     e = {a: g(f"e{a}") for a in _AXES}
-    # Torque density about the origin and cyclically permuted coordinates (y, z, x).
-    ig.addComputePerDof(g("t"), f"cross(x, {fm})")
+    # cyclic permutations (y, z, x) and (z, x, y): the only vector-function passes of a correction
     ig.addComputePerDof(g("xp"), "vector(_y(x), _z(x), _x(x))")
-    # -- sums: 16 scalar passes --
-    ig.addComputeSum(g("M3"), mass)  # 3M: a scalar per-DOF value counts once per component
+    ig.addComputePerDof(g("xpp"), "vector(_z(x), _x(x), _y(x))")
+    ig.addComputeSum(g("M3"), mass)  # 3M: the scalar mass counts once per component
     for a in _AXES:
         ig.addComputeSum(g(f"mx{a}"), f"{mass}*x*{e[a]}")
     for a in _AXES:
-        ig.addComputeSum(g(f"f{a}"), f"{fm}*{e[a]}")
-    for a in _AXES:
-        ig.addComputeSum(g(f"t{a}"), f"{g('t')}*{e[a]}")
-    for a in _AXES:
         ig.addComputeSum(g(f"q{a}{a}"), f"{mass}*x*x*{e[a]}")
-    # x * xp selects x_x x_y, x_y x_z, x_z x_x on the three components
-    for a, p in zip(_AXES, ("xy", "yz", "zx")):
+    for a, p in zip(_AXES, ("xy", "yz", "zx")):  # x * xp = (x_x x_y, x_y x_z, x_z x_x)
         ig.addComputeSum(g(f"q{p}"), f"{mass}*x*{g('xp')}*{e[a]}")
-    # -- globals (double precision on every platform) --
     M = g("M")
     ig.addComputeGlobal(M, f"{g('M3')}/3")
     inv = f"select({M}, 1/{M}, 0)"
     for a in _AXES:
         ig.addComputeGlobal(g(f"c{a}"), f"{g(f'mx{a}')}*{inv}")
-        ig.addComputeGlobal(g(f"acm{a}"), f"{g(f'f{a}')}*{inv}")
     c = {a: g(f"c{a}") for a in _AXES}
-    F = {a: g(f"f{a}") for a in _AXES}
-    # torque about the centre of mass: tau = tau_origin - c x F
-    for a, b, d in (("x", "y", "z"), ("y", "z", "x"), ("z", "x", "y")):
-        ig.addComputeGlobal(g(f"tau{a}"), f"{g(f't{a}')} - ({c[b]}*{F[d]} - {c[d]}*{F[b]})")
     # second moments about the centre of mass C_ab = sum m x_a x_b - M c_a c_b; I = tr(C) 1 - C
     C = {p: f"({g(f'q{p}')} - {M}*{c[p[0]]}*{c[p[1]]})" for p in _PAIRS}
     ig.addComputeGlobal(g("Ixx"), f"{C['yy']} + {C['zz']}")
@@ -204,7 +220,6 @@ def _emit_full(ig, target):
     ig.addComputeGlobal(g("Izz"), f"{C['xx']} + {C['yy']}")
     for p in ("xy", "yz", "zx"):
         ig.addComputeGlobal(g(f"I{p}"), f"-{C[p]}")
-    # regularised inverse through the adjugate (I is symmetric)
     shift = f"{REGULARISATION!r}*({g('Ixx')} + {g('Iyy')} + {g('Izz')})"
     A, B, Z = (f"({g(f'I{p}')} + {shift})" for p in ("xx", "yy", "zz"))
     D, E, Fy = g("Ixy"), g("Izx"), g("Iyz")
@@ -214,17 +229,201 @@ def _emit_full(ig, target):
     ig.addComputeGlobal(g("adjxy"), f"{E}*{Fy} - {Z}*{D}")
     ig.addComputeGlobal(g("adjzx"), f"{D}*{Fy} - {B}*{E}")
     ig.addComputeGlobal(g("adjyz"), f"{D}*{E} - {A}*{Fy}")
-    det = g("det")
-    ig.addComputeGlobal(det, f"{A}*{g('adjxx')} + {D}*{g('adjxy')} + {E}*{g('adjzx')}")
+    ig.addComputeGlobal(g("det"), f"{A}*{g('adjxx')} + {D}*{g('adjxy')} + {E}*{g('adjzx')}")
+
+
+def _emit_solve(ig, scale: str = "1"):
+    """From the sums proj_f* (net force or momentum change) and proj_t* (torque about the origin):
+    proj_acm = F/M and proj_al = I^-1 (tau_origin - c x F), both times ``scale``."""
+    g = _g
+    M = g("M")
+    inv = f"select({M}, 1/{M}, 0)"
+    c = {a: g(f"c{a}") for a in _AXES}
+    F = {a: g(f"f{a}") for a in _AXES}
+    for a in _AXES:
+        ig.addComputeGlobal(g(f"acm{a}"), f"{scale}*{F[a]}*{inv}")
+    for a, b, d in (("x", "y", "z"), ("y", "z", "x"), ("z", "x", "y")):
+        ig.addComputeGlobal(g(f"tau{a}"), f"{g(f't{a}')} - ({c[b]}*{F[d]} - {c[d]}*{F[b]})")
     adj = {p: g(f"adj{p}") for p in _PAIRS}
     adj.update({"yx": adj["xy"], "xz": adj["zx"], "zy": adj["yz"]})
-    tau = {a: g(f"tau{a}") for a in _AXES}
+    det = g("det")
     for a in _AXES:
-        row = " + ".join(f"{adj[a + b]}*{tau[b]}" for b in _AXES)
-        ig.addComputeGlobal(g(f"al{a}"), f"select({det}, ({row})/{det}, 0)")
-    # -- the projected acceleration (massless particles: 0) --
-    def vec(stem):
-        return f"vector({g(stem + 'x')}, {g(stem + 'y')}, {g(stem + 'z')})"
+        row = " + ".join(f"{adj[a + b]}*{g(f'tau{b}')}" for b in _AXES)
+        ig.addComputeGlobal(g(f"al{a}"), f"select({det}, {scale}*({row})/{det}, 0)")
+    al = {a: g(f"al{a}") for a in _AXES}
+    for a, b, d in (("x", "y", "z"), ("y", "z", "x"), ("z", "x", "y")):  # k = acm - al x c
+        ig.addComputeGlobal(g(f"k{a}"), f"{g(f'acm{a}')} - ({al[b]}*{c[d]} - {al[d]}*{c[b]})")
 
-    ig.addComputePerDof(
-        target, f"select({mass}, {fm}/{mass} - {vec('acm')} - cross({vec('al')}, x - {vec('c')}), 0)")
+
+def _rigid():
+    """The rigid-body field acm + al x (x - c) = k + al x x as a scalar-path expression:
+    (al x x) = (al_y, al_z, al_x) * xpp - (al_z, al_x, al_y) * xp componentwise."""
+    g = _g
+
+    def comb(a, b, c):
+        return f"({g(a)}*{g('ex')} + {g(b)}*{g('ey')} + {g(c)}*{g('ez')})"
+
+    return (f"{comb('kx', 'ky', 'kz')} + {comb('aly', 'alz', 'alx')}*{g('xpp')}"
+            f" - {comb('alz', 'alx', 'aly')}*{g('xp')}")
+
+
+def _emit_net(ig, vector_var: str, torque_expr: str | None = None):
+    """Sums proj_f* = sum of per-DOF ``vector_var`` and proj_t* = its torque about the origin.
+
+    Without ``torque_expr`` the torque sum x x j is formed on the scalar path from the permuted
+    coordinates of the current geometry: (x x j)_x = [xpp j]_z - [xp j]_y and cyclically."""
+    g = _g
+    e = {a: g(f"e{a}") for a in _AXES}
+    for a in _AXES:
+        ig.addComputeSum(g(f"f{a}"), f"{vector_var}*{e[a]}")
+    if torque_expr is not None:
+        ig.addComputePerDof(g("t"), torque_expr)
+        for a in _AXES:
+            ig.addComputeSum(g(f"t{a}"), f"{g('t')}*{e[a]}")
+    else:
+        xp, xpp = g("xp"), g("xpp")
+        for a, b, d in (("x", "z", "y"), ("y", "x", "z"), ("z", "y", "x")):
+            ig.addComputeSum(g(f"t{a}"), f"{vector_var}*({xpp}*{e[b]} - {xp}*{e[d]})")
+
+
+# -- public emitters -------------------------------------------------------------------------------
+def emit_projected_acceleration(integrator: mm.CustomIntegrator, target: str, reuse: bool | None = None) -> None:
+    """Append the computations that set per-DOF ``target`` to the projected acceleration.
+
+    References only ``f`` (all force groups), ``m`` and ``x``: one force evaluation if the forces are
+    not cached, as for a plain ``f/m`` kick.  ``target`` must already be a per-DOF variable.
+    ``reuse`` (default: the first call of a program outside any block) emits the cache check.
+    If the computation just before is the compiler's RATTLE velocity correction, the drift's
+    constraint impulses are first restored to zero net momentum and torque
+    (:func:`emit_drift_restoration`)."""
+    ig = integrator
+    g = _g
+    steps = _steps(ig)
+    first, in_block = _first_call(steps)
+    if reuse is None:
+        reuse = first and not in_block
+    if not _mass_current(steps):
+        _emit_mass(ig)
+    if steps and steps[-1][0] == mm.CustomIntegrator.ComputePerDof and steps[-1][1] == "v":
+        match = _RATTLE_CORRECTION.match(steps[-1][2].strip())
+        if match:
+            emit_drift_restoration(ig, match.group(1), match.group(2))
+    mass, fm = g("mass"), g("fm")
+    ig.addComputePerDof(fm, f"select({mass}, f, 0)")
+    raw = f"select({mass}, {fm}/{mass}, 0)"
+    if reuse:
+        ig.addComputeSum(g("chg"), f"(x - {g('xref')})^2 + ({raw} - {g('raw')})^2")
+        ig.beginIfBlock(f"{g('chg')} != 0")
+    if not _geometry_current(_steps(ig)):
+        _emit_geometry(ig)
+    _emit_net(ig, fm)
+    _emit_solve(ig)
+    ig.addComputePerDof(target, f"select({mass}, {fm}/{mass} - ({_rigid()}), 0)")
+    # Remember where and from what this acceleration was computed, for the next step's first kick.
+    ig.addComputePerDof(g("xref"), "x")
+    ig.addComputePerDof(g("raw"), raw)
+    ig.addComputePerDof(g("aref"), target)
+    if reuse:
+        ig.endBlock()
+        ig.addComputePerDof(target, f"select({g('chg')}, {target}, {g('aref')})")
+
+
+def emit_drift_restoration(integrator: mm.CustomIntegrator, unconstrained: str = "symprk_xu",
+                           substep: str = "dt") -> None:
+    """After a RATTLE drift ``x += h v; xu = x; ConstrainPositions; v += (x - xu)/h``: remove the
+    round-off net momentum and torque of the constraint impulses m (x - xu)/h (about the positions
+    before the drift, x - h v) with a rigid-body velocity correction at the current positions.
+
+    ``unconstrained``: the per-DOF variable holding the positions before ConstrainPositions;
+    ``substep``: the drift's substep h as an expression (e.g. ``0.5*dt``)."""
+    ig = integrator
+    g = _g
+    if not _mass_current(_steps(ig)):
+        _emit_mass(ig)
+    mass, j = g("mass"), g("fm")
+    h = f"({substep})"
+    ig.addComputePerDof(j, f"select({mass}, {mass}*(x - {unconstrained})/{h}, 0)")
+    if not _geometry_current(_steps(ig)):
+        _emit_geometry(ig)
+    _emit_net(ig, j, f"cross(x - {h}*v, {j})")  # torque about the positions before the drift
+    _emit_solve(ig)
+    ig.addComputePerDof("v", f"v - select({mass}, {_rigid()}, 0)")
+
+
+def emit_constrain_velocities(integrator: mm.CustomIntegrator) -> None:
+    """``addConstrainVelocities`` followed by the removal of the round-off net momentum and torque of
+    the velocity-constraint impulses (a rigid-body correction; distance constraints stay satisfied)."""
+    ig = integrator
+    g = _g
+    if not _mass_current(_steps(ig)):
+        _emit_mass(ig)
+    mass, j, vb = g("mass"), g("fm"), g("vb")
+    ig.addComputePerDof(vb, "v")
+    ig.addConstrainVelocities()
+    ig.addComputePerDof(j, f"select({mass}, {mass}*(v - {vb}), 0)")
+    if not _geometry_current(_steps(ig)):
+        _emit_geometry(ig)
+    _emit_net(ig, j)
+    _emit_solve(ig)
+    ig.addComputePerDof("v", f"v - select({mass}, {_rigid()}, 0)")
+
+
+# -- until the compiler calls emit_constrain_velocities itself ----------------------------------------
+def compiler_has_velocity_hook() -> bool:
+    """True if :mod:`openmm_symprk.program` already emits :func:`emit_constrain_velocities` for
+    ``exact_momentum=True`` programs with constraints."""
+    from . import program
+    from .catalogue import get_method
+
+    ig = mm.CustomIntegrator(0.001)
+    program.compile_program(ig, get_method("verlet"), True, exact_momentum=True)
+    return any(var == _g("vb") for _, var, _ in _steps(ig))
+
+
+class velocity_hook:
+    """Context manager: integrators compiled inside it with ``exact_momentum=True`` and constraints
+    restore the momentum of the end-of-step velocity projection (:func:`emit_constrain_velocities`).
+
+    A stop-gap for the hook that :mod:`openmm_symprk.program` lacks (``_Emitter.finish`` calls
+    ``addConstrainVelocities`` directly); it does nothing if the compiler already has the hook."""
+
+    def __enter__(self):
+        from . import program
+
+        self._program = program
+        self._orig = None
+        if compiler_has_velocity_hook():
+            return self
+        orig = self._orig = program._Emitter.finish
+
+        def finish(em, check_finite):
+            if em.constraints and em.exact_momentum:
+                emit_constrain_velocities(em.ig)
+                em.constraints = False
+                try:
+                    orig(em, check_finite)
+                finally:
+                    em.constraints = True
+            else:
+                orig(em, check_finite)
+
+        program._Emitter.finish = finish
+        return self
+
+    def __exit__(self, *exc):
+        if self._orig is not None:
+            self._program._Emitter.finish = self._orig
+        return False
+
+
+def exact_integrator(step_size, method="verlet", system=None, **options):
+    """A :class:`~openmm_symprk.integrators.SymplecticIntegrator` with ``exact_momentum=True``, the
+    System's masses stored (:func:`set_masses`) and the end-of-step velocity hook (see
+    :class:`velocity_hook`): the complete exact-momentum program on every platform."""
+    from .integrators import SymplecticIntegrator
+
+    with velocity_hook():
+        ig = SymplecticIntegrator(step_size, method, system=system, exact_momentum=True, **options)
+    if system is not None:
+        set_masses(ig, system)
+    return ig
