@@ -40,7 +40,8 @@ def test_unknown_method():
 def test_nonsymplectic_refused_unless_opted_in():
     with pytest.raises(TableauError, match=r"rk4 is not symplectic.*residual 1\.\d+e-01"):
         SymplecticIntegrator(0.001, "rk4")
-    SymplecticIntegrator(0.001, "rk4", allow_nonsymplectic=True)
+    with pytest.warns(UserWarning, match="no system= was given"):
+        SymplecticIntegrator(0.001, "rk4", allow_nonsymplectic=True)
     bad = PRKTableau([[0, 0], [1, 0]], [0.5, 0.5], [[0, 0], [1, 0]], [0.5, 0.5], name="heun")
     with pytest.raises(TableauError, match="heun is not symplectic"):
         PRKIntegrator(0.001, bad)
