@@ -22,8 +22,10 @@ import numpy as np
 from .measure import rms_deviation
 from .runs import label
 
-#: Accuracy targets for "which method is cheapest": RMS trajectory error (nm).
+#: Accuracy targets for "which method is cheapest": RMS trajectory error (nm) ...
 TRAJ_TARGETS = (1e-3, 1e-5, 1e-7)
+#: ... and max |E - E0| per degree of freedom (kJ/mol).
+ENERGY_TARGETS = (1e-2, 1e-3, 1e-4, 1e-6)
 
 
 def aggregate(config, scenes, jobs, store) -> dict:
@@ -59,11 +61,13 @@ def aggregate(config, scenes, jobs, store) -> dict:
                             "settings": {k: v for k, v in config["scenes"][name].items() if k != "params"}}
     import openmm
 
+    accurate = [r for r in runs if scenes[r["scene"]].purpose == "accuracy"]
     return {"config": config, "machine": {"python": _platform.python_version(), "openmm": openmm.__version__,
                                           "cpu": _platform.processor() or _platform.machine(),
                                           "cores": _cores()},
             "scenes": scene_info, "runs": runs, "references": list(refs.values()), "stability": stab,
-            "best": best_at_accuracy(runs)}
+            "best": best_at_accuracy(accurate),
+            "best_energy": best_at_accuracy(accurate, ENERGY_TARGETS, "energy_error_per_dof")}
 
 
 def _cores():
@@ -80,19 +84,22 @@ def usable(r) -> bool:
     return r.get("status") == "ok" and not r.get("failed")
 
 
-def best_at_accuracy(runs, targets=TRAJ_TARGETS) -> dict:
-    """Per scene and target: the cheapest usable run (force evaluations per ps) reaching the target."""
+def best_at_accuracy(runs, targets=TRAJ_TARGETS, key="traj_error") -> dict:
+    """Per scene and target: the cheapest usable run (force evaluations per ps; ties: wall time) whose
+    ``key`` error reaches the target, among the swept step sizes (Langevin excluded)."""
     out = {}
     for name in sorted({r["scene"] for r in runs}):
-        rows = [r for r in runs if r["scene"] == name and usable(r) and r.get("traj_error") is not None
+        rows = [r for r in runs if r["scene"] == name and usable(r) and r.get(key) is not None
                 and r["method"] != "openmm-langevin"]
+        if not rows:
+            continue
         per = {}
         for t in targets:
-            ok = [r for r in rows if r["traj_error"] <= t]
+            ok = [r for r in rows if r[key] <= t]
             if ok:
                 b = min(ok, key=lambda r: (r["force_evals_per_ps"], r["wall_per_ps"] or math.inf))
                 per[f"{t:g}"] = {"method": b["method"], "step_fs": b["step_fs"],
-                                 "force_evals_per_ps": b["force_evals_per_ps"], "traj_error": b["traj_error"]}
+                                 "force_evals_per_ps": b["force_evals_per_ps"], "error": b[key]}
             else:
                 per[f"{t:g}"] = None
         out[name] = per
@@ -138,12 +145,12 @@ def format_stability(results) -> str:
     return "\n".join(lines)
 
 
-def format_best(results) -> str:
-    lines = [f"Cheapest run (force evaluations per ps) reaching an RMS trajectory error at the final time:"]
-    for scene, per in results["best"].items():
+def format_best(results, key="best", what="an RMS trajectory error at the final time", unit="nm") -> str:
+    lines = [f"Cheapest run (force evaluations per ps) reaching {what}:"]
+    for scene, per in results.get(key, {}).items():
         parts = []
         for t, b in per.items():
-            parts.append(f"<= {t} nm: " + (f"{b['method']} at {b['step_fs']:g} fs ({b['force_evals_per_ps']:.0f}/ps)"
+            parts.append(f"<= {t} {unit}: " + (f"{b['method']} at {b['step_fs']:g} fs ({b['force_evals_per_ps']:.0f}/ps)"
                                           if b else "none"))
         lines.append(f"  {scene:15s} " + "; ".join(parts))
     return "\n".join(lines)
@@ -159,7 +166,8 @@ def format_summary(results) -> str:
             if ref else "no trajectory reference")
         out += ["", f"== {name}: {info['description']} [{info['platform']}; errors vs {src}]",
                 format_runs(results, name)]
-    out += ["", "== largest stable step", format_stability(results), "", format_best(results)]
+    out += ["", "== largest stable step", format_stability(results), "", format_best(results), "",
+            format_best(results, "best_energy", "a max |E - E0| per DOF", "kJ/mol")]
     return "\n".join(out)
 
 
