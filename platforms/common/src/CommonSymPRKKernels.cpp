@@ -17,7 +17,7 @@ void CommonIntegrateSymPRKStepKernel::initialize(const System& system, const Sym
     ContextSelector selector(cc);
     hasConstraints = (system.getNumConstraints() > 0);
     projectionBlockSize = 1;
-    while (projectionBlockSize*2 <= min(256, cc.getMaxThreadBlockSize()))
+    while (projectionBlockSize*2 <= min(128, cc.getMaxThreadBlockSize()))
         projectionBlockSize *= 2;
     map<string, string> defines;
     defines["NUM_ATOMS"] = cc.intToString(cc.getNumAtoms());

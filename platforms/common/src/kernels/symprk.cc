@@ -126,67 +126,56 @@ KERNEL void symprkDriftApply(mixed cdt, GLOBAL real4* RESTRICT posq, GLOBAL real
     }
 }
 
-/** Velocity check alone (used when the step ends with the velocity projection). */
-KERNEL void symprkCheck(GLOBAL const mixed4* RESTRICT velm, int checkStep, GLOBAL int* RESTRICT badStep) {
-    for (int index = GLOBAL_ID; index < NUM_ATOMS; index += GLOBAL_SIZE) {
-        mixed4 v = velm[index];
-        if (v.w != 0)
-            symprkCheckVelocity(v, checkStep, badStep);
-    }
-}
-
-DEVICE mixed symprkReduce(mixed value, LOCAL_ARG mixed* temp) {
-    SYNC_THREADS;
-    temp[LOCAL_ID] = value;
-    for (int i = 1; i < WORK_GROUP_SIZE; i *= 2) {
-        SYNC_THREADS;
-        if (LOCAL_ID%(i*2) == 0 && LOCAL_ID+i < WORK_GROUP_SIZE)
-            temp[LOCAL_ID] += temp[LOCAL_ID+i];
-    }
-    SYNC_THREADS;
-    return temp[0];
-}
-
 /**
  * The exact-momentum projection, run as one block of WORK_GROUP_SIZE threads: centre of mass r_cm, net force,
  * torque about r_cm and the inertia tensor about r_cm (sums in the mixed type: double in mixed and double
  * precision), then projection[0..2] = r_cm, [3..5] = a_cm = F/M, [6..8] = alpha = I^-1 tau (I regularised by
- * 1e-12 of its trace).  Massless particles are excluded.
+ * 1e-12 of its trace).  Massless particles are excluded.  Each thread's partial sums are added in a fixed
+ * order by one thread per quantity (deterministic, and only four barriers: PoCL's kernel compiler is slow
+ * on barriers inside loops).
  */
 KERNEL void symprkProjection(GLOBAL const real4* RESTRICT posq, GLOBAL const real4* RESTRICT posqCorrection,
         GLOBAL const mixed4* RESTRICT velm, GLOBAL const mm_long* RESTRICT force, GLOBAL mixed* RESTRICT projection) {
-    LOCAL mixed temp[WORK_GROUP_SIZE];
+    LOCAL mixed partial[9*WORK_GROUP_SIZE];
+    LOCAL mixed total[9];
+    const int tid = LOCAL_ID;
     const mixed fscale = 1/(mixed) 0x100000000;
-    mixed m = 0, mx = 0, my = 0, mz = 0, fx = 0, fy = 0, fz = 0;
-    for (int index = LOCAL_ID; index < NUM_ATOMS; index += LOCAL_SIZE) {
+    mixed s0 = 0, s1 = 0, s2 = 0, s3 = 0, s4 = 0, s5 = 0, s6 = 0;
+    for (int index = tid; index < NUM_ATOMS; index += WORK_GROUP_SIZE) {
         mixed4 v = velm[index];
         if (v.w != 0) {
             mixed mass = 1/v.w;
             mixed4 p = symprkLoadPos(posq, posqCorrection, index);
-            m += mass;
-            mx += mass*p.x;
-            my += mass*p.y;
-            mz += mass*p.z;
-            fx += fscale*force[index];
-            fy += fscale*force[index+PADDED_NUM_ATOMS];
-            fz += fscale*force[index+2*PADDED_NUM_ATOMS];
+            s0 += mass;
+            s1 += mass*p.x;
+            s2 += mass*p.y;
+            s3 += mass*p.z;
+            s4 += fscale*force[index];
+            s5 += fscale*force[index+PADDED_NUM_ATOMS];
+            s6 += fscale*force[index+2*PADDED_NUM_ATOMS];
         }
     }
-    m = symprkReduce(m, temp);
-    mx = symprkReduce(mx, temp);
-    my = symprkReduce(my, temp);
-    mz = symprkReduce(mz, temp);
-    fx = symprkReduce(fx, temp);
-    fy = symprkReduce(fy, temp);
-    fz = symprkReduce(fz, temp);
-    if (m == 0) {
-        if (LOCAL_ID < 9)
-            projection[LOCAL_ID] = 0;
-        return;
+    partial[tid] = s0;
+    partial[tid+WORK_GROUP_SIZE] = s1;
+    partial[tid+2*WORK_GROUP_SIZE] = s2;
+    partial[tid+3*WORK_GROUP_SIZE] = s3;
+    partial[tid+4*WORK_GROUP_SIZE] = s4;
+    partial[tid+5*WORK_GROUP_SIZE] = s5;
+    partial[tid+6*WORK_GROUP_SIZE] = s6;
+    SYNC_THREADS;
+    if (tid < 7) {
+        mixed sum = 0;
+        for (int i = 0; i < WORK_GROUP_SIZE; i++)
+            sum += partial[tid*WORK_GROUP_SIZE+i];
+        total[tid] = sum;
     }
-    const mixed cx = mx/m, cy = my/m, cz = mz/m;
+    SYNC_THREADS;
+    const mixed m = total[0];
+    const mixed invM = (m == 0 ? (mixed) 0 : 1/m);
+    const mixed cx = total[1]*invM, cy = total[2]*invM, cz = total[3]*invM;
+    const mixed fx = total[4], fy = total[5], fz = total[6];
     mixed tx = 0, ty = 0, tz = 0, dxx = 0, dyy = 0, dzz = 0, oxy = 0, oxz = 0, oyz = 0;
-    for (int index = LOCAL_ID; index < NUM_ATOMS; index += LOCAL_SIZE) {
+    for (int index = tid; index < NUM_ATOMS; index += WORK_GROUP_SIZE) {
         mixed4 v = velm[index];
         if (v.w != 0) {
             mixed mass = 1/v.w;
@@ -204,18 +193,28 @@ KERNEL void symprkProjection(GLOBAL const real4* RESTRICT posq, GLOBAL const rea
             oyz += mass*ry*rz;
         }
     }
-    tx = symprkReduce(tx, temp);
-    ty = symprkReduce(ty, temp);
-    tz = symprkReduce(tz, temp);
-    dxx = symprkReduce(dxx, temp);
-    dyy = symprkReduce(dyy, temp);
-    dzz = symprkReduce(dzz, temp);
-    oxy = symprkReduce(oxy, temp);
-    oxz = symprkReduce(oxz, temp);
-    oyz = symprkReduce(oyz, temp);
-    if (LOCAL_ID == 0) {
-        mixed Ixx = dyy+dzz, Iyy = dxx+dzz, Izz = dxx+dyy;
-        mixed Ixy = -oxy, Ixz = -oxz, Iyz = -oyz;
+    SYNC_THREADS;
+    partial[tid] = tx;
+    partial[tid+WORK_GROUP_SIZE] = ty;
+    partial[tid+2*WORK_GROUP_SIZE] = tz;
+    partial[tid+3*WORK_GROUP_SIZE] = dxx;
+    partial[tid+4*WORK_GROUP_SIZE] = dyy;
+    partial[tid+5*WORK_GROUP_SIZE] = dzz;
+    partial[tid+6*WORK_GROUP_SIZE] = oxy;
+    partial[tid+7*WORK_GROUP_SIZE] = oxz;
+    partial[tid+8*WORK_GROUP_SIZE] = oyz;
+    SYNC_THREADS;
+    if (tid < 9) {
+        mixed sum = 0;
+        for (int i = 0; i < WORK_GROUP_SIZE; i++)
+            sum += partial[tid*WORK_GROUP_SIZE+i];
+        total[tid] = sum;
+    }
+    SYNC_THREADS;
+    if (tid == 0) {
+        const mixed Tx = total[0], Ty = total[1], Tz = total[2];
+        mixed Ixx = total[4]+total[5], Iyy = total[3]+total[5], Izz = total[3]+total[4];
+        mixed Ixy = -total[6], Ixz = -total[7], Iyz = -total[8];
         mixed shift = (mixed) 1e-12*(Ixx+Iyy+Izz);
         Ixx += shift;
         Iyy += shift;
@@ -226,13 +225,13 @@ KERNEL void symprkProjection(GLOBAL const real4* RESTRICT posq, GLOBAL const rea
         projection[0] = cx;
         projection[1] = cy;
         projection[2] = cz;
-        projection[3] = fx/m;
-        projection[4] = fy/m;
-        projection[5] = fz/m;
-        if (det != 0) {
-            projection[6] = (axx*tx+axy*ty+axz*tz)/det;
-            projection[7] = (axy*tx+ayy*ty+ayz*tz)/det;
-            projection[8] = (axz*tx+ayz*ty+azz*tz)/det;
+        projection[3] = fx*invM;
+        projection[4] = fy*invM;
+        projection[5] = fz*invM;
+        if (det != 0 && m != 0) {
+            projection[6] = (axx*Tx+axy*Ty+axz*Tz)/det;
+            projection[7] = (axy*Tx+ayy*Ty+ayz*Tz)/det;
+            projection[8] = (axz*Tx+ayz*Ty+azz*Tz)/det;
         }
         else {
             projection[6] = 0;
