@@ -149,7 +149,20 @@ def _splitting_for(method, system):
 def _make_class():
     from ..catalogue import get_method
     from ..integrators import SimulationBlowUpError, step_size_in_ps
-    from ..systemcheck import warn_conservation
+    import warnings
+
+    from ..systemcheck import ConservationWarning, conservation_issues
+
+    warned = set()
+
+    def warn_conservation(system, context):
+        # As systemcheck.warn_conservation (once per kind), less the virtual-site caveat of the CustomIntegrator
+        # path: the native kernels place virtual sites before every force evaluation inside the step.
+        for key, msg in conservation_issues(system):
+            if key == "virtualsites" or key in warned:
+                continue
+            warned.add(key)
+            warnings.warn(f"{context}: {msg}", ConservationWarning, stacklevel=4)
 
     base = _State.swig.SymPRKIntegrator
 
