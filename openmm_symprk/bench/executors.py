@@ -79,7 +79,7 @@ class SerialExecutor:
     def wait(self, futures):
         return set(futures)
 
-    def shutdown(self, cancel=False):
+    def shutdown(self, cancel=False, grace: float = 0.0, inflight=()):
         pass
 
 
@@ -98,8 +98,25 @@ class PoolExecutor:
         done, _ = cf.wait(futures, return_when=cf.FIRST_COMPLETED)
         return done
 
-    def shutdown(self, cancel=False):
-        self.pool.shutdown(wait=True, cancel_futures=cancel)
+    def shutdown(self, cancel=False, grace: float = 3.0, inflight=()):
+        """Normal end: wait for the workers.  ``cancel`` (an interrupted sweep): drop queued runs, give
+        the running ones ``grace`` seconds to finish (their records are kept by the caller), then stop
+        the workers instead of waiting for long runs."""
+        if not cancel:
+            self.pool.shutdown(wait=True)
+            return
+        for fut in inflight:
+            fut.cancel()
+        running = [f for f in inflight if not f.done()]
+        if running:
+            cf.wait(running, timeout=grace)
+        procs = list(getattr(self.pool, "_processes", {}).values())  # CPython keeps the workers here
+        self.pool.shutdown(wait=False, cancel_futures=True)
+        for p in procs:
+            if p.is_alive():
+                p.terminate()
+        for p in procs:
+            p.join(timeout=5)
 
 
 class DaskExecutor:
@@ -125,7 +142,10 @@ class DaskExecutor:
 
         return set(wait(list(futures), return_when="FIRST_COMPLETED").done)
 
-    def shutdown(self, cancel=False):
+    def shutdown(self, cancel=False, grace: float = 0.0, inflight=()):
+        if cancel:
+            for fut in inflight:
+                fut.cancel()
         self.client.close()
 
 

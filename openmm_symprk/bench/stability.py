@@ -26,7 +26,6 @@ Narrow resonance bands are caught (blanes-moan-srkn11b-6 is unstable only for h*
 """
 from __future__ import annotations
 
-import math
 import warnings
 
 import numpy as np
@@ -213,8 +212,6 @@ def linear_settings(omega_max: float, rel_tol: float = 1e-4) -> dict:
             "omega_max": omega_max}
 
 
-def finite_or_none(x):
-    return x if x is not None and math.isfinite(x) else None
 
 
 def largest_stable_step(scene, method: str, settings: dict, platform=None) -> dict:

@@ -12,6 +12,10 @@ stored record from disk instead of recomputing it (a stability search replays it
 order, so it continues where it stopped) and submits only what is missing.  Runs whose record says
 "error" (an exception, not an integrator failure) are retried.
 
+On an interruption the queued runs are dropped, the running ones get a few seconds to finish (what
+finishes is stored), then the worker processes are stopped.  Scripts that call :func:`run_sweep` with
+``workers > 1`` need the usual ``if __name__ == "__main__":`` guard (workers are spawned).
+
 Up to ``workers + 1`` runs are in flight at a time, the most expensive ready one first (estimated from
 steps x force evaluations x the scene's cost per evaluation), so that long runs do not trail at the end.
 """
@@ -175,17 +179,16 @@ def _run_jobs(jobs, store, executor, fingerprints, progress=True, on_result=None
                     on_result(store.get(key))
                 advance(job, store.get(key))
     except BaseException:
-        for fut in inflight:
-            fut.cancel()
-        executor.shutdown(cancel=True)
+        executor.shutdown(cancel=True, inflight=list(inflight))
         for fut, (job, spec, key) in inflight.items():  # keep what finished while stopping
             if fut.done() and not fut.cancelled():
                 try:
                     rec, arrays = fut.result()
                 except BaseException:  # noqa: BLE001
                     continue
-                store.put(key, rec, arrays)
-                stats["computed"] += 1
+                if store.get(key) is None:
+                    store.put(key, rec, arrays)
+                    stats["computed"] += 1
         bar.close()
         raise
     bar.close()
