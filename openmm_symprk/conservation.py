@@ -122,9 +122,9 @@ def linear_momentum(obj, system: mm.System | None = None, masses=None) -> np.nda
 def angular_momentum(obj, system: mm.System | None = None, about="com", masses=None) -> np.ndarray:
     """Total angular momentum sum_i m_i (x_i - c) x v_i (amu nm^2/ps), float64, shape (3,).
 
-    ``about``: "com" (the centre of mass, default: conserved by any isolated system), "origin"
-    (conserved only if the linear momentum is zero or parallel to the centre of mass...; a
-    CMMotionRemover changes it), or a point in nm."""
+    ``about``: "com" (the centre of mass, default), "origin", or a point in nm.  In an isolated
+    system both L about the centre of mass and L about the origin are conserved (L_origin = L_com +
+    M r_cm x V_cm, with V_cm constant); a CMMotionRemover keeps the first and changes the second."""
     x, v, m, _, _ = _resolve(obj, system, masses)
     return _angular(x, v, m, about)
 
@@ -230,6 +230,8 @@ def energies(obj, system: mm.System | None = None, masses=None) -> dict:
 def constraint_violation(obj, system: mm.System | None = None) -> float:
     """Largest relative constraint violation max_k |r_k - d_k| / d_k (0 without constraints)."""
     x, _, _, _, system = _resolve(obj, system, np.zeros(0), velocities=False)
+    if system is None:
+        raise TypeError("a State carries no constraints: pass system=")
     return _constraint_violation(x, system)
 
 

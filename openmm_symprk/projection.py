@@ -26,7 +26,9 @@ distance-constraint velocity condition, since (r_i - r_j).(gamma x (r_i - r_j)) 
 :func:`emit_projected_acceleration` applies the drift restoration by itself when the computation just
 before it is the compiler's RATTLE velocity correction ``v + (x - symprk_xu)/(c*dt)``; the
 end-of-step velocity projection needs the compiler to call :func:`emit_constrain_velocities` instead
-of ``addConstrainVelocities`` (a hook that :mod:`openmm_symprk.program` does not have yet).
+of ``addConstrainVelocities``, and a drift that ends a step (position Verlet) needs it to call
+:func:`emit_drift_restoration`: hooks that :mod:`openmm_symprk.program` does not have yet
+(:func:`exact_integrator` / :class:`compiler_hooks` supply them meanwhile).
 
 Precision
 ---------
@@ -368,61 +370,79 @@ def emit_constrain_velocities(integrator: mm.CustomIntegrator) -> None:
     ig.addComputePerDof("v", f"v - select({mass}, {_rigid()}, 0)")
 
 
-# -- until the compiler calls emit_constrain_velocities itself ----------------------------------------
-def compiler_has_velocity_hook() -> bool:
-    """True if :mod:`openmm_symprk.program` already emits :func:`emit_constrain_velocities` for
-    ``exact_momentum=True`` programs with constraints."""
+# -- until the compiler calls the constraint hooks itself -------------------------------------------
+def compiler_hooks_present() -> tuple:
+    """(velocity hook, drift hook): whether :mod:`openmm_symprk.program` already emits
+    :func:`emit_constrain_velocities` at the end of a step and :func:`emit_drift_restoration` after
+    every RATTLE drift (checked on position Verlet, whose last drift is not followed by a kick)."""
     from . import program
     from .catalogue import get_method
 
     ig = mm.CustomIntegrator(0.001)
-    program.compile_program(ig, get_method("verlet"), True, exact_momentum=True)
-    return any(var == _g("vb") for _, var, _ in _steps(ig))
+    program.compile_program(ig, get_method("position-verlet"), True, exact_momentum=True)
+    steps = _steps(ig)
+    velocity = any(var == _g("vb") for _, var, _ in steps)
+    corrections = [i for i, (k, var, expr) in enumerate(steps)
+                   if k == mm.CustomIntegrator.ComputePerDof and var == "v" and _RATTLE_CORRECTION.match(expr.strip())]
+    drift = bool(corrections) and all(
+        any(var == _g("fm") and "symprk_xu" in expr for _, var, expr in steps[i + 1:i + 4]) for i in corrections)
+    return velocity, drift
 
 
-class velocity_hook:
+class compiler_hooks:
     """Context manager: integrators compiled inside it with ``exact_momentum=True`` and constraints
-    restore the momentum of the end-of-step velocity projection (:func:`emit_constrain_velocities`).
+    also restore the momentum of every RATTLE drift (:func:`emit_drift_restoration`, including a drift
+    that ends a step, as in position Verlet) and of the end-of-step velocity projection
+    (:func:`emit_constrain_velocities`).
 
-    A stop-gap for the hook that :mod:`openmm_symprk.program` lacks (``_Emitter.finish`` calls
-    ``addConstrainVelocities`` directly); it does nothing if the compiler already has the hook."""
+    A stop-gap for the two hooks that :mod:`openmm_symprk.program` lacks (``_Emitter.drift`` and
+    ``_Emitter.finish``); it patches nothing that the compiler already does."""
 
     def __enter__(self):
         from . import program
 
         self._program = program
-        self._orig = None
-        if compiler_has_velocity_hook():
-            return self
-        orig = self._orig = program._Emitter.finish
+        self._saved = {}
+        velocity, drift = compiler_hooks_present()
+        if not velocity:
+            orig_finish = self._saved["finish"] = program._Emitter.finish
 
-        def finish(em, check_finite):
-            if em.constraints and em.exact_momentum:
-                emit_constrain_velocities(em.ig)
-                em.constraints = False
-                try:
-                    orig(em, check_finite)
-                finally:
-                    em.constraints = True
-            else:
-                orig(em, check_finite)
+            def finish(em, check_finite):
+                if em.constraints and em.exact_momentum:
+                    emit_constrain_velocities(em.ig)
+                    em.constraints = False
+                    try:
+                        orig_finish(em, check_finite)
+                    finally:
+                        em.constraints = True
+                else:
+                    orig_finish(em, check_finite)
 
-        program._Emitter.finish = finish
+            program._Emitter.finish = finish
+        if not drift:
+            orig_drift = self._saved["drift"] = program._Emitter.drift
+
+            def drift_(em, c):
+                orig_drift(em, c)
+                if em.constraints and em.exact_momentum:
+                    emit_drift_restoration(em.ig, "symprk_xu", f"{program._num(c)}*dt")
+
+            program._Emitter.drift = drift_
         return self
 
     def __exit__(self, *exc):
-        if self._orig is not None:
-            self._program._Emitter.finish = self._orig
+        for name, fn in self._saved.items():
+            setattr(self._program._Emitter, name, fn)
         return False
 
 
 def exact_integrator(step_size, method="verlet", system=None, **options):
     """A :class:`~openmm_symprk.integrators.SymplecticIntegrator` with ``exact_momentum=True``, the
-    System's masses stored (:func:`set_masses`) and the end-of-step velocity hook (see
-    :class:`velocity_hook`): the complete exact-momentum program on every platform."""
+    System's masses stored (:func:`set_masses`) and the constraint hooks (see
+    :class:`compiler_hooks`): the complete exact-momentum program on every platform."""
     from .integrators import SymplecticIntegrator
 
-    with velocity_hook():
+    with compiler_hooks():
         ig = SymplecticIntegrator(step_size, method, system=system, exact_momentum=True, **options)
     if system is not None:
         set_masses(ig, system)
