@@ -148,63 +148,80 @@ void ReferenceIntegrateSymPRKStepKernel::execute(ContextImpl& context, const Sym
 
     if (context.updateContextState())
         forcesAreValid = false;
+
+    // One pass over the atoms per kick and per drift; a kick directly followed by a drift (every kick but a
+    // step's last) shares its pass with it.  The per-atom arithmetic is the same either way.
+    auto driftAtom = [&] (int i, double cdt) {
+        if (hasConstraints)
+            xRef[i] = pos[i];
+        if (masses[i] != 0.0)
+            for (int j = 0; j < 3; j++)
+                pos[i][j] = pos[i][j] + cdt*vel[i][j];
+        if (hasConstraints)
+            xUnconstrained[i] = pos[i];
+    };
+    auto finishDrift = [&] (double cdt) {
+        if (hasConstraints) {
+            constraints.apply(xRef, pos, inverseMasses, tol);
+            parallelFor([&] (int t, int start, int end) {
+                for (int i = start; i < end; i++)
+                    if (masses[i] != 0.0)
+                        for (int j = 0; j < 3; j++)
+                            vel[i][j] = vel[i][j] + (pos[i][j]-xUnconstrained[i][j])/cdt;
+            });
+        }
+        if (hasVirtualSites)
+            vsites.computePositions(*system, pos, data.periodicBoxVectors);
+        forcesAreValid = false;
+    };
     const int numSubsteps = integrator.getNumSubsteps();
-    for (int s = 0; s < numSubsteps; s++) {
+    for (int s = 0; s < numSubsteps; ) {
         const double cdt = integrator.getSubstepCoefficient(s)*dt;
         if (integrator.getSubstepKind(s) == SymPRKIntegrator::Kick) {
             if (!forcesAreValid || context.getLastForceGroups() != groups) {
                 context.calcForcesAndEnergy(true, false, groups);
                 forcesAreValid = true;
             }
+            const bool fuse = (s+1 < numSubsteps);  // kinds alternate: the next sub-step is a drift
+            const double cdtDrift = (fuse ? integrator.getSubstepCoefficient(s+1)*dt : 0.0);
             if (exact) {
                 computeProjection(pos, force);
                 parallelFor([&] (int t, int start, int end) {
-                    for (int i = start; i < end; i++)
+                    for (int i = start; i < end; i++) {
                         if (masses[i] != 0.0) {
                             Vec3 a = force[i]/masses[i] - acm - alpha.cross(pos[i]-com);
                             vel[i] = vel[i] + a*cdt;
                         }
+                        if (fuse)
+                            driftAtom(i, cdtDrift);
+                    }
                 });
             }
             else {
                 parallelFor([&] (int t, int start, int end) {
-                    for (int i = start; i < end; i++)
+                    for (int i = start; i < end; i++) {
                         if (masses[i] != 0.0)
                             for (int j = 0; j < 3; j++)
                                 vel[i][j] = vel[i][j] + cdt*force[i][j]/masses[i];
-                });
-            }
-        }
-        else {
-            if (hasConstraints) {
-                parallelFor([&] (int t, int start, int end) {
-                    for (int i = start; i < end; i++) {
-                        xRef[i] = pos[i];
-                        if (masses[i] != 0.0)
-                            for (int j = 0; j < 3; j++)
-                                pos[i][j] = pos[i][j] + cdt*vel[i][j];
-                        xUnconstrained[i] = pos[i];
+                        if (fuse)
+                            driftAtom(i, cdtDrift);
                     }
                 });
-                constraints.apply(xRef, pos, inverseMasses, tol);
-                parallelFor([&] (int t, int start, int end) {
-                    for (int i = start; i < end; i++)
-                        if (masses[i] != 0.0)
-                            for (int j = 0; j < 3; j++)
-                                vel[i][j] = vel[i][j] + (pos[i][j]-xUnconstrained[i][j])/cdt;
-                });
             }
-            else {
-                parallelFor([&] (int t, int start, int end) {
-                    for (int i = start; i < end; i++)
-                        if (masses[i] != 0.0)
-                            for (int j = 0; j < 3; j++)
-                                pos[i][j] = pos[i][j] + cdt*vel[i][j];
-                });
+            if (fuse) {
+                finishDrift(cdtDrift);
+                s += 2;
             }
-            if (hasVirtualSites)
-                vsites.computePositions(*system, pos, data.periodicBoxVectors);
-            forcesAreValid = false;
+            else
+                s += 1;
+        }
+        else {
+            parallelFor([&] (int t, int start, int end) {
+                for (int i = start; i < end; i++)
+                    driftAtom(i, cdt);
+            });
+            finishDrift(cdt);
+            s += 1;
         }
     }
     if (hasConstraints)
