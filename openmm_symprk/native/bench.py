@@ -138,6 +138,9 @@ def main(argv=None) -> int:
         return 1
     methods = [m.strip() for m in args.methods.split(",") if m.strip()]
     props = {"Precision": args.precision} if args.precision else {}
+    import os
+
+    print(f"load average before: {os.getloadavg()[0]:.2f} (other processes on this machine skew every timing)")
     print(f"openmm {mm.version.full_version}, platform {args.platform} {props or ''}, "
           f"threads: {mm.Platform.getPlatformByName(args.platform).getPropertyDefaultValue('Threads') if args.platform == 'CPU' else '-'}")
     for which in args.systems.split(","):
@@ -152,6 +155,7 @@ def main(argv=None) -> int:
         best = measure(system, pos, vel, methods, args.platform, props, steps=steps,
                        repeats=1 if args.quick else args.repeats, custom=not args.no_custom)
         print(format_table(f"{title}: {steps} steps x best of {1 if args.quick else args.repeats}", best, methods))
+    print(f"load average after: {os.getloadavg()[0]:.2f}")
     return 0
 
 
