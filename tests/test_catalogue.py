@@ -98,3 +98,14 @@ def test_families_and_table():
     for name in ALL:
         assert name in table
     assert not methods["rk4"].symplectic and methods["gauss-2"].symplectic
+
+
+def test_narrow_instability_band_is_found():
+    """sofroniou-spaletta-10 is unstable in a band 7.6e-4 wide near h*omega = pi, narrower than the scan
+    grid; the interval ends at the band, not at the next wide instability (~5.97)."""
+    from openmm_symprk.numerics import _stable
+
+    tab = methods["sofroniou-spaletta-10"].tableau()
+    assert not _stable(tab, np.array([3.1415]))[0]
+    assert _stable(tab, np.array([3.1405, 3.1425])).all()  # stable on both sides of the band
+    assert stability_interval("sofroniou-spaletta-10") == pytest.approx(3.14108, abs=1e-4)
