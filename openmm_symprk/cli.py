@@ -63,15 +63,6 @@ def _cmd_info(args):
     print(f"  catalogue: {len(openmm_symprk.methods)} methods (symprk methods)")
 
 
-def _delegate(module: str):
-    def run(args):
-        import importlib
-
-        return importlib.import_module(module).main(args.rest)
-
-    return run
-
-
 def build_parser():
     p = argparse.ArgumentParser(prog="symprk", description="Symplectic PRK integrators for OpenMM")
     sub = p.add_subparsers(dest="command", required=True)
@@ -95,16 +86,23 @@ def build_parser():
     i = sub.add_parser("info", help="versions, platforms and backends")
     i.set_defaults(func=_cmd_info)
 
-    for name, module, text in (("bench", "openmm_symprk.bench.cli", "work-precision and stability sweeps"),
-                               ("conservation", "openmm_symprk.conservation_study",
-                                "conservation table: platform x method x projection")):
-        s = sub.add_parser(name, help=text, add_help=False)
-        s.add_argument("rest", nargs=argparse.REMAINDER)
-        s.set_defaults(func=_delegate(module))
+    for name, text in (("bench", "work-precision and stability sweeps (symprk bench --help)"),
+                       ("conservation", "conservation table: platform x method x projection "
+                                        "(symprk conservation --help)")):
+        sub.add_parser(name, help=text)
     return p
 
 
+#: sub-commands whose own argument parser lives in another module (argv passed through untouched)
+DELEGATED = {"bench": "openmm_symprk.bench.cli", "conservation": "openmm_symprk.conservation_study"}
+
+
 def main(argv=None):
+    argv = sys.argv[1:] if argv is None else list(argv)
+    if argv and argv[0] in DELEGATED:
+        import importlib
+
+        return importlib.import_module(DELEGATED[argv[0]]).main(argv[1:]) or 0
     args = build_parser().parse_args(argv)
     try:
         rc = args.func(args)
