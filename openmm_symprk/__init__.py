@@ -21,6 +21,11 @@ _LAZY = {
     "RigidGroup": ".rigid_molecules",
     "RigidGroupError": ".rigid_molecules",
     "RigidGroupWarning": ".rigid_molecules",
+    "linear_momentum": ".conservation",
+    "angular_momentum": ".conservation",
+    "diagnostics": ".conservation",
+    "ConservationReporter": ".reporters",
+    "VelocityTRRReporter": ".reporters",
 }
 
 

@@ -112,7 +112,7 @@ class PRKIntegrator(mm.CustomIntegrator):
         try:
             self.program_info = program.compile_program(
                 self, method, bool(constraints), exact_momentum=exact_momentum, check_finite=check_finite,
-                tolerance=tolerance, max_iterations=int(max_iterations))
+                tolerance=tolerance, max_iterations=int(max_iterations), system=system)
         except program.ConstraintSupportError as exc:
             raise program.ConstraintSupportError(str(exc).replace("user tableau", self.method_name)) from None
         self.check_finite = check_finite

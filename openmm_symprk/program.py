@@ -13,7 +13,9 @@ One compiler for everything (OPENMM_NOTES.md explains each rule):
   so they are omitted (each one would cost a constraint solve).
 * General tableaux (explicit non-splitting, implicit) for unconstrained systems: stage values live in
   per-DOF variables; implicit stages are solved by fixed-point iteration in a single while block.
-* Optional exact-momentum kicks (:mod:`openmm_symprk.projection`) and a blow-up check: the step counter
+* Optional exact momentum (:mod:`openmm_symprk.projection`): projected kicks, and the round-off net
+  momentum and torque of every constraint projection removed (after each RATTLE drift and after the
+  end-of-step velocity projection), with the System's masses in double; and a blow-up check: the step counter
   and the first step at which the velocities stopped being finite are kept in global variables.
 """
 from __future__ import annotations
@@ -57,7 +59,7 @@ def _num(c) -> str:
 class _Emitter:
     """Appends computations to a CustomIntegrator, with the shared kick and drift rules."""
 
-    def __init__(self, integrator: mm.CustomIntegrator, constraints: bool, exact_momentum: bool):
+    def __init__(self, integrator: mm.CustomIntegrator, constraints: bool, exact_momentum: bool, system=None):
         self.ig = integrator
         self.constraints = constraints
         self.exact_momentum = exact_momentum
@@ -65,7 +67,7 @@ class _Emitter:
         if exact_momentum:
             from .projection import add_projection_variables
 
-            add_projection_variables(integrator)
+            add_projection_variables(integrator, system)
 
     def per_dof(self, name: str):
         if name not in self._vars:
@@ -102,9 +104,17 @@ class _Emitter:
             self.ig.addComputePerDof("symprk_xu", "x")
             self.ig.addConstrainPositions()
             self.ig.addComputePerDof("v", f"v + (x - symprk_xu)/({_num(c)}*dt)")
+            if self.exact_momentum:
+                from .projection import emit_drift_restoration
+
+                emit_drift_restoration(self.ig, "symprk_xu", f"{_num(c)}*dt")
 
     def finish(self, check_finite: bool):
-        if self.constraints:
+        if self.constraints and self.exact_momentum:
+            from .projection import emit_constrain_velocities
+
+            emit_constrain_velocities(self.ig)
+        elif self.constraints:
             self.ig.addConstrainVelocities()
         self.glob(STEP_VAR)
         self.ig.addComputeGlobal(STEP_VAR, f"{STEP_VAR} + 1")
@@ -120,9 +130,9 @@ class _Emitter:
 
 
 def compile_splitting(integrator, splitting: Splitting, constraints: bool, exact_momentum=False,
-                      check_finite=True, update_context_state=True) -> ProgramInfo:
+                      check_finite=True, update_context_state=True, system=None) -> ProgramInfo:
     """Emit the program of a kick/drift sequence (RATTLE when ``constraints``)."""
-    em = _Emitter(integrator, constraints, exact_momentum)
+    em = _Emitter(integrator, constraints, exact_momentum, system)
     if update_context_state:
         integrator.addUpdateContextState()
     for label, c in splitting.coefficients(np.float64):
@@ -144,12 +154,12 @@ def _lincomb(base: str, coeffs, names) -> str:
 
 
 def compile_tableau(integrator, tab: PRKTableau, exact_momentum=False, check_finite=True,
-                    update_context_state=True, tolerance=1e-10, max_iterations=50) -> ProgramInfo:
+                    update_context_state=True, tolerance=1e-12, max_iterations=60, system=None) -> ProgramInfo:
     """Emit the program of a general PRK pair (unconstrained systems only).
 
     Per-DOF variables: symprk_x0/v0 (start of step), symprk_k<i> (stage accelerations F(Q_i)/m),
     symprk_p<i> (stage velocities P_i), symprk_q<i> (implicit stage positions)."""
-    em = _Emitter(integrator, False, exact_momentum)
+    em = _Emitter(integrator, False, exact_momentum, system)
     s = tab.stages
     A, Ah, b, bh = (np.asarray(m, dtype=np.float64) for m in (tab.A, tab.A_hat, tab.b, tab.b_hat))
     if update_context_state:
@@ -245,7 +255,8 @@ def compile_program(integrator, method, constraints: bool, **options) -> Program
         except TableauError:
             pass
     if isinstance(method, Splitting):
-        keep = {k: v for k, v in options.items() if k in ("exact_momentum", "check_finite", "update_context_state")}
+        keep = {k: v for k, v in options.items()
+                if k in ("exact_momentum", "check_finite", "update_context_state", "system")}
         return compile_splitting(integrator, method, constraints, **keep)
     if constraints:
         raise ConstraintSupportError(

@@ -23,12 +23,8 @@ sum m x_old x (x - x_u)/h with x_old = x - h v, both zero.  :func:`emit_drift_re
 their round-off values with a rigid-body velocity correction w + gamma x (r - r_cm) (which keeps every
 distance-constraint velocity condition, since (r_i - r_j).(gamma x (r_i - r_j)) = 0), and
 :func:`emit_constrain_velocities` does the same for the velocity projection at the end of a step.
-:func:`emit_projected_acceleration` applies the drift restoration by itself when the computation just
-before it is the compiler's RATTLE velocity correction ``v + (x - symprk_xu)/(c*dt)``; the
-end-of-step velocity projection needs the compiler to call :func:`emit_constrain_velocities` instead
-of ``addConstrainVelocities``, and a drift that ends a step (position Verlet) needs it to call
-:func:`emit_drift_restoration`: hooks that :mod:`openmm_symprk.program` does not have yet
-(:func:`exact_integrator` / :class:`compiler_hooks` supply them meanwhile).
+:func:`openmm_symprk.program` calls both after every RATTLE drift and at the end of every step when
+``exact_momentum=True``.
 
 Precision
 ---------
@@ -75,7 +71,6 @@ centre of mass is not zero for the exact forces and removing it changes the dyna
 """
 from __future__ import annotations
 
-import re
 
 import openmm as mm
 
@@ -102,8 +97,6 @@ GLOBALS = tuple(
 #: Per-DOF variables: selectors, masses, force/impulse, torque density, permuted x, cache, saved v.
 PER_DOF = ("ex", "ey", "ez", "mass", "fm", "t", "xp", "xpp", "xref", "aref", "raw", "vb")
 
-#: The compiler's RATTLE velocity correction (program._Emitter.drift), recognised before a kick.
-_RATTLE_CORRECTION = re.compile(r"^v \+ \(x - (\w+)\)/\((.+)\)$")
 
 
 def _g(name: str) -> str:
@@ -294,10 +287,7 @@ def emit_projected_acceleration(integrator: mm.CustomIntegrator, target: str, re
 
     References only ``f`` (all force groups), ``m`` and ``x``: one force evaluation if the forces are
     not cached, as for a plain ``f/m`` kick.  ``target`` must already be a per-DOF variable.
-    ``reuse`` (default: the first call of a program outside any block) emits the cache check.
-    If the computation just before is the compiler's RATTLE velocity correction, the drift's
-    constraint impulses are first restored to zero net momentum and torque
-    (:func:`emit_drift_restoration`)."""
+    ``reuse`` (default: the first call of a program outside any block) emits the cache check."""
     ig = integrator
     g = _g
     steps = _steps(ig)
@@ -306,10 +296,6 @@ def emit_projected_acceleration(integrator: mm.CustomIntegrator, target: str, re
         reuse = first and not in_block
     if not _mass_current(steps):
         _emit_mass(ig)
-    if steps and steps[-1][0] == mm.CustomIntegrator.ComputePerDof and steps[-1][1] == "v":
-        match = _RATTLE_CORRECTION.match(steps[-1][2].strip())
-        if match:
-            emit_drift_restoration(ig, match.group(1), match.group(2))
     mass, fm = g("mass"), g("fm")
     ig.addComputePerDof(fm, f"select({mass}, f, 0)")
     raw = f"select({mass}, {fm}/{mass}, 0)"
@@ -368,82 +354,3 @@ def emit_constrain_velocities(integrator: mm.CustomIntegrator) -> None:
     _emit_net(ig, j)
     _emit_solve(ig)
     ig.addComputePerDof("v", f"v - select({mass}, {_rigid()}, 0)")
-
-
-# -- until the compiler calls the constraint hooks itself -------------------------------------------
-def compiler_hooks_present() -> tuple:
-    """(velocity hook, drift hook): whether :mod:`openmm_symprk.program` already emits
-    :func:`emit_constrain_velocities` at the end of a step and :func:`emit_drift_restoration` after
-    every RATTLE drift (checked on position Verlet, whose last drift is not followed by a kick)."""
-    from . import program
-    from .catalogue import get_method
-
-    ig = mm.CustomIntegrator(0.001)
-    program.compile_program(ig, get_method("position-verlet"), True, exact_momentum=True)
-    steps = _steps(ig)
-    velocity = any(var == _g("vb") for _, var, _ in steps)
-    corrections = [i for i, (k, var, expr) in enumerate(steps)
-                   if k == mm.CustomIntegrator.ComputePerDof and var == "v" and _RATTLE_CORRECTION.match(expr.strip())]
-    drift = bool(corrections) and all(
-        any(var == _g("fm") and "symprk_xu" in expr for _, var, expr in steps[i + 1:i + 4]) for i in corrections)
-    return velocity, drift
-
-
-class compiler_hooks:
-    """Context manager: integrators compiled inside it with ``exact_momentum=True`` and constraints
-    also restore the momentum of every RATTLE drift (:func:`emit_drift_restoration`, including a drift
-    that ends a step, as in position Verlet) and of the end-of-step velocity projection
-    (:func:`emit_constrain_velocities`).
-
-    A stop-gap for the two hooks that :mod:`openmm_symprk.program` lacks (``_Emitter.drift`` and
-    ``_Emitter.finish``); it patches nothing that the compiler already does."""
-
-    def __enter__(self):
-        from . import program
-
-        self._program = program
-        self._saved = {}
-        velocity, drift = compiler_hooks_present()
-        if not velocity:
-            orig_finish = self._saved["finish"] = program._Emitter.finish
-
-            def finish(em, check_finite):
-                if em.constraints and em.exact_momentum:
-                    emit_constrain_velocities(em.ig)
-                    em.constraints = False
-                    try:
-                        orig_finish(em, check_finite)
-                    finally:
-                        em.constraints = True
-                else:
-                    orig_finish(em, check_finite)
-
-            program._Emitter.finish = finish
-        if not drift:
-            orig_drift = self._saved["drift"] = program._Emitter.drift
-
-            def drift_(em, c):
-                orig_drift(em, c)
-                if em.constraints and em.exact_momentum:
-                    emit_drift_restoration(em.ig, "symprk_xu", f"{program._num(c)}*dt")
-
-            program._Emitter.drift = drift_
-        return self
-
-    def __exit__(self, *exc):
-        for name, fn in self._saved.items():
-            setattr(self._program._Emitter, name, fn)
-        return False
-
-
-def exact_integrator(step_size, method="verlet", system=None, **options):
-    """A :class:`~openmm_symprk.integrators.SymplecticIntegrator` with ``exact_momentum=True``, the
-    System's masses stored (:func:`set_masses`) and the constraint hooks (see
-    :class:`compiler_hooks`): the complete exact-momentum program on every platform."""
-    from .integrators import SymplecticIntegrator
-
-    with compiler_hooks():
-        ig = SymplecticIntegrator(step_size, method, system=system, exact_momentum=True, **options)
-    if system is not None:
-        set_masses(ig, system)
-    return ig
