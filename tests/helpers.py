@@ -1,14 +1,16 @@
-"""Small float64 measurements shared by the OpenMM tests."""
+"""Small float64 measurements shared by the OpenMM tests (built on openmm_symprk.conservation)."""
 import numpy as np
 import openmm.unit as unit
 
+from openmm_symprk.conservation import angular_momentum, linear_momentum
+
 
 def momenta(ctx, masses):
-    st = ctx.getState(getPositions=True, getVelocities=True)
-    x = st.getPositions(asNumpy=True).value_in_unit(unit.nanometer)
-    v = st.getVelocities(asNumpy=True).value_in_unit(unit.nanometer / unit.picosecond)
-    m = masses[:, None]
-    return (m * v).sum(0), (m * np.cross(x, v)).sum(0), float(np.sum(m * np.abs(v)))
+    """(P, L about the origin, sum m|v|) in float64."""
+    state = ctx.getState(getPositions=True, getVelocities=True)
+    v = state.getVelocities(asNumpy=True).value_in_unit(unit.nanometer / unit.picosecond)
+    return (linear_momentum(state, masses=masses), angular_momentum(state, about="origin", masses=masses),
+            float(np.sum(masses[:, None] * np.abs(v))))
 
 
 def drift_after(ctx, integrator, masses, steps):
