@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import json
 import os
+import sys
 
 import openmm as mm
 
@@ -38,7 +39,36 @@ class _State:
     swig = None
     reason = ""
     build_info: dict = {}
+    build_dir = ""
     plugin_errors: dict = {}
+
+
+def _build_dir() -> str:
+    """The folder holding this package's native build.
+
+    Normally this package's own folder.  When the package is imported from a source checkout that was
+    installed non-editably (``pip install .`` then ``python -m pytest`` in the checkout, as CI does), the
+    checkout shadows the installed copy and has no build outputs: the installed copy's folder is used then,
+    and added to this package's ``__path__`` so that its extension module imports."""
+    def built(d):
+        return os.path.exists(os.path.join(d, "_build_info.json")) or os.path.exists(os.path.join(d, "_build_error.txt"))
+
+    if built(_HERE):
+        return _HERE
+    candidates = []
+    try:
+        from importlib.metadata import distribution
+
+        candidates.append(str(distribution("openmm_symprk").locate_file(os.path.join("openmm_symprk", "native"))))
+    except Exception:
+        pass
+    candidates += [os.path.join(p or os.getcwd(), "openmm_symprk", "native") for p in sys.path]
+    for d in candidates:
+        if os.path.isdir(d) and os.path.realpath(d) != os.path.realpath(_HERE) and built(d):
+            if d not in __path__:
+                __path__.append(d)
+            return d
+    return _HERE
 
 
 def _load() -> _State:
@@ -46,8 +76,10 @@ def _load() -> _State:
     if st.loaded:
         return st
     st.loaded = True
-    info_path = os.path.join(_HERE, "_build_info.json")
-    error_path = os.path.join(_HERE, "_build_error.txt")
+    where = _build_dir()
+    st.build_dir = where
+    info_path = os.path.join(where, "_build_info.json")
+    error_path = os.path.join(where, "_build_error.txt")
     if not os.path.exists(info_path) and os.path.exists(error_path):
         with open(error_path) as fh:
             st.reason = "the native plugin failed to build at install time: " + fh.read().strip()
@@ -73,7 +105,7 @@ def _load() -> _State:
     except Exception as exc:
         st.reason = f"the native plugin's Python module does not import: {exc}"
         return st
-    libdir = os.path.join(_HERE, "lib")
+    libdir = os.path.join(where, "lib")
     for platform, name in st.build_info.get("libraries", {}).items():
         if platform == "api":
             continue
