@@ -17,8 +17,8 @@ from openmm_symprk import SymplecticIntegrator, methods
 from openmm_symprk.integrators import SimulationBlowUpError
 from openmm_symprk import native
 
-pytestmark = pytest.mark.skipif(not native.native_available(),
-                                reason=f"native plugin unavailable: {native.unavailable_reason()}")
+needs_native = pytest.mark.skipif(not native.native_available(),
+                                  reason=f"native plugin unavailable: {native.unavailable_reason()}")
 
 SPLITTINGS = [m.name for m in methods.splittings()]
 N = native.NativeSymplecticIntegrator
@@ -43,6 +43,7 @@ def _opencl_ok():
 
 
 # -- Reference: the same trajectory as the CustomIntegrator, every explicit method, with and without constraints
+@needs_native
 @pytest.mark.parametrize("name", SPLITTINGS)
 @pytest.mark.parametrize("scene_name", ["water8", "morse", "constrained"])
 def test_same_trajectory_as_custom_on_reference(name, scene_name, request):
@@ -56,6 +57,7 @@ def test_same_trajectory_as_custom_on_reference(name, scene_name, request):
     np.testing.assert_allclose(v1, v2, rtol=0, atol=1e-10)
 
 
+@needs_native
 @pytest.mark.parametrize("name", ["verlet", "yoshida-4", "blanes-moan-srkn6b-4"])
 def test_exact_momentum_matches_custom_on_reference(name, water8):
     dt = 2 * unit.femtoseconds
@@ -65,6 +67,7 @@ def test_exact_momentum_matches_custom_on_reference(name, water8):
     np.testing.assert_allclose(v1, v2, rtol=0, atol=1e-9)
 
 
+@needs_native
 @pytest.mark.parametrize("name", ["verlet", "omelyan-2", "yoshida-4", "kahan-li-6"])
 def test_same_conservation_figures(name, water8):
     figures = []
@@ -78,6 +81,7 @@ def test_same_conservation_figures(name, water8):
     assert abs(dl1 - dl2) <= 1e-13 and abs(dp1 - dp2) <= 1e-13
 
 
+@needs_native
 def test_threaded_loops_are_bitwise_identical(water27, monkeypatch):
     """The per-atom loops on the platform's thread pool give the same numbers as the serial loops."""
     out = []
@@ -103,6 +107,7 @@ class Counter:
 
 @pytest.mark.parametrize("name", ["verlet", "position-verlet", "omelyan-2", "yoshida-4", "mclachlan-atela-4",
                                   "blanes-moan-srkn6b-4", "kahan-li-6", "kahan-li-8"])
+@needs_native
 @pytest.mark.parametrize("scene_name", ["water8", "morse"])
 def test_force_evaluations_per_step(name, scene_name, request):
     scene = request.getfixturevalue(scene_name)
@@ -126,6 +131,7 @@ def test_force_evaluations_per_step(name, scene_name, request):
 
 
 # -- OpenCL (PoCL in CI) ---------------------------------------------------------------------------------------
+@needs_native
 @pytest.mark.skipif(not _opencl_ok(), reason="no native OpenCL kernel here (OpenCL platform or its build missing)")
 @pytest.mark.parametrize("precision,tol", [("double", 1e-5), ("mixed", 1e-5), ("single", 1e-4)])
 def test_opencl_matches_reference(precision, tol, water8, morse, constrained):
@@ -137,6 +143,7 @@ def test_opencl_matches_reference(precision, tol, water8, morse, constrained):
             assert np.abs(ocl[0] - ref[0]).max() < tol, (scene.name, name)
 
 
+@needs_native
 @pytest.mark.skipif(not _opencl_ok(), reason="no native OpenCL kernel here (OpenCL platform or its build missing)")
 def test_opencl_same_program_as_custom_in_double(morse, constrained):
     for scene in (morse, constrained):
@@ -146,6 +153,7 @@ def test_opencl_same_program_as_custom_in_double(morse, constrained):
         assert np.abs(a[0] - b[0]).max() < 1e-9 and np.abs(a[1] - b[1]).max() < 1e-7
 
 
+@needs_native
 @pytest.mark.skipif(not _opencl_ok(), reason="no native OpenCL kernel here (OpenCL platform or its build missing)")
 @pytest.mark.parametrize("precision,plain,exact", [("double", 1e-10, 1e-11), ("mixed", 1e-4, 1e-11)])
 def test_opencl_conservation(precision, plain, exact, water8):
@@ -158,6 +166,7 @@ def test_opencl_conservation(precision, plain, exact, water8):
 
 
 # -- CPU ----------------------------------------------------------------------------------------------------------
+@needs_native
 def test_cpu_platform_runs_native(water8):
     assert "CPU" in native.native_platforms()
     ref = _run(water8, N(1 * unit.femtoseconds, "yoshida-4", system=water8.system), 50)
@@ -166,6 +175,7 @@ def test_cpu_platform_runs_native(water8):
 
 
 # -- XML, checkpoints ---------------------------------------------------------------------------------------------
+@needs_native
 def test_xml_round_trip(water8):
     ig = N(1.5 * unit.femtoseconds, "kahan-li-6", system=water8.system, exact_momentum=True)
     ig.setConstraintTolerance(1e-7)
@@ -183,6 +193,7 @@ def test_xml_round_trip(water8):
     np.testing.assert_array_equal(a[1], b[1])
 
 
+@needs_native
 @pytest.mark.parametrize("scene_name", ["water8", "morse"])
 def test_checkpoint_continues_bitwise_on_reference(scene_name, request):
     scene = request.getfixturevalue(scene_name)
@@ -244,6 +255,7 @@ def _vsite_error(system, x):
     return err
 
 
+@needs_native
 @pytest.mark.skipif(not _opencl_ok(), reason="no native OpenCL kernel here (OpenCL platform or its build missing)")
 def test_opencl_virtual_sites_and_checkpoint():
     system, pos, vel = _tip4p_cluster()
@@ -269,6 +281,7 @@ def test_opencl_virtual_sites_and_checkpoint():
 
 
 
+@needs_native
 def test_virtual_sites_follow_their_parents():
     """TIP4P-Ew waters: the site is placed after every step (and before each force evaluation inside the
     step: the energy is conserved, unlike the CustomIntegrator path's, which sees sites one drift behind)."""
@@ -286,6 +299,7 @@ def test_virtual_sites_follow_their_parents():
     assert max(energies) - min(energies) < 0.05
 
 
+@needs_native
 def test_blow_up_names_the_first_bad_step():
     system = mm.System()
     system.addParticle(1.0)
@@ -314,6 +328,7 @@ def test_blow_up_names_the_first_bad_step():
     assert np.all(v * v <= 1e10)
 
 
+@needs_native
 def test_errors(water8):
     with pytest.raises(ValueError, match="positive"):
         N(-1 * unit.femtoseconds, "verlet")
@@ -337,9 +352,34 @@ def test_errors(water8):
         ig.setSubsteps([0], [1.0])
 
 
+@needs_native
 def test_unavailable_reason_is_reported(monkeypatch):
     monkeypatch.setattr(native._State, "swig", None)
     monkeypatch.setattr(native._State, "reason", "test: no plugin")
     assert not native.native_available() and native.native_platforms() == []
     with pytest.raises(native.NativeUnavailableError, match="test: no plugin"):
         N(1 * unit.femtoseconds, "verlet")
+
+
+# -- the build driver's failure path (runs whether or not the plugin is built) ---------------------------------------
+def _build_driver():
+    import importlib.util
+
+    path = os.path.join(os.path.dirname(__file__), "..", "platforms", "build_native.py")
+    if not os.path.exists(path):
+        pytest.skip("not a source checkout (platforms/build_native.py absent)")
+    spec = importlib.util.spec_from_file_location("symprk_build_native_test", path)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+@pytest.mark.parametrize("env,match", [({"SYMPRK_NATIVE": "0"}, "disabled"),
+                                       ({"CXX": "no-such-compiler-symprk"}, "no C\\+\\+ compiler")])
+def test_build_driver_fails_cleanly(env, match, tmp_path, monkeypatch):
+    bn = _build_driver()
+    for k, v in env.items():
+        monkeypatch.setenv(k, v)
+    with pytest.raises(bn.NativeBuildError, match=match):
+        bn.build(tmp_path / "native", tmp_path / "tmp", log=lambda *a: None)
+    assert not (tmp_path / "native" / "_build_info.json").exists()

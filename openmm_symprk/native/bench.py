@@ -127,6 +127,8 @@ def main(argv=None) -> int:
     ap.add_argument("--systems", default="cluster,box")
     ap.add_argument("--no-custom", action="store_true", help="skip the CustomIntegrator timings")
     ap.add_argument("--quick", action="store_true", help="fewer steps and repeats (a rough look)")
+    ap.add_argument("--no-forces", action="store_true",
+                    help="remove every force (constraints stay): times the integrators' own work alone")
     args = ap.parse_args(argv)
     from . import native_available, native_platforms, unavailable_reason
 
@@ -152,6 +154,10 @@ def main(argv=None) -> int:
             steps = args.steps or (20 if args.quick else 100)
         else:
             raise SystemExit(f"unknown system {which!r} (cluster, box)")
+        if args.no_forces:
+            while system.getNumForces():
+                system.removeForce(0)
+            title += ", no forces (integrator work only)"
         best = measure(system, pos, vel, methods, args.platform, props, steps=steps,
                        repeats=1 if args.quick else args.repeats, custom=not args.no_custom)
         print(format_table(f"{title}: {steps} steps x best of {1 if args.quick else args.repeats}", best, methods))
