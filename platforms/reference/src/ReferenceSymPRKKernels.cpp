@@ -118,8 +118,13 @@ void ReferenceIntegrateSymPRKStepKernel::computeProjection(const vector<Vec3>& p
         d += diag[t];
         o += offdiag[t];
     }
-    // Inertia tensor about the centre of mass, regularised by 1e-12 of its trace (a linear molecule or a single
-    // particle then gives a finite alpha; the shift changes a round-off-sized torque by 1e-12 of itself).
+    alpha = solveInertia(d, o, tau);
+}
+
+Vec3 ReferenceIntegrateSymPRKStepKernel::solveInertia(Vec3 d, Vec3 o, Vec3 tau) {
+    // d = (sum m x^2, sum m y^2, sum m z^2), o = (sum m xy, sum m xz, sum m yz) about the centre of mass.
+    // The inertia tensor is regularised by 1e-12 of its trace (a linear molecule or a single particle then
+    // gives a finite result; the shift changes a round-off-sized torque by 1e-12 of itself).
     double Ixx = d[1]+d[2], Iyy = d[0]+d[2], Izz = d[0]+d[1];
     double Ixy = -o[0], Ixz = -o[1], Iyz = -o[2];
     double shift = 1e-12*(Ixx+Iyy+Izz);
@@ -130,9 +135,62 @@ void ReferenceIntegrateSymPRKStepKernel::computeProjection(const vector<Vec3>& p
     double axy = Ixz*Iyz-Izz*Ixy, axz = Ixy*Iyz-Iyy*Ixz, ayz = Ixy*Ixz-Ixx*Iyz;
     double det = Ixx*axx+Ixy*axy+Ixz*axz;
     if (det == 0.0 || !std::isfinite(det))
-        alpha = Vec3();
-    else
-        alpha = Vec3(axx*tau[0]+axy*tau[1]+axz*tau[2], axy*tau[0]+ayy*tau[1]+ayz*tau[2], axz*tau[0]+ayz*tau[1]+azz*tau[2])/det;
+        return Vec3();
+    return Vec3(axx*tau[0]+axy*tau[1]+axz*tau[2], axy*tau[0]+ayy*tau[1]+ayz*tau[2], axz*tau[0]+ayz*tau[1]+azz*tau[2])/det;
+}
+
+void ReferenceIntegrateSymPRKStepKernel::removeRigidChange(const vector<Vec3>& pos, vector<Vec3>& vel, Vec3 dP, Vec3 dL) {
+    // Velocities changed by impulses whose net momentum dP and angular momentum dL (about the origin) should be
+    // zero but are not, by round-off: add the rigid-body velocity w + gamma x (r - c) that cancels both
+    // (c: centre of mass of pos).  A rigid-body velocity keeps every distance-constraint velocity condition.
+    int chunks = threadStart.size()-1;
+    vector<double> mass(chunks, 0.0);
+    vector<Vec3> mx(chunks);
+    parallelFor([&] (int t, int start, int end) {
+        double m = 0;
+        Vec3 a;
+        for (int i = start; i < end; i++)
+            if (masses[i] != 0.0) {
+                m += masses[i];
+                a += pos[i]*masses[i];
+            }
+        mass[t] = m;
+        mx[t] = a;
+    });
+    double M = 0;
+    Vec3 moment;
+    for (int t = 0; t < chunks; t++) {
+        M += mass[t];
+        moment += mx[t];
+    }
+    if (M == 0.0)
+        return;
+    Vec3 c = moment/M;
+    vector<Vec3> diag(chunks), offdiag(chunks);
+    parallelFor([&] (int t, int start, int end) {
+        Vec3 d, o;
+        for (int i = start; i < end; i++)
+            if (masses[i] != 0.0) {
+                Vec3 r = pos[i]-c;
+                double m = masses[i];
+                d += Vec3(m*r[0]*r[0], m*r[1]*r[1], m*r[2]*r[2]);
+                o += Vec3(m*r[0]*r[1], m*r[0]*r[2], m*r[1]*r[2]);
+            }
+        diag[t] = d;
+        offdiag[t] = o;
+    });
+    Vec3 d, o;
+    for (int t = 0; t < chunks; t++) {
+        d += diag[t];
+        o += offdiag[t];
+    }
+    Vec3 w = -dP/M;
+    Vec3 gamma = solveInertia(d, o, c.cross(dP)-dL);
+    parallelFor([&] (int t, int start, int end) {
+        for (int i = start; i < end; i++)
+            if (masses[i] != 0.0)
+                vel[i] = vel[i] + w + gamma.cross(pos[i]-c);
+    });
 }
 
 void ReferenceIntegrateSymPRKStepKernel::execute(ContextImpl& context, const SymPRKIntegrator& integrator, bool& forcesAreValid, long long stepIndex) {
@@ -163,12 +221,33 @@ void ReferenceIntegrateSymPRKStepKernel::execute(ContextImpl& context, const Sym
     auto finishDrift = [&] (double cdt) {
         if (hasConstraints) {
             constraints.apply(xRef, pos, inverseMasses, tol);
+            int chunks = threadStart.size()-1;
+            vector<Vec3> netP(chunks), netL(chunks);
             parallelFor([&] (int t, int start, int end) {
+                Vec3 p, l;
                 for (int i = start; i < end; i++)
-                    if (masses[i] != 0.0)
+                    if (masses[i] != 0.0) {
                         for (int j = 0; j < 3; j++)
                             vel[i][j] = vel[i][j] + (pos[i][j]-xUnconstrained[i][j])/cdt;
+                        if (exact) {
+                            Vec3 impulse = (pos[i]-xUnconstrained[i])*(masses[i]/cdt);
+                            p += impulse;
+                            l += xRef[i].cross(impulse);
+                        }
+                    }
+                netP[t] = p;
+                netL[t] = l;
             });
+            if (exact) {
+                // Exact momentum: the constraint impulses m (x - x_u)/h carry no net momentum and no torque about
+                // the pre-drift positions in exact arithmetic; remove their round-off values.
+                Vec3 dP, dL;
+                for (int t = 0; t < chunks; t++) {
+                    dP += netP[t];
+                    dL += netL[t];
+                }
+                removeRigidChange(pos, vel, dP, dL);
+            }
         }
         if (hasVirtualSites)
             vsites.computePositions(*system, pos, data.periodicBoxVectors);
@@ -224,8 +303,22 @@ void ReferenceIntegrateSymPRKStepKernel::execute(ContextImpl& context, const Sym
             s += 1;
         }
     }
-    if (hasConstraints)
-        constraints.applyToVelocities(pos, vel, inverseMasses, tol);
+    if (hasConstraints) {
+        if (exact) {
+            vBefore = vel;
+            constraints.applyToVelocities(pos, vel, inverseMasses, tol);
+            Vec3 dP, dL;
+            for (int i = 0; i < numParticles; i++)
+                if (masses[i] != 0.0) {
+                    Vec3 impulse = (vel[i]-vBefore[i])*masses[i];
+                    dP += impulse;
+                    dL += pos[i].cross(impulse);
+                }
+            removeRigidChange(pos, vel, dP, dL);
+        }
+        else
+            constraints.applyToVelocities(pos, vel, inverseMasses, tol);
+    }
 
     // Record the first step that leaves a velocity NaN, infinite or beyond 1e5 nm/ps (NaN fails every <=).
     if (blowUpStep == 0) {

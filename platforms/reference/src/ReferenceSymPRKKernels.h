@@ -34,10 +34,12 @@ public:
 private:
     void parallelFor(const std::function<void(int, int, int)>& task);
     void computeProjection(const std::vector<Vec3>& pos, const std::vector<Vec3>& force);
+    void removeRigidChange(const std::vector<Vec3>& pos, std::vector<Vec3>& vel, Vec3 dP, Vec3 dL);
+    static Vec3 solveInertia(Vec3 diag, Vec3 offdiag, Vec3 rhs);
     ReferencePlatform::PlatformData& data;
     const System* system;
     std::vector<double> masses, inverseMasses;
-    std::vector<Vec3> xRef, xUnconstrained;
+    std::vector<Vec3> xRef, xUnconstrained, vBefore;
     std::vector<int> threadStart;
     bool hasConstraints, hasVirtualSites, useThreads;
     int numParticles;
