@@ -30,8 +30,12 @@ void CommonIntegrateSymPRKStepKernel::initialize(const System& system, const Sym
     driftDeltaKernel = program->createKernel("symprkDriftDelta");
     driftApplyKernel = program->createKernel("symprkDriftApply");
     projectionKernel = program->createKernel("symprkProjection");
+    rigidSumsKernel = program->createKernel("symprkRigidSums");
+    rigidApplyKernel = program->createKernel("symprkRigidApply");
     bool useDouble = (cc.getUseDoublePrecision() || cc.getUseMixedPrecision());
     projection.initialize(cc, 9, useDouble ? sizeof(double) : sizeof(float), "symprkProjection");
+    rigid.initialize(cc, 9, useDouble ? sizeof(double) : sizeof(float), "symprkRigid");
+    vBefore.initialize(cc, cc.getPaddedNumAtoms(), useDouble ? 4*sizeof(double) : 4*sizeof(float), "symprkVelocitiesBefore");
     badStep.initialize<int>(cc, 1, "symprkBadStep");
     int zero = 0;
     badStep.upload(&zero);
@@ -90,6 +94,26 @@ void CommonIntegrateSymPRKStepKernel::execute(ContextImpl& context, const SymPRK
         driftApplyKernel->addArg(integration.getPosDelta());
         driftApplyKernel->addArg(0);
         driftApplyKernel->addArg(badStep);
+        driftApplyKernel->addArg(0);
+        driftApplyKernel->addArg(rigid);
+        rigidSumsKernel->addArg();
+        rigidSumsKernel->addArg();
+        rigidSumsKernel->addArg(cc.getPosq());
+        if (mixed)
+            rigidSumsKernel->addArg(cc.getPosqCorrection());
+        else
+            rigidSumsKernel->addArg(nullptr);
+        rigidSumsKernel->addArg(cc.getVelm());
+        rigidSumsKernel->addArg(integration.getPosDelta());
+        rigidSumsKernel->addArg(vBefore);
+        rigidSumsKernel->addArg(rigid);
+        rigidApplyKernel->addArg(cc.getPosq());
+        if (mixed)
+            rigidApplyKernel->addArg(cc.getPosqCorrection());
+        else
+            rigidApplyKernel->addArg(nullptr);
+        rigidApplyKernel->addArg(cc.getVelm());
+        rigidApplyKernel->addArg(rigid);
         projectionKernel->addArg(cc.getPosq());
         if (mixed)
             projectionKernel->addArg(cc.getPosqCorrection());
@@ -141,8 +165,16 @@ void CommonIntegrateSymPRKStepKernel::execute(ContextImpl& context, const SymPRK
                 setMixedArg(driftDeltaKernel, 0, cdt);
                 driftDeltaKernel->execute(numAtoms);
                 integration.applyConstraints(tol);
+                if (exact) {
+                    // Exact momentum: cancel the round-off net momentum and torque of the constraint impulses
+                    // (about the pre-drift positions) with a rigid-body velocity at the new positions.
+                    rigidSumsKernel->setArg(0, 0);
+                    setMixedArg(rigidSumsKernel, 1, cdt);
+                    rigidSumsKernel->execute(projectionBlockSize, projectionBlockSize);
+                }
                 setMixedArg(driftApplyKernel, 0, cdt);
                 driftApplyKernel->setArg(5, checkStep);
+                driftApplyKernel->setArg(7, exact ? 1 : 0);
                 driftApplyKernel->execute(numAtoms);
             }
             else {
@@ -153,8 +185,18 @@ void CommonIntegrateSymPRKStepKernel::execute(ContextImpl& context, const SymPRK
             forcesAreValid = false;
         }
     }
-    if (hasConstraints)
-        integration.applyVelocityConstraints(tol);
+    if (hasConstraints) {
+        if (exact) {
+            cc.getVelm().copyTo(vBefore);
+            integration.applyVelocityConstraints(tol);
+            rigidSumsKernel->setArg(0, 1);
+            setMixedArg(rigidSumsKernel, 1, 1.0);
+            rigidSumsKernel->execute(projectionBlockSize, projectionBlockSize);
+            rigidApplyKernel->execute(numAtoms);
+        }
+        else
+            integration.applyVelocityConstraints(tol);
+    }
     cc.setTime(cc.getTime()+dt);
     cc.setStepCount(cc.getStepCount()+1);
     cc.reorderAtoms();

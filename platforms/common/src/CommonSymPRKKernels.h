@@ -37,8 +37,8 @@ private:
     bool hasInitializedKernels, hasConstraints;
     int projectionBlockSize;
     long long blowUpStep;
-    ComputeArray projection, badStep;
-    ComputeKernel kickKernel, kickProjectedKernel, driftKernel, driftDeltaKernel, driftApplyKernel, checkKernel, projectionKernel;
+    ComputeArray projection, badStep, rigid, vBefore;
+    ComputeKernel kickKernel, kickProjectedKernel, driftKernel, driftDeltaKernel, driftApplyKernel, projectionKernel, rigidSumsKernel, rigidApplyKernel;
 };
 
 } // namespace OpenMM

@@ -102,7 +102,8 @@ KERNEL void symprkDriftDelta(mixed cdt, GLOBAL const mixed4* RESTRICT velm, GLOB
 
 /** drift with constraints, part 2: x += constrained displacement, v += (x - x_unconstrained)/(c*dt). */
 KERNEL void symprkDriftApply(mixed cdt, GLOBAL real4* RESTRICT posq, GLOBAL real4* RESTRICT posqCorrection,
-        GLOBAL mixed4* RESTRICT velm, GLOBAL const mixed4* RESTRICT posDelta, int checkStep, GLOBAL int* RESTRICT badStep) {
+        GLOBAL mixed4* RESTRICT velm, GLOBAL const mixed4* RESTRICT posDelta, int checkStep, GLOBAL int* RESTRICT badStep,
+        int useRigid, GLOBAL const mixed* RESTRICT rigid) {
 #ifdef SUPPORTS_DOUBLE_PRECISION
     const double invCdt = 1.0/(double) cdt;
 #else
@@ -119,6 +120,12 @@ KERNEL void symprkDriftApply(mixed cdt, GLOBAL real4* RESTRICT posq, GLOBAL real
             v.x += (mixed) ((d.x-cdt*v.x)*invCdt);
             v.y += (mixed) ((d.y-cdt*v.y)*invCdt);
             v.z += (mixed) ((d.z-cdt*v.z)*invCdt);
+            if (useRigid) {
+                mixed rx = p.x-rigid[0], ry = p.y-rigid[1], rz = p.z-rigid[2];
+                v.x += rigid[3] + (rigid[7]*rz - rigid[8]*ry);
+                v.y += rigid[4] + (rigid[8]*rx - rigid[6]*rz);
+                v.z += rigid[5] + (rigid[6]*ry - rigid[7]*rx);
+            }
             symprkStorePos(posq, posqCorrection, index, p);
             velm[index] = v;
             symprkCheckVelocity(v, checkStep, badStep);
@@ -237,6 +244,145 @@ KERNEL void symprkProjection(GLOBAL const real4* RESTRICT posq, GLOBAL const rea
             projection[6] = 0;
             projection[7] = 0;
             projection[8] = 0;
+        }
+    }
+}
+
+/**
+ * Exact momentum with constraints: the net momentum dP and angular momentum dL (about the origin) of the
+ * constraint impulses, which vanish in exact arithmetic, and the rigid-body velocity w + gamma x (r - c)
+ * that cancels their round-off values: rigid[0..2] = c, [3..5] = w = -dP/M, [6..8] = gamma = I_c^-1 (c x dP - dL).
+ * mode 0, before symprkDriftApply: impulses m (d - c*dt*v)/(c*dt) about the pre-drift positions, r = x + d.
+ * mode 1, after the velocity projection: impulses m (v - vBefore) about r = x.  One block of WORK_GROUP_SIZE.
+ */
+KERNEL void symprkRigidSums(int mode, mixed cdt, GLOBAL const real4* RESTRICT posq, GLOBAL const real4* RESTRICT posqCorrection,
+        GLOBAL const mixed4* RESTRICT velm, GLOBAL const mixed4* RESTRICT posDelta, GLOBAL const mixed4* RESTRICT vBefore,
+        GLOBAL mixed* RESTRICT rigid) {
+    LOCAL mixed partial[10*WORK_GROUP_SIZE];
+    LOCAL mixed total[10];
+    const int tid = LOCAL_ID;
+    mixed s[10];
+    for (int k = 0; k < 10; k++)
+        s[k] = 0;
+    for (int index = tid; index < NUM_ATOMS; index += WORK_GROUP_SIZE) {
+        mixed4 v = velm[index];
+        if (v.w != 0) {
+            mixed mass = 1/v.w;
+            mixed4 x = symprkLoadPos(posq, posqCorrection, index);
+            mixed3 r, J;
+            if (mode == 0) {
+                mixed4 d = posDelta[index];
+                r = make_mixed3(x.x+d.x, x.y+d.y, x.z+d.z);
+                J = make_mixed3(mass*(d.x-cdt*v.x)/cdt, mass*(d.y-cdt*v.y)/cdt, mass*(d.z-cdt*v.z)/cdt);
+            }
+            else {
+                mixed4 vb = vBefore[index];
+                r = make_mixed3(x.x, x.y, x.z);
+                J = make_mixed3(mass*(v.x-vb.x), mass*(v.y-vb.y), mass*(v.z-vb.z));
+            }
+            s[0] += mass;
+            s[1] += mass*r.x;
+            s[2] += mass*r.y;
+            s[3] += mass*r.z;
+            s[4] += J.x;
+            s[5] += J.y;
+            s[6] += J.z;
+            s[7] += x.y*J.z-x.z*J.y;
+            s[8] += x.z*J.x-x.x*J.z;
+            s[9] += x.x*J.y-x.y*J.x;
+        }
+    }
+    for (int k = 0; k < 10; k++)
+        partial[k*WORK_GROUP_SIZE+tid] = s[k];
+    SYNC_THREADS;
+    if (tid < 10) {
+        mixed sum = 0;
+        for (int i = 0; i < WORK_GROUP_SIZE; i++)
+            sum += partial[tid*WORK_GROUP_SIZE+i];
+        total[tid] = sum;
+    }
+    SYNC_THREADS;
+    const mixed M = total[0];
+    const mixed invM = (M == 0 ? (mixed) 0 : 1/M);
+    const mixed cx = total[1]*invM, cy = total[2]*invM, cz = total[3]*invM;
+    const mixed px = total[4], py = total[5], pz = total[6];
+    const mixed lx = total[7], ly = total[8], lz = total[9];
+    for (int k = 0; k < 6; k++)
+        s[k] = 0;
+    for (int index = tid; index < NUM_ATOMS; index += WORK_GROUP_SIZE) {
+        mixed4 v = velm[index];
+        if (v.w != 0) {
+            mixed mass = 1/v.w;
+            mixed4 x = symprkLoadPos(posq, posqCorrection, index);
+            if (mode == 0) {
+                mixed4 d = posDelta[index];
+                x.x += d.x;
+                x.y += d.y;
+                x.z += d.z;
+            }
+            mixed rx = x.x-cx, ry = x.y-cy, rz = x.z-cz;
+            s[0] += mass*rx*rx;
+            s[1] += mass*ry*ry;
+            s[2] += mass*rz*rz;
+            s[3] += mass*rx*ry;
+            s[4] += mass*rx*rz;
+            s[5] += mass*ry*rz;
+        }
+    }
+    SYNC_THREADS;
+    for (int k = 0; k < 6; k++)
+        partial[k*WORK_GROUP_SIZE+tid] = s[k];
+    SYNC_THREADS;
+    if (tid < 6) {
+        mixed sum = 0;
+        for (int i = 0; i < WORK_GROUP_SIZE; i++)
+            sum += partial[tid*WORK_GROUP_SIZE+i];
+        total[tid] = sum;
+    }
+    SYNC_THREADS;
+    if (tid == 0) {
+        mixed Ixx = total[1]+total[2], Iyy = total[0]+total[2], Izz = total[0]+total[1];
+        mixed Ixy = -total[3], Ixz = -total[4], Iyz = -total[5];
+        mixed shift = (mixed) 1e-12*(Ixx+Iyy+Izz);
+        Ixx += shift;
+        Iyy += shift;
+        Izz += shift;
+        mixed axx = Iyy*Izz-Iyz*Iyz, ayy = Ixx*Izz-Ixz*Ixz, azz = Ixx*Iyy-Ixy*Ixy;
+        mixed axy = Ixz*Iyz-Izz*Ixy, axz = Ixy*Iyz-Iyy*Ixz, ayz = Ixy*Ixz-Ixx*Iyz;
+        mixed det = Ixx*axx+Ixy*axy+Ixz*axz;
+        // right-hand side c x dP - dL
+        mixed bx = (cy*pz-cz*py)-lx, by = (cz*px-cx*pz)-ly, bz = (cx*py-cy*px)-lz;
+        rigid[0] = cx;
+        rigid[1] = cy;
+        rigid[2] = cz;
+        rigid[3] = -px*invM;
+        rigid[4] = -py*invM;
+        rigid[5] = -pz*invM;
+        if (det != 0 && M != 0) {
+            rigid[6] = (axx*bx+axy*by+axz*bz)/det;
+            rigid[7] = (axy*bx+ayy*by+ayz*bz)/det;
+            rigid[8] = (axz*bx+ayz*by+azz*bz)/det;
+        }
+        else {
+            rigid[6] = 0;
+            rigid[7] = 0;
+            rigid[8] = 0;
+        }
+    }
+}
+
+/** Add the rigid-body velocity of symprkRigidSums (mode 1) at the current positions. */
+KERNEL void symprkRigidApply(GLOBAL const real4* RESTRICT posq, GLOBAL const real4* RESTRICT posqCorrection,
+        GLOBAL mixed4* RESTRICT velm, GLOBAL const mixed* RESTRICT rigid) {
+    for (int index = GLOBAL_ID; index < NUM_ATOMS; index += GLOBAL_SIZE) {
+        mixed4 v = velm[index];
+        if (v.w != 0) {
+            mixed4 p = symprkLoadPos(posq, posqCorrection, index);
+            mixed rx = p.x-rigid[0], ry = p.y-rigid[1], rz = p.z-rigid[2];
+            v.x += rigid[3] + (rigid[7]*rz - rigid[8]*ry);
+            v.y += rigid[4] + (rigid[8]*rx - rigid[6]*rz);
+            v.z += rigid[5] + (rigid[6]*ry - rigid[7]*rx);
+            velm[index] = v;
         }
     }
 }
