@@ -190,6 +190,11 @@ def test_cpu_platform_runs_native(water8):
     ref = _run(water8, N(1 * unit.femtoseconds, "yoshida-4", system=water8.system), 50)
     cpu = _run(water8, N(1 * unit.femtoseconds, "yoshida-4", system=water8.system), 50, "CPU")
     assert np.abs(cpu[0] - ref[0]).max() < 1e-5
+    # single-precision forces drift the momenta (~1e-6); the exact-momentum projection (in double) does not
+    ig = N(2 * unit.femtoseconds, "yoshida-4", system=water8.system, exact_momentum=True)
+    ctx = water8.context(ig, "CPU")
+    dp, dl = drift_after(ctx, ig, water8.masses(), 500)
+    assert dp <= 1e-12 and dl <= 1e-12
 
 
 # -- XML, checkpoints ---------------------------------------------------------------------------------------------
