@@ -17,6 +17,7 @@ __version__ = "0.1.0"
 # name -> module that defines it, imported lazily (keeps `import openmm_symprk` light)
 _LAZY = {
     "rigidbody": ".rigidbody",
+    "native": ".native",
     "make_rigid": ".rigid_molecules",
     "RigidGroup": ".rigid_molecules",
     "RigidGroupError": ".rigid_molecules",

@@ -55,11 +55,19 @@ def _cmd_info(args):
     import openmm as mm
 
     import openmm_symprk
+    from . import native
 
     print(f"openmm_symprk {openmm_symprk.__version__}, OpenMM {mm.__version__}")
-    names = [mm.Platform.getPlatform(i).getName() for i in range(mm.Platform.getNumPlatforms())]
-    for n in names:
-        print(f"  platform {n:10s} backend: CustomIntegrator program")
+    details = native.native_details()
+    for n in [mm.Platform.getPlatform(i).getName() for i in range(mm.Platform.getNumPlatforms())]:
+        how = details.get(n, "")
+        backend = "native plugin" if how == "native" else f"CustomIntegrator program (native: {how or 'n/a'})"
+        print(f"  platform {n:10s} backend for splittings: {backend}")
+    auto = "native" if native.native_available() and all(
+        details.get(mm.Platform.getPlatform(i).getName()) == "native" for i in range(mm.Platform.getNumPlatforms())) \
+        else "custom"
+    print(f"  SymplecticIntegrator(backend='auto') gives: {auto} for splittings and compositions, "
+          f"custom for implicit and general tableaux")
     print(f"  catalogue: {len(openmm_symprk.methods)} methods (symprk methods)")
 
 

@@ -189,13 +189,73 @@ def _is_splitting(tab: PRKTableau) -> bool:
         return False
 
 
+BACKENDS = ("auto", "native", "custom")
+
+
+def _platform_names() -> list:
+    return [mm.Platform.getPlatform(i).getName() for i in range(mm.Platform.getNumPlatforms())]
+
+#: options of SymplecticIntegrator that the native backend supports
+_NATIVE_OPTIONS = {"exact_momentum", "check_finite"}
+
+
+def choose_backend(method, backend: str = "auto", options=None) -> str:
+    """'native' or 'custom' for a catalogue method (see :class:`SymplecticIntegrator`)."""
+    if backend not in BACKENDS:
+        raise ValueError(f"backend must be one of {', '.join(map(repr, BACKENDS))}, got {backend!r}")
+    if backend == "custom":
+        return "custom"
+    from . import native
+
+    m = get_method(method)
+    extra = sorted(set(options or {}) - _NATIVE_OPTIONS)
+    if backend == "native":
+        if not native.native_available():
+            raise native.NativeUnavailableError(f"backend='native' was asked for, but the native backend is "
+                                                f"unavailable: {native.unavailable_reason()}")
+        if not m.is_splitting:
+            raise native.NativeMethodError(
+                f"backend='native' runs kick/drift splittings and compositions only; {m.name!r} is a "
+                f"PRK tableau of the {m.family} family. Use backend='custom' (or 'auto').")
+        if extra:
+            raise ValueError(f"backend='native' does not take the option(s) {', '.join(extra)}; "
+                             f"it accepts {', '.join(sorted(_NATIVE_OPTIONS))}. Use backend='custom'.")
+        return "native"
+    # auto: native only where it can run everything this installation may use it on
+    usable = (m.is_splitting and not extra and native.native_available()
+              and set(_platform_names()) <= set(native.native_platforms()))
+    return "native" if usable else "custom"
+
+
 class SymplecticIntegrator(PRKIntegrator):
     """A catalogue method by name (``openmm_symprk.methods``), e.g. "verlet", "yoshida-4", "kahan-li-8".
 
     See :class:`PRKIntegrator` for the options.  Names are case-insensitive and accept aliases
-    (velocity-verlet, forest-ruth, ...); an unknown name raises UnknownMethodError with close names."""
+    (velocity-verlet, forest-ruth, ...); an unknown name raises UnknownMethodError with close names.
 
-    def __init__(self, stepSize, method: str = "verlet", system: mm.System | None = None, **options):
+    ``backend``: "auto" (default) returns the native plugin integrator
+    (:class:`openmm_symprk.native.NativeSymplecticIntegrator`, no CustomIntegrator overhead) when it is
+    built, the method is a kick/drift splitting or composition, only ``exact_momentum``/``check_finite``
+    options are given, and the plugin has kernels for every platform of this OpenMM installation;
+    otherwise this CustomIntegrator.  "native" insists on the plugin (a clear error if it cannot be
+    used), "custom" on the CustomIntegrator program.  ``symprk info`` shows what each platform gets."""
+
+    def __new__(cls, stepSize=None, method: str = "verlet", system: mm.System | None = None, backend: str = "auto",
+                **options):
+        if choose_backend(method, backend, options) == "native":
+            from .native import NativeSymplecticIntegrator
+
+            ig = NativeSymplecticIntegrator(stepSize, method, system=system, **options)
+            ig.backend = "native"
+            ig.program_info = program.ProgramInfo(
+                "splitting", system is None or has_constraints(system), ig.splitting.force_evaluations(),
+                len(ig.splitting), bool(options.get("exact_momentum", False)), ["native SymPRKIntegrator plugin"])
+            return ig
+        return super().__new__(cls)
+
+    def __init__(self, stepSize, method: str = "verlet", system: mm.System | None = None, backend: str = "auto",
+                 **options):
         m = get_method(method)
         super().__init__(stepSize, m, system=system, name=m.name, **options)
         self.method = m
+        self.backend = "custom"

@@ -222,8 +222,8 @@ def _step_types(ig):
 
 
 def test_no_constraint_steps_without_constraints(morse, water8):
-    free = SymplecticIntegrator(1 * unit.femtoseconds, "yoshida-4", system=morse.system)
-    rattle = SymplecticIntegrator(1 * unit.femtoseconds, "yoshida-4", system=water8.system)
+    free = SymplecticIntegrator(1 * unit.femtoseconds, "yoshida-4", system=morse.system, backend="custom")
+    rattle = SymplecticIntegrator(1 * unit.femtoseconds, "yoshida-4", system=water8.system, backend="custom")
     cp, cv = mm.CustomIntegrator.ConstrainPositions, mm.CustomIntegrator.ConstrainVelocities
     assert cp not in _step_types(free) and cv not in _step_types(free)
     # one position projection per drift, one velocity projection per step
@@ -263,7 +263,7 @@ def test_virtual_sites_are_warned_about_and_do_break_conservation(water8):
     vel[real] = np.cross([0, 0, 2.0], pos[real] - pos[real].mean(0))
     _warned.discard("virtualsites")
     with pytest.warns(ConservationWarning, match="virtual sites"):
-        ig = SymplecticIntegrator(1 * unit.femtoseconds, "verlet", system=system)
+        ig = SymplecticIntegrator(1 * unit.femtoseconds, "verlet", system=system, backend="custom")
     ctx = mm.Context(system, ig, mm.Platform.getPlatformByName("Reference"))
     ctx.setPositions(pos)
     ctx.computeVirtualSites()

@@ -22,7 +22,8 @@ from openmm_symprk.projection import add_projection_variables, emit_projected_ac
 
 
 def exact_integrator(h, method, system):
-    return SymplecticIntegrator(h, method, system=system, exact_momentum=True)
+    """The CustomIntegrator program with projection.py's steps (the native plugin has its own tests)."""
+    return SymplecticIntegrator(h, method, system=system, exact_momentum=True, backend="custom")
 
 pytestmark = pytest.mark.filterwarnings("ignore::UserWarning")
 
@@ -50,7 +51,7 @@ def _run(scene, platform, props, steps, exact, method="verlet", h=0.002):
     if exact:
         ig = exact_integrator(h, method, scene.system)
     else:
-        ig = SymplecticIntegrator(h, method, system=scene.system)
+        ig = SymplecticIntegrator(h, method, system=scene.system, backend="custom")
     ctx = scene.context(ig, platform, props)
     out = _drift(ctx, ig, steps)
     del ctx
@@ -95,7 +96,7 @@ def test_reference_trajectory_unchanged(water8):
     out = []
     for exact in (False, True):
         ig = exact_integrator(0.002, "yoshida-4", water8.system) if exact else \
-            SymplecticIntegrator(0.002, "yoshida-4", system=water8.system)
+            SymplecticIntegrator(0.002, "yoshida-4", system=water8.system, backend="custom")
         ctx = water8.context(ig)
         ig.step(100)
         st = ctx.getState(getPositions=True, getVelocities=True)
@@ -217,7 +218,7 @@ def test_failure_cmmotionremover_origin(water8):
     v = water8.velocities + np.array([0.3, -0.2, 0.1])
     results = {}
     for about in ("com", "origin"):
-        ig = SymplecticIntegrator(0.002, "verlet", system=system)
+        ig = SymplecticIntegrator(0.002, "verlet", system=system, backend="custom")
         ctx = mm.Context(system, ig, mm.Platform.getPlatformByName("Reference"))
         ctx.setPositions(water8.positions)
         ctx.setVelocities(v)

@@ -185,7 +185,7 @@ def _make_class():
 
     from ..systemcheck import ConservationWarning, conservation_issues
 
-    warned = set()
+    from ..systemcheck import _warned as warned  # one once-per-kind registry for both backends
 
     def warn_conservation(system, context):
         # As systemcheck.warn_conservation (once per kind), less the virtual-site caveat of the CustomIntegrator
