@@ -18,7 +18,7 @@ import openmm.unit as unit
 from . import program
 from .catalogue import Method, get_method
 from .splitting import Splitting
-from .systemcheck import has_constraints, warn_conservation
+from .systemcheck import has_constraints, validate_system
 from .tableau import PRKTableau, TableauError
 
 
@@ -87,8 +87,8 @@ class PRKIntegrator(mm.CustomIntegrator):
             raise ValueError(f"tolerance must be a positive number of nm, got {tolerance!r}")
         if int(max_iterations) < 1:
             raise ValueError(f"max_iterations must be at least 1, got {max_iterations!r}")
-        if system is not None and not isinstance(system, mm.System):
-            raise TypeError(f"system must be an openmm.System, got {type(system).__name__}")
+        if system is not None:
+            validate_system(system, f"{type(self).__name__}({self.method_name})", exact_momentum)
         if constraints is None:
             if system is not None:
                 constraints = has_constraints(system)
@@ -101,12 +101,6 @@ class PRKIntegrator(mm.CustomIntegrator):
                     f"{self.method_name} is a general PRK tableau, which cannot keep constraints, and no "
                     f"system= was given to check against: it will ignore any constraints of the system it runs. "
                     f"Pass system= to have this checked.", UserWarning, stacklevel=3)
-        if system is not None:
-            warn_conservation(system, context=f"{type(self).__name__}({self.method_name})")
-            if exact_momentum and system.usesPeriodicBoundaryConditions():
-                raise ValueError(
-                    "exact_momentum=True removes the net torque of the forces, which is only correct for a "
-                    "non-periodic (isolated) system; this System is periodic. Use exact_momentum=False.")
         super().__init__(dt)
         self.tableau = tab
         try:

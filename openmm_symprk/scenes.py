@@ -107,17 +107,13 @@ def water_cluster(n_waters: int = 27, rigid: bool = True, temperature: float = 1
         pos.extend(centre + local @ R.T)
     pos = np.array(pos)
     top = _water_topology(n_waters)
-    ff = app.ForceField("tip3p.xml") if rigid else app.ForceField("tip3p.xml")
+    ff = app.ForceField("tip3p.xml")
     system = ff.createSystem(top, nonbondedMethod=app.NoCutoff, constraints=None, rigidWater=rigid,
                              removeCMMotion=False)
     if not rigid:
         _add_flexible_water_terms(system, n_waters)
     if minimize:
-        ctx = mm.Context(system, mm.VerletIntegrator(0.001), mm.Platform.getPlatformByName("Reference"))
-        ctx.setPositions(pos)
-        ctx.applyConstraints(1e-10)
-        mm.LocalEnergyMinimizer.minimize(ctx, 1.0, 200)
-        pos = ctx.getState(getPositions=True).getPositions(asNumpy=True).value_in_unit(unit.nanometer)
+        pos = _minimized(system, pos, 1.0)
     masses = np.array([system.getParticleMass(i).value_in_unit(unit.dalton) for i in range(system.getNumParticles())])
     vel = _spin_velocities(pos, masses, temperature, angular_velocity, rng)
     if rigid:
@@ -125,6 +121,15 @@ def water_cluster(n_waters: int = 27, rigid: bool = True, temperature: float = 1
     kind = "rigid (SETTLE)" if rigid else "flexible"
     return Scene(f"water-cluster-{n_waters}{'' if rigid else '-flexible'}", system, top, np.array(pos), vel,
                  f"{n_waters} {kind} TIP3P waters in vacuum, spinning at {tuple(angular_velocity)} rad/ps")
+
+
+def _minimized(system, pos, tolerance):
+    """Constrained, energy-minimised positions (Reference platform, at most 200 iterations)."""
+    ctx = mm.Context(system, mm.VerletIntegrator(0.001), mm.Platform.getPlatformByName("Reference"))
+    ctx.setPositions(pos)
+    ctx.applyConstraints(1e-10)
+    mm.LocalEnergyMinimizer.minimize(ctx, tolerance, 200)
+    return ctx.getState(getPositions=True).getPositions(asNumpy=True).value_in_unit(unit.nanometer)
 
 
 def _add_flexible_water_terms(system, n_waters):
@@ -218,11 +223,7 @@ def protein_vacuum(constraints=app.HBonds, temperature: float = 300.0, angular_v
                              removeCMMotion=False)
     pos = np.array(mod.positions.value_in_unit(unit.nanometer))
     if minimize:
-        ctx = mm.Context(system, mm.VerletIntegrator(0.001), mm.Platform.getPlatformByName("Reference"))
-        ctx.setPositions(pos)
-        ctx.applyConstraints(1e-10)
-        mm.LocalEnergyMinimizer.minimize(ctx, 10.0, 200)
-        pos = ctx.getState(getPositions=True).getPositions(asNumpy=True).value_in_unit(unit.nanometer)
+        pos = _minimized(system, pos, 10.0)
     rng = np.random.default_rng(seed)
     masses = np.array([system.getParticleMass(i).value_in_unit(unit.dalton) for i in range(system.getNumParticles())])
     vel = _spin_velocities(pos, masses, temperature, angular_velocity, rng)

@@ -69,3 +69,20 @@ def warn_conservation(system: mm.System, context: str = "openmm_symprk", once: b
             continue
         _warned.add(key)
         warnings.warn(f"{context}: {msg}", ConservationWarning, stacklevel=3)
+
+
+
+def validate_system(system, context: str, exact_momentum: bool = False, skip=()) -> None:
+    """What both integrator backends check of a ``system=`` argument: its type, one warning per kind of
+    conservation issue (less the kinds in ``skip``), and exact momentum refused on a periodic system."""
+    if not isinstance(system, mm.System):
+        raise TypeError(f"system must be an openmm.System, got {type(system).__name__}")
+    for key, msg in conservation_issues(system):
+        if key in skip or key in _warned:
+            continue
+        _warned.add(key)
+        warnings.warn(f"{context}: {msg}", ConservationWarning, stacklevel=4)
+    if exact_momentum and system.usesPeriodicBoundaryConditions():
+        raise ValueError(
+            "exact_momentum=True removes the net torque of the forces, which is only correct for a "
+            "non-periodic (isolated) system; this System is periodic. Use exact_momentum=False.")

@@ -5,6 +5,17 @@ import openmm.unit as unit
 from openmm_symprk.conservation import angular_momentum, linear_momentum
 
 
+class Counter:
+    """A callable for openmm.PythonForce that contributes nothing but counts its evaluations."""
+
+    def __init__(self):
+        self.n = 0
+
+    def __call__(self, state):
+        self.n += 1
+        return 0.0, np.zeros((state.getPositions(asNumpy=True).shape[0], 3))
+
+
 def momenta(ctx, masses):
     """(P, L about the origin, sum m|v|) in float64."""
     state = ctx.getState(getPositions=True, getVelocities=True)

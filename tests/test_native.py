@@ -12,7 +12,7 @@ import openmm.app as app
 import openmm.unit as unit
 import pytest
 
-from helpers import drift_after
+from helpers import Counter, drift_after
 from openmm_symprk import SymplecticIntegrator, methods
 from openmm_symprk.integrators import SimulationBlowUpError
 from openmm_symprk import native
@@ -94,15 +94,6 @@ def test_threaded_loops_are_bitwise_identical(water27, monkeypatch):
 
 
 # -- cost -----------------------------------------------------------------------------------------------------
-class Counter:
-    """A PythonForce that contributes nothing but counts its evaluations."""
-
-    def __init__(self):
-        self.n = 0
-
-    def __call__(self, state):
-        self.n += 1
-        return 0.0, np.zeros((state.getPositions(asNumpy=True).shape[0], 3))
 
 
 @pytest.mark.parametrize("name", ["verlet", "position-verlet", "omelyan-2", "yoshida-4", "mclachlan-atela-4",

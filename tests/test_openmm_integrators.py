@@ -6,22 +6,13 @@ import openmm.unit as unit
 import pytest
 
 from conftest import platform_available
-from helpers import drift_after
+from helpers import Counter, drift_after
 from openmm_symprk import PRKIntegrator, SymplecticIntegrator, methods
 from openmm_symprk.convergence import measure_order
 
 SYMPLECTIC_SPLITTINGS = [m.name for m in methods.splittings()]
 
 
-class Counter:
-    """A PythonForce that contributes nothing but counts its evaluations."""
-
-    def __init__(self):
-        self.n = 0
-
-    def __call__(self, state):
-        self.n += 1
-        return 0.0, np.zeros((state.getPositions(asNumpy=True).shape[0], 3))
 
 
 def counted(scene):

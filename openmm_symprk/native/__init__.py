@@ -181,20 +181,7 @@ def _splitting_for(method, system):
 def _make_class():
     from ..catalogue import get_method
     from ..integrators import SimulationBlowUpError, step_size_in_ps
-    import warnings
-
-    from ..systemcheck import ConservationWarning, conservation_issues
-
-    from ..systemcheck import _warned as warned  # one once-per-kind registry for both backends
-
-    def warn_conservation(system, context):
-        # As systemcheck.warn_conservation (once per kind), less the virtual-site caveat of the CustomIntegrator
-        # path: the native kernels place virtual sites before every force evaluation inside the step.
-        for key, msg in conservation_issues(system):
-            if key == "virtualsites" or key in warned:
-                continue
-            warned.add(key)
-            warnings.warn(f"{context}: {msg}", ConservationWarning, stacklevel=4)
+    from ..systemcheck import validate_system
 
     base = _State.swig.SymPRKIntegrator
 
@@ -216,14 +203,10 @@ def _make_class():
                     f"method {m.name!r} is a general ({m.family}) PRK tableau; the native backend runs kick/drift "
                     f"splittings and compositions only. Use openmm_symprk.SymplecticIntegrator (CustomIntegrator "
                     f"backend) for it.")
-            if system is not None and not isinstance(system, mm.System):
-                raise TypeError(f"system must be an openmm.System, got {type(system).__name__}")
             if system is not None:
-                warn_conservation(system, context=f"NativeSymplecticIntegrator({m.name})")
-                if exact_momentum and system.usesPeriodicBoundaryConditions():
-                    raise ValueError(
-                        "exact_momentum=True removes the net torque of the forces, which is only correct for a "
-                        "non-periodic (isolated) system; this System is periodic. Use exact_momentum=False.")
+                # the native kernels place virtual sites after every drift: no CustomIntegrator caveat
+                validate_system(system, f"NativeSymplecticIntegrator({m.name})", exact_momentum,
+                                skip=("virtualsites",))
             splitting = _splitting_for(m, system)
             coeffs = splitting.coefficients()
             kinds = [0 if label == "kick" else 1 for label, _ in coeffs]
