@@ -16,6 +16,18 @@ class Counter:
         return 0.0, np.zeros((state.getPositions(asNumpy=True).shape[0], 3))
 
 
+def counted(scene):
+    """A copy of the scene's System with a counting PythonForce added, and its Counter."""
+    import copy
+
+    import openmm as mm
+
+    system = copy.deepcopy(scene.system)
+    counter = Counter()
+    system.addForce(mm.PythonForce(counter))
+    return system, counter
+
+
 def momenta(ctx, masses):
     """(P, L about the origin, sum m|v|) in float64."""
     state = ctx.getState(getPositions=True, getVelocities=True)
@@ -30,3 +42,17 @@ def drift_after(ctx, integrator, masses, steps):
     integrator.step(steps)
     p1, l1, _ = momenta(ctx, masses)
     return float(np.linalg.norm(p1 - p0) / scale), float(np.linalg.norm(l1 - l0) / np.linalg.norm(l0))
+
+
+def stiff_diatomic():
+    """Two unit masses on a stiff harmonic bond (omega = sqrt(2k/m) ~ 447/ps): steps beyond a method's
+    stability limit make it blow up within a few dozen steps."""
+    import openmm as mm
+
+    system = mm.System()
+    system.addParticle(1.0)
+    system.addParticle(1.0)
+    bond = mm.HarmonicBondForce()
+    bond.addBond(0, 1, 0.1, 1.0e5)
+    system.addForce(bond)
+    return system

@@ -6,6 +6,7 @@ import openmm as mm
 import openmm.unit as unit
 import pytest
 
+from helpers import stiff_diatomic
 from openmm_symprk import PRKIntegrator, PRKTableau, SimulationBlowUpError, SymplecticIntegrator, TableauError
 from openmm_symprk.catalogue import UnknownMethodError
 from openmm_symprk.program import ConstraintSupportError
@@ -76,18 +77,8 @@ def test_bad_options():
         SymplecticIntegrator(0.001, "verlet", system="not a system")
 
 
-def _stiff_diatomic():
-    system = mm.System()
-    system.addParticle(1.0)
-    system.addParticle(1.0)
-    bond = mm.HarmonicBondForce()
-    bond.addBond(0, 1, 0.1, 1.0e5)  # omega = sqrt(2k/m) ~ 447/ps
-    system.addForce(bond)
-    return system
-
-
 def test_blow_up_names_step_and_method():
-    system = _stiff_diatomic()
+    system = stiff_diatomic()
     h = 1.7 / np.sqrt(2 * 1.0e5)  # h*omega = 1.7, just beyond yoshida-4's stability limit 1.5734
 
     def run(steps):

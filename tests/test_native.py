@@ -12,7 +12,7 @@ import openmm.app as app
 import openmm.unit as unit
 import pytest
 
-from helpers import Counter, drift_after
+from helpers import counted, drift_after, stiff_diatomic
 from openmm_symprk import SymplecticIntegrator, methods
 from openmm_symprk.integrators import SimulationBlowUpError
 from openmm_symprk import native
@@ -102,9 +102,7 @@ def test_threaded_loops_are_bitwise_identical(water27, monkeypatch):
 @pytest.mark.parametrize("scene_name", ["water8", "morse"])
 def test_force_evaluations_per_step(name, scene_name, request):
     scene = request.getfixturevalue(scene_name)
-    system = copy.deepcopy(scene.system)
-    counter = Counter()
-    system.addForce(mm.PythonForce(counter))
+    system, counter = counted(scene)
     ig = N(1 * unit.femtoseconds, name, system=system)
     ctx = mm.Context(system, ig, mm.Platform.getPlatformByName("Reference"))
     ctx.setPositions(scene.positions)
@@ -315,12 +313,7 @@ def test_virtual_sites_follow_their_parents():
 
 @needs_native
 def test_blow_up_names_the_first_bad_step():
-    system = mm.System()
-    system.addParticle(1.0)
-    system.addParticle(1.0)
-    bond = mm.HarmonicBondForce()
-    bond.addBond(0, 1, 0.1, 1.0e5)  # omega = sqrt(2k/m) ~ 447/ps
-    system.addForce(bond)
+    system = stiff_diatomic()
     h = 1.7 / np.sqrt(2 * 1.0e5)  # h*omega = 1.7, beyond yoshida-4's stability limit 1.5734
 
     def run():

@@ -1,4 +1,7 @@
-"""The compiled integrators on OpenMM: cost, conservation, orders, platforms, checkpoints, XML."""
+"""The compiled CustomIntegrator programs on OpenMM: cost, conservation, orders, platforms, checkpoints, XML.
+
+Tests that are about the program the compiler emits ask for backend="custom"; the native plugin is
+checked against that program, bit for bit, in test_native.py."""
 import numpy as np
 import openmm as mm
 import openmm.app as app
@@ -6,7 +9,7 @@ import openmm.unit as unit
 import pytest
 
 from conftest import platform_available
-from helpers import Counter, drift_after
+from helpers import counted, drift_after
 from openmm_symprk import PRKIntegrator, SymplecticIntegrator, methods
 from openmm_symprk.convergence import measure_order
 
@@ -15,22 +18,13 @@ SYMPLECTIC_SPLITTINGS = [m.name for m in methods.splittings()]
 
 
 
-def counted(scene):
-    import copy
-
-    system = copy.deepcopy(scene.system)
-    counter = Counter()
-    system.addForce(mm.PythonForce(counter))
-    return system, counter
-
-
 @pytest.mark.parametrize("name", ["verlet", "position-verlet", "omelyan-2", "yoshida-4", "mclachlan-atela-4",
                                   "blanes-moan-srkn6b-4", "kahan-li-6", "kahan-li-8"])
 @pytest.mark.parametrize("scene_name", ["water8", "morse"])
 def test_force_evaluations_per_step(name, scene_name, request):
     scene = request.getfixturevalue(scene_name)
     system, counter = counted(scene)
-    ig = SymplecticIntegrator(1 * unit.femtoseconds, name, system=system)
+    ig = SymplecticIntegrator(1 * unit.femtoseconds, name, system=system, backend="custom")
     ctx = mm.Context(system, ig, mm.Platform.getPlatformByName("Reference"))
     ctx.setPositions(scene.positions)
     ctx.setVelocities(scene.velocities)
@@ -145,7 +139,7 @@ def test_same_program_runs_on_other_platforms(platform, props, water8):
         pytest.skip(f"{platform} platform not available")
     results = {}
     for plat, pr in (("Reference", {}), (platform, props)):
-        ig = SymplecticIntegrator(2 * unit.femtoseconds, "yoshida-4", system=water8.system)
+        ig = SymplecticIntegrator(2 * unit.femtoseconds, "yoshida-4", system=water8.system, backend="custom")
         ctx = water8.context(ig, plat, pr)
         dp, dl = drift_after(ctx, ig, water8.masses(), 200)
         x = ctx.getState(getPositions=True).getPositions(asNumpy=True).value_in_unit(unit.nanometer)
