@@ -73,8 +73,9 @@ setup(
         "tqdm>=4.60",
     ],
     extras_require={
-        "test": ["pytest>=7"],
+        "test": ["pytest>=7", "pyelftools>=0.29"],
         "cluster": ["dask[distributed]>=2023.1"],
+        "cuda12": ["openmm-cuda-12>=8.6,<8.7"],
     },
     entry_points={"console_scripts": ["symprk=openmm_symprk.cli:main"]},
     cmdclass={"build_ext": BuildNative},

@@ -59,16 +59,23 @@ def _cmd_info(args):
 
     print(f"openmm_symprk {openmm_symprk.__version__}, OpenMM {mm.__version__}")
     details = native.native_details()
-    for n in [mm.Platform.getPlatform(i).getName() for i in range(mm.Platform.getNumPlatforms())]:
+    names = [mm.Platform.getPlatform(i).getName() for i in range(mm.Platform.getNumPlatforms())]
+    for n in names:
         how = details.get(n, "")
         backend = "native plugin" if how == "native" else f"CustomIntegrator program (native: {how or 'n/a'})"
         print(f"  platform {n:10s} backend for splittings: {backend}")
-    auto = "native" if native.native_available() and all(
-        details.get(mm.Platform.getPlatform(i).getName()) == "native" for i in range(mm.Platform.getNumPlatforms())) \
-        else "custom"
+    auto = "native" if native.native_available() and all(details.get(n) == "native" for n in names) else "custom"
     print(f"  SymplecticIntegrator(backend='auto') gives: {auto} for splittings and compositions, "
           f"custom for implicit and general tableaux")
     print(f"  catalogue: {len(openmm_symprk.methods)} methods (symprk methods)")
+    if args.require_native:
+        wanted = [p.strip() for p in args.require_native.split(",") if p.strip()]
+        missing = [p for p in wanted if details.get(p) != "native"]
+        if missing:
+            print(f"symprk info: error: the native plugin does not serve {', '.join(missing)} "
+                  f"({'; '.join(f'{p}: ' + (details.get(p) or 'no such OpenMM platform here') for p in missing)})",
+                  file=sys.stderr)
+            return 1
 
 
 def build_parser():
@@ -92,6 +99,8 @@ def build_parser():
     c.set_defaults(func=_cmd_check)
 
     i = sub.add_parser("info", help="versions, platforms and backends")
+    i.add_argument("--require-native", metavar="PLATFORMS",
+                   help="exit with status 1 unless the native plugin serves these platforms (comma-separated)")
     i.set_defaults(func=_cmd_info)
 
     for name, text in (("bench", "work-precision and stability sweeps (symprk bench --help)"),

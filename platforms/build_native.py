@@ -8,15 +8,19 @@ What it builds (g++ directly, C++17, the wheel's headers under OpenMM.libs/inclu
 
 * ``lib/libOpenMMSymPRK.so``          the API library: SymPRKIntegrator, the abstract kernel, the XML proxy
 * ``lib/libOpenMMSymPRKReference.so`` Reference kernel + factory (serves the CPU platform too)
-* ``lib/libOpenMMSymPRKOpenCL.so``    Common kernel + OpenCL factory (needs the OpenCL C headers,
-  Debian package ``opencl-c-headers``; skipped with a note when they are missing)
-* ``lib/libOpenMMSymPRKCUDA.so``      only with SYMPRK_BUILD_CUDA=1 and a wheel that ships libOpenMMCUDA.so
+* ``lib/libOpenMMSymPRKOpenCL.so``    Common kernel + OpenCL factory (the OpenCL C headers come from PyPI's
+  nvidia-cuda-opencl-cu12, a build requirement on Linux x86_64, or from the system)
+* ``lib/libOpenMMSymPRKCUDA.so``      Common kernel + CUDA factory (cuda.h from PyPI's nvidia-cuda-runtime-cu12 and
+  nvidia-cuda-nvcc-cu12, build requirements on Linux x86_64, or CUDA_HOME); it links against OpenMM
+  only, so it builds and loads without a GPU and serves OpenMM's CUDA platform wherever that is
+  installed (``pip install "openmm_symprk[cuda12]"``)
 * ``symprk_swig.py`` + ``_symprk_swig<ext>`` the SWIG wrapper (SWIG >= 4.4, PyPI ``swig``)
 * ``_build_info.json``                what was built, against which openmm, and why anything was skipped
 
 Every failure raises NativeBuildError with the reason; setup.py turns it into a warning and installs the
-pure-Python package.  Environment: CXX (compiler, default g++), SYMPRK_NATIVE=0 (skip the build),
-SYMPRK_OPENCL_INCLUDE (a folder holding CL/opencl.h), SYMPRK_BUILD_CUDA=1, CUDA_HOME.
+pure-Python package (a platform kernel that cannot be built is skipped with its reason in
+``_build_info.json``).  Environment: CXX (compiler, default g++), SYMPRK_NATIVE=0 (skip the build),
+SYMPRK_OPENCL_INCLUDE (a folder holding CL/opencl.h), CUDA_HOME (a CUDA toolkit).
 """
 from __future__ import annotations
 
@@ -47,28 +51,33 @@ _PROBE = ("import json, os, openmm, openmm.version as v; lib = v.openmm_library_
 
 
 def locate_openmm() -> dict:
-    """The installed openmm wheel: library folder, include folder, plugin folder, version.
+    """The openmm wheel to build against: library folder, include folder, plugin folder, version.
 
-    Tried in this process first; under pip's build isolation openmm is not importable here, so the same
-    interpreter is asked again without the isolation's path settings (the openmm that the package will
-    run with is the one installed for this interpreter)."""
+    The openmm installed for the interpreter the package will run with comes first (under pip's build
+    isolation this process sees only the build environment, so that interpreter is asked in a subprocess
+    without the isolation's path settings); when it has none yet (a fresh install: pip installs the
+    package's dependencies after building it), the openmm of the build environment is used, which
+    pyproject.toml pins to the same minor series as the runtime requirement."""
     info = None
-    try:
-        import openmm.version as v  # noqa: F401
-        import openmm
+    env = {k: val for k, val in os.environ.items() if k not in ("PYTHONPATH", "PYTHONNOUSERSITE", "PYTHONHOME")}
+    for exe in dict.fromkeys([sys.executable, getattr(sys, "_base_executable", sys.executable)]):
+        try:
+            out = subprocess.run([exe, "-c", _PROBE], capture_output=True, text=True, env=env, timeout=120)
+        except Exception:
+            continue
+        if out.returncode == 0 and out.stdout.strip():
+            info = json.loads(out.stdout.strip().splitlines()[-1])
+            info["origin"] = "target environment"
+            break
+    if info is None:
+        try:
+            import openmm.version as v  # noqa: F401
+            import openmm
 
-        info = {"lib": v.openmm_library_path, "version": v.full_version, "short": v.short_version,
-                "package": os.path.dirname(openmm.__file__)}
-    except Exception:
-        env = {k: val for k, val in os.environ.items() if k not in ("PYTHONPATH", "PYTHONNOUSERSITE", "PYTHONHOME")}
-        for exe in dict.fromkeys([sys.executable, getattr(sys, "_base_executable", sys.executable)]):
-            try:
-                out = subprocess.run([exe, "-c", _PROBE], capture_output=True, text=True, env=env, timeout=120)
-            except Exception:
-                continue
-            if out.returncode == 0 and out.stdout.strip():
-                info = json.loads(out.stdout.strip().splitlines()[-1])
-                break
+            info = {"lib": v.openmm_library_path, "version": v.full_version, "short": v.short_version,
+                    "package": os.path.dirname(openmm.__file__), "origin": "build environment"}
+        except Exception:
+            pass
     if info is None:
         raise NativeBuildError("openmm is not installed for this Python (pip installs it with the package; "
                                "rebuild with `pip install .` once it is there)")
@@ -117,12 +126,42 @@ def _cxx() -> list:
     return cxx.split()
 
 
+def _package_include(module: str) -> str | None:
+    """The ``include`` folder of an installed NVIDIA header package (e.g. nvidia.cuda_opencl), or None."""
+    try:
+        import importlib
+
+        mod = importlib.import_module(module)
+    except Exception:
+        return None
+    for base in list(getattr(mod, "__path__", [])) + [os.path.dirname(getattr(mod, "__file__", "") or "")]:
+        if base and os.path.isdir(os.path.join(base, "include")):
+            return os.path.join(base, "include")
+    return None
+
+
 def _opencl_include() -> str | None:
-    """A folder holding CL/opencl.h, or None."""
-    for d in filter(None, [os.environ.get("SYMPRK_OPENCL_INCLUDE"), "/usr/include", "/usr/local/include",
+    """A folder holding CL/opencl.h: SYMPRK_OPENCL_INCLUDE, the headers of PyPI's nvidia-cuda-opencl-cu12
+    (a build requirement on Linux x86_64), or the system's (Debian: opencl-c-headers)."""
+    for d in filter(None, [os.environ.get("SYMPRK_OPENCL_INCLUDE"), _package_include("nvidia.cuda_opencl"),
+                           "/usr/include", "/usr/local/include",
                            os.path.join(os.environ.get("CUDA_HOME", "/usr/local/cuda"), "include")]):
         if os.path.exists(os.path.join(d, "CL", "opencl.h")):
             return d
+    return None
+
+
+def _cuda_includes() -> list | None:
+    """Folders holding cuda.h and crt/host_defines.h: CUDA_HOME, a toolkit in /usr/local/cuda, or the headers
+    of PyPI's nvidia-cuda-runtime-cu12 and nvidia-cuda-nvcc-cu12 (build requirements on Linux x86_64)."""
+    for home in filter(None, [os.environ.get("CUDA_HOME"), "/usr/local/cuda"]):
+        inc = os.path.join(home, "include")
+        if os.path.exists(os.path.join(inc, "cuda.h")) and os.path.exists(os.path.join(inc, "crt", "host_defines.h")):
+            return [inc]
+    runtime, nvcc = _package_include("nvidia.cuda_runtime"), _package_include("nvidia.cuda_nvcc")
+    if runtime and nvcc and os.path.exists(os.path.join(runtime, "cuda.h")) and \
+            os.path.exists(os.path.join(nvcc, "crt", "host_defines.h")):
+        return [runtime, nvcc]
     return None
 
 
@@ -161,9 +200,9 @@ class _Builder:
                     raise NativeBuildError(f"compiling {src.name} failed:\n{' '.join(cmd)}\n{res.stderr[-4000:]}")
         return objs
 
-    def link(self, objs: list, target: Path, libs: list, libdirs: list, rpath: list):
+    def link(self, objs: list, target: Path, libs: list, libdirs: list, rpath: list, extra=()):
         cmd = self.cxx + ["-shared", "-o", str(target)] + [str(o) for o in objs] + [f"-L{d}" for d in libdirs] + \
-            [f"-l{lib}" for lib in libs] + [f"-Wl,-rpath,{r}" for r in rpath] + ["-Wl,--enable-new-dtags"]
+            [f"-l{lib}" for lib in libs] + [f"-Wl,-rpath,{r}" for r in rpath] + ["-Wl,--enable-new-dtags"] + list(extra)
         res = subprocess.run(cmd, capture_output=True, text=True)
         if res.returncode != 0:
             raise NativeBuildError(f"linking {target.name} failed:\n{' '.join(cmd)}\n{res.stderr[-4000:]}")
@@ -190,12 +229,15 @@ def build(package_dir, tmp_dir=None, log=print) -> dict:
     t0 = time.time()
     out = Path(package_dir).resolve()
     tmp = Path(tmp_dir) if tmp_dir else Path(tempfile.mkdtemp(prefix="symprk-native-"))
+    _cxx()  # the compiler first: without one nothing else matters
     omm = locate_openmm()
     swig = find_swig()
-    log(f"openmm_symprk native: building against openmm {omm['version']} ({omm['lib']}) with {swig}")
+    log(f"openmm_symprk native: building against openmm {omm['version']} ({omm['origin']}: {omm['lib']}) "
+        f"with {swig}")
     clean(out)
     b = _Builder(omm, out, tmp, log)
-    info = {"openmm_version": omm["version"], "openmm_lib": omm["lib"], "libraries": {}, "skipped": {}}
+    info = {"openmm_version": omm["version"], "openmm_lib": omm["lib"], "openmm_origin": omm["origin"],
+            "libraries": {}, "skipped": {}}
 
     # SWIG runs while the C++ compiles (it only reads the headers).
     swig_out = tmp / "symprk_wrap.cxx"
@@ -203,51 +245,64 @@ def build(package_dir, tmp_dir=None, log=print) -> dict:
                 "-outdir", str(tmp), "-o", str(swig_out), str(HERE / "python" / "symprk.i")]
     swig_proc = subprocess.Popen(swig_cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
 
+    strict = ["-Wl,--no-undefined"]  # every symbol of a kernel library resolves at link time
     api = b.lib_dir / "libOpenMMSymPRK.so"
     b.link(b.compile([HERE / "openmmapi" / "src" / "SymPRKIntegrator.cpp",
-                      HERE / "serialization" / "src" / "SymPRKIntegratorProxy.cpp"]), api, ["OpenMM"], [omm["lib"]], b.rpath_lib)
+                      HERE / "serialization" / "src" / "SymPRKIntegratorProxy.cpp"]), api, ["OpenMM"], [omm["lib"]],
+           b.rpath_lib, strict)
     info["libraries"]["api"] = api.name
     ref = b.lib_dir / "libOpenMMSymPRKReference.so"
     b.link(b.compile([HERE / "reference" / "src" / "ReferenceSymPRKKernels.cpp",
                       HERE / "reference" / "src" / "ReferenceSymPRKKernelFactory.cpp"]),
-           ref, ["OpenMMSymPRK", "OpenMM"], [b.lib_dir, omm["lib"]], b.rpath_lib)
+           ref, ["OpenMMSymPRK", "OpenMM"], [b.lib_dir, omm["lib"]], b.rpath_lib, strict)
     info["libraries"]["Reference"] = ref.name
 
     common_src = [HERE / "common" / "src" / "CommonSymPRKKernels.cpp", _embed_kernel_sources(tmp)]
+    common_objs = b.compile(common_src)  # platform independent: shared by the OpenCL and CUDA libraries
     ocl_inc = _opencl_include()
     if not (Path(omm["plugins"]) / "libOpenMMOpenCL.so").exists():
         info["skipped"]["OpenCL"] = "the openmm wheel has no OpenCL platform library (plugins/libOpenMMOpenCL.so)"
     elif ocl_inc is None:
-        info["skipped"]["OpenCL"] = ("the OpenCL C headers (CL/opencl.h) are missing: install Debian's "
-                                     "opencl-c-headers (or set SYMPRK_OPENCL_INCLUDE) and rebuild")
+        info["skipped"]["OpenCL"] = ("no OpenCL C headers (CL/opencl.h) were found: they come with the build "
+                                     "requirement nvidia-cuda-opencl-cu12 on Linux x86_64; elsewhere install "
+                                     "them (Debian: opencl-c-headers) or set SYMPRK_OPENCL_INCLUDE, then rebuild")
     else:
         try:
-            objs = b.compile(common_src + [HERE / "opencl" / "src" / "OpenCLSymPRKKernelFactory.cpp"],
+            objs = b.compile([HERE / "opencl" / "src" / "OpenCLSymPRKKernelFactory.cpp"],
                              extra_includes=[ocl_inc, Path(omm["include"]) / "openmm" / "opencl"],
                              extra_flags=["-DCL_TARGET_OPENCL_VERSION=120"])
             ocl = b.lib_dir / "libOpenMMSymPRKOpenCL.so"
-            b.link(objs, ocl, ["OpenMMSymPRK", "OpenMMOpenCL", "OpenMM"], [b.lib_dir, omm["lib"], omm["plugins"]], b.rpath_lib)
+            b.link(common_objs + objs, ocl, ["OpenMMSymPRK", "OpenMMOpenCL", "OpenMM"],
+                   [b.lib_dir, omm["lib"], omm["plugins"]], b.rpath_lib)
             info["libraries"]["OpenCL"] = ocl.name
         except NativeBuildError as exc:
             info["skipped"]["OpenCL"] = str(exc).splitlines()[0]
             log(f"  OpenCL kernel skipped: {exc}")
-    if os.environ.get("SYMPRK_BUILD_CUDA", "") == "1":
-        cuda_home = os.environ.get("CUDA_HOME", "/usr/local/cuda")
-        if not (Path(omm["plugins"]) / "libOpenMMCUDA.so").exists():
-            info["skipped"]["CUDA"] = "the openmm wheel has no CUDA platform library"
-        elif not os.path.exists(os.path.join(cuda_home, "include", "cuda.h")):
-            info["skipped"]["CUDA"] = f"no CUDA toolkit headers under {cuda_home}/include"
-        else:
-            try:
-                objs = b.compile(common_src + [HERE / "cuda" / "src" / "CudaSymPRKKernelFactory.cpp"],
-                                 extra_includes=[os.path.join(cuda_home, "include"), Path(omm["include"]) / "openmm" / "cuda"])
-                cu = b.lib_dir / "libOpenMMSymPRKCUDA.so"
-                b.link(objs, cu, ["OpenMMSymPRK", "OpenMMCUDA", "OpenMM"], [b.lib_dir, omm["lib"], omm["plugins"]], b.rpath_lib)
-                info["libraries"]["CUDA"] = cu.name
-            except NativeBuildError as exc:
-                info["skipped"]["CUDA"] = str(exc).splitlines()[0]
+    cuda_inc = _cuda_includes()
+    if not (Path(omm["include"]) / "openmm" / "cuda" / "CudaContext.h").exists():
+        info["skipped"]["CUDA"] = "the openmm wheel ships no CUDA platform headers (openmm/cuda/CudaContext.h)"
+    elif cuda_inc is None:
+        info["skipped"]["CUDA"] = ("no CUDA headers (cuda.h, crt/host_defines.h) were found: they come with the "
+                                   "build requirements nvidia-cuda-runtime-cu12 and nvidia-cuda-nvcc-cu12 on Linux "
+                                   "x86_64; elsewhere set CUDA_HOME to a CUDA toolkit and rebuild")
     else:
-        info["skipped"]["CUDA"] = "not built (set SYMPRK_BUILD_CUDA=1 on a machine with CUDA and a CUDA-enabled openmm)"
+        # The Common compute classes (ComputeArray, IntegrationUtilities, ...) live in each platform library,
+        # here OpenMM's libOpenMMCUDA.so (pip install "openmm_symprk[cuda12]").  It is linked when this build
+        # can see it; otherwise those symbols stay undefined and resolve when the package loads this library,
+        # which it does only in a process where OpenMM's CUDA platform (and so libOpenMMCUDA.so) is loaded.
+        # Nothing else is left undefined (tests/native check the library's symbol table).
+        try:
+            objs = b.compile([HERE / "cuda" / "src" / "CudaSymPRKKernelFactory.cpp"],
+                             extra_includes=cuda_inc + [Path(omm["include"]) / "openmm" / "cuda"])
+            cu = b.lib_dir / "libOpenMMSymPRKCUDA.so"
+            cuda_lib = Path(omm["plugins"]) / "libOpenMMCUDA.so"
+            libs = ["OpenMMSymPRK", "OpenMM"] + (["OpenMMCUDA"] if cuda_lib.exists() else [])
+            b.link(common_objs + objs, cu, libs, [b.lib_dir, omm["lib"], omm["plugins"]], b.rpath_lib)
+            info["cuda_platform_linked"] = cuda_lib.exists()
+            info["libraries"]["CUDA"] = cu.name
+        except NativeBuildError as exc:
+            info["skipped"]["CUDA"] = str(exc).splitlines()[0]
+            log(f"  CUDA kernel skipped: {exc}")
 
     _, swig_err = swig_proc.communicate()
     if swig_proc.returncode != 0:

@@ -106,9 +106,10 @@ def _load() -> _State:
         st.reason = f"the native plugin's Python module does not import: {exc}"
         return st
     libdir = os.path.join(where, "lib")
+    present = set(_platform_names())
     for platform, name in st.build_info.get("libraries", {}).items():
-        if platform == "api":
-            continue
+        if platform == "api" or (platform != "Reference" and platform not in present):
+            continue  # a kernel library is loaded only where OpenMM has its platform (CUDA needs libOpenMMCUDA)
         try:
             mm.Platform.loadPluginLibrary(os.path.join(libdir, name))
         except Exception as exc:
@@ -147,6 +148,11 @@ def native_platforms() -> list:
     if not native_available():
         return []
     return [p for p in _platform_names() if _supports(p)]
+
+
+def build_directory() -> str:
+    """The folder holding the native build (``lib/``, the SWIG module, ``_build_info.json``)."""
+    return _load().build_dir
 
 
 def build_info() -> dict:
