@@ -20,7 +20,7 @@ class BuildNative(build_ext):
 
     def run(self):
         inplace = bool(self.inplace or getattr(self, "editable_mode", False))
-        target = os.path.join(HERE if inplace else self.build_lib, "openmm_symprk", "native")
+        target = os.path.join(HERE if inplace else self.build_lib, "openmm_symprk", "plugin")
         os.makedirs(target, exist_ok=True)
         error_file = os.path.join(target, "_build_error.txt")
         if os.path.exists(error_file):
@@ -63,7 +63,7 @@ setup(
     long_description_content_type="text/markdown",
     python_requires=">=3.10",
     packages=find_packages(include=["openmm_symprk", "openmm_symprk.*"]),
-    package_data={"openmm_symprk": ["data/*.toml"]},
+    package_data={"openmm_symprk.methods": ["data/*.toml"]},
     install_requires=[
         "openmm>=8.6,<8.7",
         "numpy>=1.24",

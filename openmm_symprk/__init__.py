@@ -3,40 +3,51 @@
     from openmm_symprk import SymplecticIntegrator, methods
     integrator = SymplecticIntegrator(2*unit.femtoseconds, "yoshida-4", system=system)
 
-Heavier parts (rigid bodies, diagnostics, reporters, MDAnalysis analysis, benchmarks) load on first use.
+The package by layer (each imports only from the ones above it):
+
+* :mod:`.methods` -- tableaux, splittings, the catalogue, pure-numpy reference integrators (no OpenMM);
+* :mod:`.physics` -- momenta and inertia on arrays, about a stated point (no OpenMM);
+* :mod:`.systems` -- facts of an OpenMM System, conservation checks, initial states, minimal scenes;
+* :mod:`.plugin` -- the compiled OpenMM plugin and its loader;
+* :mod:`.integrators` -- the integrators (CustomIntegrator programs and the native plugin, one base);
+* :mod:`.conservation`, :mod:`.rigid` -- diagnostics, reporters, MDAnalysis analysis; rigid bodies;
+* :mod:`.studies` -- demo, bench, conservation table, speed; :mod:`.cli` -- the ``symprk`` command.
+
+Heavier parts (rigid bodies, diagnostics, reporters, MDAnalysis analysis, studies) load on first use.
 """
 from importlib import import_module
 
-from .catalogue import UnknownMethodError, get_method, methods
-from .integrators import PRKIntegrator, SimulationBlowUpError, SymplecticIntegrator, step_size_in_ps
-from .splitting import Splitting, compose
-from .tableau import PRKTableau, TableauError
+from .integrators import (CheckpointMismatchError, CustomSymplecticIntegrator, NativeSymplecticIntegrator,
+                          PRKIntegrator, SimulationBlowUpError, SymplecticIntegrator, SystemMismatchError, deserialize,
+                          restore, step_size_in_ps)
+from .methods import PRKTableau, Splitting, TableauError, UnknownMethodError, compose, get_method, methods
 
-__version__ = "0.1.0"
+__version__ = "0.2.0"
 
 # name -> module that defines it, imported lazily (keeps `import openmm_symprk` light)
 _LAZY = {
-    "rigidbody": ".rigidbody",
-    "native": ".native",
-    "make_rigid": ".rigid_molecules",
-    "RigidGroup": ".rigid_molecules",
-    "RigidGroupError": ".rigid_molecules",
-    "RigidGroupWarning": ".rigid_molecules",
-    "linear_momentum": ".conservation",
-    "angular_momentum": ".conservation",
-    "diagnostics": ".conservation",
-    "ConservationReporter": ".reporters",
-    "VelocityTRRReporter": ".reporters",
+    "rigidbody": ".rigid.lie_poisson",
+    "native": ".integrators.native",
+    "make_rigid": ".rigid.molecules",
+    "RigidGroup": ".rigid.molecules",
+    "RigidGroupError": ".rigid.molecules",
+    "RigidGroupWarning": ".rigid.molecules",
+    "linear_momentum": ".conservation.diagnostics",
+    "angular_momentum": ".conservation.diagnostics",
+    "diagnostics": ".conservation.diagnostics",
+    "ConservationReporter": ".conservation.reporters",
+    "VelocityTRRReporter": ".conservation.reporters",
 }
 
 
 def __getattr__(name):
     if name in _LAZY:
         module = import_module(_LAZY[name], __name__)
-        return module if module.__name__.endswith("." + name) else getattr(module, name)
+        return module if name in ("rigidbody", "native") else getattr(module, name)
     raise AttributeError(f"module 'openmm_symprk' has no attribute {name!r}")
 
 
-__all__ = ["SymplecticIntegrator", "PRKIntegrator", "PRKTableau", "Splitting", "compose", "methods",
-           "get_method", "UnknownMethodError", "TableauError", "SimulationBlowUpError", "step_size_in_ps",
-           *_LAZY]
+__all__ = ["SymplecticIntegrator", "PRKIntegrator", "CustomSymplecticIntegrator", "NativeSymplecticIntegrator",
+           "PRKTableau", "Splitting", "compose", "methods", "get_method", "UnknownMethodError", "TableauError",
+           "SimulationBlowUpError", "SystemMismatchError", "CheckpointMismatchError", "restore", "deserialize",
+           "step_size_in_ps", *_LAZY]

@@ -1,50 +1,94 @@
-"""The ``symprk`` command: demo, methods, check, info, and the studies (bench, conservation)."""
+"""The ``symprk`` command: demo, methods, check, info, and the studies (bench, conservation, speed).
+
+Every error the user can cause (a bad name, file, platform, value, a blow-up) ends in one line on stderr
+and a non-zero exit status; only a bug shows a traceback.
+"""
 from __future__ import annotations
 
 import argparse
 import sys
 
 
+class CommandError(Exception):
+    """A user-facing error of a sub-command: printed as one line, exit status 2."""
+
+
+def _positive(kind):
+    def parse(text):
+        try:
+            value = kind(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
+        if not value > 0:
+            raise argparse.ArgumentTypeError(f"must be positive, got {text}")
+        return value
+    return parse
+
+
+def _platform_name(name: str) -> str:
+    import openmm as mm
+
+    names = [mm.Platform.getPlatform(i).getName() for i in range(mm.Platform.getNumPlatforms())]
+    if name not in names:
+        raise CommandError(f"unknown OpenMM platform {name!r}; this installation has {', '.join(names)}")
+    return name
+
+
 def _cmd_demo(args):
-    from .demo import run_demo
+    from .studies.demo import run_demo
 
     run_demo(methods=args.method, n_waters=args.waters, steps=args.steps, step_fs=args.step_fs,
-             platform=args.platform)
+             platform=_platform_name(args.platform), backend=args.backend)
 
 
 def _cmd_methods(args):
-    from .catalogue import format_table, methods
+    from .methods.catalogue import format_table, methods
 
     entries = [methods[n] for n in args.names] if args.names else None
     print(format_table(entries))
-    if args.names:
-        for n in args.names:
-            m = methods[n]
-            print(f"\n{m.name}: {m.title}\n  source: {m.source}\n  aliases: {', '.join(m.aliases) or '-'}"
-                  f"\n  order under RATTLE constraints: {m.constrained_order or 'not available (no constraints)'}"
-                  f"\n  {m.tableau().summary()}")
-            if m.splitting is not None:
-                print("  sequence (applied left to right):")
-                for label, c in m.splitting.coefficients():
-                    print(f"    {label:5s} {c: .17f}")
+    for n in args.names or ():
+        m = methods[n]
+        print(f"\n{m.name}: {m.title}\n  source: {m.source}\n  aliases: {', '.join(m.aliases) or '-'}"
+              f"\n  order under RATTLE constraints: {m.constrained_order or 'not available (no constraints)'}"
+              f"\n  {m.tableau().summary()}")
+        if m.splitting is not None:
+            print("  sequence (applied left to right):")
+            for label, c in m.splitting.coefficients():
+                print(f"    {label:5s} {c: .17f}")
+
+
+def _read_tableau_file(path: str) -> dict:
+    import json
+    import tomllib
+
+    try:
+        with open(path, "rb") as fh:
+            raw = fh.read()
+    except OSError as exc:
+        raise CommandError(f"cannot read {path}: {exc.strerror or exc}") from None
+    try:
+        data = tomllib.loads(raw.decode()) if path.endswith(".toml") else json.loads(raw)
+    except (ValueError, UnicodeDecodeError) as exc:
+        kind = "TOML" if path.endswith(".toml") else "JSON"
+        raise CommandError(f"{path} is not valid {kind}: {exc}") from None
+    if not isinstance(data, dict) or "A" not in data or "b" not in data:
+        found = ", ".join(sorted(data)) if isinstance(data, dict) else type(data).__name__
+        raise CommandError(f"{path} must hold a table with A and b (and optionally A_hat, b_hat); found {found}")
+    return data
 
 
 def _cmd_check(args):
     """Check a user tableau pair given as a JSON or TOML file with A, b, A_hat, b_hat."""
-    import json
-    import tomllib
+    from .methods.reference import measure_order
+    from .methods.stability import stability_interval
+    from .methods.tableau import PRKTableau
 
-    from .tableau import PRKTableau
-
-    text = open(args.file, "rb").read()
-    data = tomllib.loads(text.decode()) if args.file.endswith(".toml") else json.loads(text)
+    data = _read_tableau_file(args.file)
     tab = PRKTableau(data["A"], data["b"], data.get("A_hat", data["A"]), data.get("b_hat", data["b"]),
                      name=args.file)
     print(tab.summary())
     print("symplectic for MD (condition (6)):", tab.is_symplectic)
     print("symplectic for any H ((6) and (7)):", tab.is_symplectic_general)
-    from .numerics import measure_order, stability_interval
-
     print(f"largest stable h*omega on the harmonic oscillator: {stability_interval(tab):.4f}")
     orders, _ = measure_order(tab, dtype=float)
     print(f"measured order on Henon-Heiles: {orders[-1]:.2f}")
@@ -55,27 +99,28 @@ def _cmd_info(args):
     import openmm as mm
 
     import openmm_symprk
-    from . import native
+
+    from . import plugin
 
     print(f"openmm_symprk {openmm_symprk.__version__}, OpenMM {mm.__version__}")
-    details = native.native_details()
-    names = [mm.Platform.getPlatform(i).getName() for i in range(mm.Platform.getNumPlatforms())]
-    for n in names:
-        how = details.get(n, "")
-        backend = "native plugin" if how == "native" else f"CustomIntegrator program (native: {how or 'n/a'})"
+    details = plugin.details()
+    for n, how in details.items():
+        backend = "native plugin" if how == "native" else f"CustomIntegrator program (native: {how})"
         print(f"  platform {n:10s} backend for splittings: {backend}")
-    auto = "native" if native.native_available() and all(details.get(n) == "native" for n in names) else "custom"
+    auto = "native" if plugin.available() and all(how == "native" for how in details.values()) else "custom"
     print(f"  SymplecticIntegrator(backend='auto') gives: {auto} for splittings and compositions, "
           f"custom for implicit and general tableaux")
+    if not plugin.available():
+        print(f"  to get the native plugin: {plugin.fix_hint()}")
     print(f"  catalogue: {len(openmm_symprk.methods)} methods (symprk methods)")
     if args.require_native:
         wanted = [p.strip() for p in args.require_native.split(",") if p.strip()]
         missing = [p for p in wanted if details.get(p) != "native"]
         if missing:
-            print(f"symprk info: error: the native plugin does not serve {', '.join(missing)} "
-                  f"({'; '.join(f'{p}: ' + (details.get(p) or 'no such OpenMM platform here') for p in missing)})",
-                  file=sys.stderr)
-            return 1
+            raise CommandError(
+                f"the native plugin does not serve {', '.join(missing)} "
+                f"({'; '.join(f'{p}: ' + (details.get(p) or 'no such OpenMM platform here') for p in missing)})")
+    return 0
 
 
 def build_parser():
@@ -84,10 +129,11 @@ def build_parser():
 
     d = sub.add_parser("demo", help="spinning rigid-water cluster: conservation vs OpenMM's Verlet")
     d.add_argument("--method", nargs="+", default=["verlet", "yoshida-4"], help="catalogue names")
-    d.add_argument("--waters", type=int, default=64)
-    d.add_argument("--steps", type=int, default=2000)
-    d.add_argument("--step-fs", type=float, default=2.0)
+    d.add_argument("--waters", type=_positive(int), default=64)
+    d.add_argument("--steps", type=_positive(int), default=2000)
+    d.add_argument("--step-fs", type=_positive(float), default=2.0)
     d.add_argument("--platform", default="Reference")
+    d.add_argument("--backend", default="auto", choices=("auto", "native", "custom"))
     d.set_defaults(func=_cmd_demo)
 
     m = sub.add_parser("methods", help="print the catalogue (or details of named methods)")
@@ -100,18 +146,31 @@ def build_parser():
 
     i = sub.add_parser("info", help="versions, platforms and backends")
     i.add_argument("--require-native", metavar="PLATFORMS",
-                   help="exit with status 1 unless the native plugin serves these platforms (comma-separated)")
+                   help="exit with status 2 unless the native plugin serves these platforms (comma-separated)")
     i.set_defaults(func=_cmd_info)
 
-    for name, text in (("bench", "work-precision and stability sweeps (symprk bench --help)"),
-                       ("conservation", "conservation table: platform x method x projection "
-                                        "(symprk conservation --help)")):
+    for name, text in DELEGATED_HELP.items():
         sub.add_parser(name, help=text)
     return p
 
 
 #: sub-commands whose own argument parser lives in another module (argv passed through untouched)
-DELEGATED = {"bench": "openmm_symprk.bench.cli", "conservation": "openmm_symprk.conservation_study"}
+DELEGATED = {"bench": "openmm_symprk.studies.bench.cli", "conservation": "openmm_symprk.studies.conservation_table",
+             "speed": "openmm_symprk.studies.native_speed"}
+DELEGATED_HELP = {"bench": "work-precision and stability sweeps (symprk bench --help)",
+                  "conservation": "conservation table: platform x method x projection (symprk conservation --help)",
+                  "speed": "native backend vs OpenMM's VerletIntegrator, time per step (symprk speed --help)"}
+
+
+def _user_errors():
+    """The exception types that mean "the input was wrong" rather than "the package has a bug"."""
+    import openmm as mm
+
+    from .integrators import SimulationBlowUpError
+    from .methods import TableauError, UnknownMethodError
+
+    return (CommandError, UnknownMethodError, TableauError, SimulationBlowUpError, mm.OpenMMException, ValueError,
+            TypeError, OSError)
 
 
 def main(argv=None):
@@ -123,12 +182,12 @@ def main(argv=None):
     args = build_parser().parse_args(argv)
     try:
         rc = args.func(args)
-    except Exception as exc:  # a clean message for the known error types, a traceback otherwise
-        from .catalogue import UnknownMethodError
-        from .tableau import TableauError
-
-        if isinstance(exc, (UnknownMethodError, TableauError, ValueError, TypeError, FileNotFoundError)):
-            print(f"symprk: error: {exc}", file=sys.stderr)
+    except KeyboardInterrupt:
+        print("symprk: interrupted", file=sys.stderr)
+        return 130
+    except Exception as exc:  # one line for what the user can fix, a traceback for a bug
+        if isinstance(exc, _user_errors()):
+            print(f"symprk {args.command}: error: {exc}", file=sys.stderr)
             return 2
         raise
     return rc or 0

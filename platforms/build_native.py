@@ -2,7 +2,7 @@
 
 Used by setup.py (``pip install .``) and runnable by hand for development::
 
-    python platforms/build_native.py            # builds into openmm_symprk/native/ (in place)
+    python platforms/build_native.py            # builds into openmm_symprk/plugin/ (in place)
 
 What it builds (g++ directly, C++17, the wheel's headers under OpenMM.libs/include, new C++11 ABI):
 
@@ -14,7 +14,7 @@ What it builds (g++ directly, C++17, the wheel's headers under OpenMM.libs/inclu
   nvidia-cuda-nvcc-cu12, build requirements on Linux x86_64, or CUDA_HOME); it links against OpenMM
   only, so it builds and loads without a GPU and serves OpenMM's CUDA platform wherever that is
   installed (``pip install "openmm_symprk[cuda12]"``)
-* ``symprk_swig.py`` + ``_symprk_swig<ext>`` the SWIG wrapper (SWIG >= 4.4, PyPI ``swig``)
+* ``symprk_swig.py`` + ``symprk_swig_ext<ext>`` the SWIG wrapper (SWIG >= 4.4, PyPI ``swig``)
 * ``_build_info.json``                what was built, against which openmm, and why anything was skipped
 
 Every failure raises NativeBuildError with the reason; setup.py turns it into a warning and installs the
@@ -221,7 +221,7 @@ def _embed_kernel_sources(tmp: Path) -> Path:
 
 
 def build(package_dir, tmp_dir=None, log=print) -> dict:
-    """Build everything into ``package_dir`` (the openmm_symprk/native folder).  Returns the build info."""
+    """Build everything into ``package_dir`` (the openmm_symprk/plugin folder).  Returns the build info."""
     if os.environ.get("SYMPRK_NATIVE", "1").strip().lower() in ("0", "no", "off", "false"):
         raise NativeBuildError("SYMPRK_NATIVE=0: native build disabled by the environment")
     if not sys.platform.startswith("linux"):
@@ -241,7 +241,8 @@ def build(package_dir, tmp_dir=None, log=print) -> dict:
 
     # SWIG runs while the C++ compiles (it only reads the headers).
     swig_out = tmp / "symprk_wrap.cxx"
-    swig_cmd = [swig, "-python", "-c++", "-O", f"-I{omm['include']}", f"-I{HERE / 'openmmapi' / 'include'}",
+    swig_cmd = [swig, "-python", "-c++", "-O", "-interface", "symprk_swig_ext", f"-I{omm['include']}",
+                f"-I{HERE / 'openmmapi' / 'include'}",
                 "-outdir", str(tmp), "-o", str(swig_out), str(HERE / "python" / "symprk.i")]
     swig_proc = subprocess.Popen(swig_cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
 
@@ -310,7 +311,7 @@ def build(package_dir, tmp_dir=None, log=print) -> dict:
     py_inc = sysconfig.get_paths()["include"]
     ext_suffix = sysconfig.get_config_var("EXT_SUFFIX") or ".so"
     wrap_obj = b.compile([swig_out], extra_includes=[py_inc])
-    ext = out / f"_symprk_swig{ext_suffix}"
+    ext = out / f"symprk_swig_ext{ext_suffix}"
     b.link(wrap_obj, ext, ["OpenMMSymPRK", "OpenMM"], [b.lib_dir, omm["lib"]],
            ["$ORIGIN/lib", "$ORIGIN/../../OpenMM.libs/lib", str(b.lib_dir), omm["lib"]])
     shutil.copyfile(tmp / "symprk_swig.py", out / "symprk_swig.py")
@@ -326,7 +327,8 @@ def build(package_dir, tmp_dir=None, log=print) -> dict:
 def clean(package_dir) -> None:
     """Remove a previous build's outputs from ``package_dir``."""
     out = Path(package_dir)
-    for p in [out / "_build_info.json", out / "symprk_swig.py", *out.glob("_symprk_swig*.so")]:
+    for p in [out / "_build_info.json", out / "symprk_swig.py", *out.glob("symprk_swig_ext*.so"),
+              *out.glob("_symprk_swig*.so")]:
         if p.exists():
             p.unlink()
     if (out / "lib").exists():
@@ -334,7 +336,7 @@ def clean(package_dir) -> None:
 
 
 if __name__ == "__main__":
-    target = Path(sys.argv[1]) if len(sys.argv) > 1 else HERE.parent / "openmm_symprk" / "native"
+    target = Path(sys.argv[1]) if len(sys.argv) > 1 else HERE.parent / "openmm_symprk" / "plugin"
     try:
         build(target, HERE.parent / "build" / "native-tmp")
     except NativeBuildError as e:

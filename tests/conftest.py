@@ -10,29 +10,39 @@ def platform_available(name: str) -> bool:
         return False
 
 
+@pytest.fixture(autouse=True)
+def fresh_warnings():
+    """Every test sees the package's one-time warnings as a fresh process would."""
+    from openmm_symprk.systems.checks import warn_once
+
+    warn_once.reset()
+    yield
+    warn_once.reset()
+
+
 @pytest.fixture(scope="session")
 def water27():
-    from openmm_symprk.scenes import water_cluster
+    from openmm_symprk.systems.scenes import water_cluster
 
     return water_cluster(27)
 
 
 @pytest.fixture(scope="session")
 def water8():
-    from openmm_symprk.scenes import water_cluster
+    from openmm_symprk.systems.scenes import water_cluster
 
     return water_cluster(8)
 
 
 @pytest.fixture(scope="session")
 def morse():
-    from openmm_symprk.scenes import morse_molecule
+    from openmm_symprk.systems.scenes import morse_molecule
 
     return morse_molecule()
 
 
 @pytest.fixture(scope="session")
 def constrained():
-    from openmm_symprk.scenes import constrained_molecule
+    from openmm_symprk.systems.scenes import constrained_molecule
 
     return constrained_molecule()

@@ -1,5 +1,5 @@
 /* SWIG interface of the openmm_symprk native plugin (needs SWIG >= 4.4, like the openmm wheel's own). */
-%module(package="openmm_symprk.native") symprk_swig
+%module(package="openmm_symprk.plugin") symprk_swig
 
 %import(module="openmm") "swig/OpenMMSwigHeaders.i"
 %include "swig/typemaps.i"
@@ -86,6 +86,14 @@ public:
     void setMethodName(const std::string& name);
     long long getStepsTaken() const;
     long long getBlowUpStep() const;
+    void clearBlowUp();
+    double getMaxSpeed() const;
+    void setMaxSpeed(double speed);
+    void setExpectedSystem(int numParticles, bool constraints);
+    int getExpectedNumParticles() const;
+    bool getExpectedConstraints() const;
+    long long getProgramSignature() const;
+    static void registerMissingKernelFactories();
     void step(int steps);
     %extend {
         /** The same integrator seen as a SymPRKIntegrator (e.g. after XmlSerializer.deserialize). */

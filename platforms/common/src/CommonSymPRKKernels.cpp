@@ -23,6 +23,14 @@ void CommonIntegrateSymPRKStepKernel::initialize(const System& system, const Sym
     defines["NUM_ATOMS"] = cc.intToString(cc.getNumAtoms());
     defines["PADDED_NUM_ATOMS"] = cc.intToString(cc.getPaddedNumAtoms());
     defines["WORK_GROUP_SIZE"] = cc.intToString(projectionBlockSize);
+    // Squared blow-up speed: the given one, or the largest finite value of the velocity type (so that only NaN
+    // and infinity count, as every comparison with NaN is false and inf <= max is false).
+    const bool doubleVelocities = (cc.getUseDoublePrecision() || cc.getUseMixedPrecision());
+    const double maxSpeed = integrator.getMaxSpeed();
+    if (maxSpeed > 0)
+        defines["MAX_SPEED2"] = cc.doubleToString(maxSpeed*maxSpeed, true);
+    else
+        defines["MAX_SPEED2"] = (doubleVelocities ? "1.7976931348623157e308" : "3.402823466e38f");
     ComputeProgram program = cc.compileProgram(CommonSymPRKKernelSources::symprk, defines);
     kickKernel = program->createKernel("symprkKick");
     kickProjectedKernel = program->createKernel("symprkKickProjected");

@@ -4,27 +4,33 @@
 #include "openmm/SymPRKKernels.h"
 #include "openmm/Context.h"
 #include "openmm/OpenMMException.h"
+#include "openmm/KernelFactory.h"
 #include "openmm/internal/ContextImpl.h"
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <istream>
 #include <ostream>
+#include <set>
 #include <sstream>
 
 using namespace OpenMM;
 using namespace std;
 
-static const int64_t CHECKPOINT_MAGIC = 0x53796d50524b0001LL; // "SymPRK" + format version 1
+static const int64_t CHECKPOINT_MAGIC_V1 = 0x53796d50524b0001LL; // "SymPRK" + format version 1
+static const int64_t CHECKPOINT_MAGIC = 0x53796d50524b0002LL;    // version 2: + program signature and method
 
 SymPRKIntegrator::SymPRKIntegrator(double stepSize) : exactMomentum(false), forcesAreValid(false),
-        methodName("verlet"), stepsTaken(0), blowUpStep(0) {
+        methodName("verlet"), stepsTaken(0), blowUpStep(0), maxSpeed(0.0), expectedParticles(-1),
+        expectedConstraints(false) {
     setStepSize(stepSize);
     setConstraintTolerance(1e-5);
     setSubsteps({Kick, Drift, Kick}, {0.5, 1.0, 0.5});
 }
 
 SymPRKIntegrator::SymPRKIntegrator(double stepSize, const vector<int>& kinds, const vector<double>& coefficients) :
-        exactMomentum(false), forcesAreValid(false), methodName(""), stepsTaken(0), blowUpStep(0) {
+        exactMomentum(false), forcesAreValid(false), methodName(""), stepsTaken(0), blowUpStep(0), maxSpeed(0.0),
+        expectedParticles(-1), expectedConstraints(false) {
     setStepSize(stepSize);
     setConstraintTolerance(1e-5);
     setSubsteps(kinds, coefficients);
@@ -101,9 +107,99 @@ long long SymPRKIntegrator::getBlowUpStep() const {
     return blowUpStep;
 }
 
+void SymPRKIntegrator::clearBlowUp() {
+    blowUpStep = 0;
+    if (context != NULL)
+        kernel.getAs<IntegrateSymPRKStepKernel>().setBlowUpStep(*context, 0);
+}
+
+void SymPRKIntegrator::setMaxSpeed(double speed) {
+    if (owner != NULL)
+        throw OpenMMException("SymPRKIntegrator: the blow-up speed cannot be changed once the integrator is bound to a Context");
+    if (!(speed >= 0.0) || !std::isfinite(speed))
+        throw OpenMMException("SymPRKIntegrator: the blow-up speed must be a finite number >= 0 (0: only NaN and infinity)");
+    maxSpeed = speed;
+}
+
+void SymPRKIntegrator::setExpectedSystem(int numParticles, bool constraints) {
+    if (owner != NULL)
+        throw OpenMMException("SymPRKIntegrator: the expected System cannot be changed once the integrator is bound to a Context");
+    expectedParticles = numParticles;
+    expectedConstraints = constraints;
+}
+
+long long SymPRKIntegrator::getProgramSignature() const {
+    // FNV-1a over the sub-step kinds, the coefficients' bits and the exact-momentum flag.
+    uint64_t hash = 1469598103934665603ULL;
+    auto mix = [&] (const void* data, size_t size) {
+        const unsigned char* bytes = (const unsigned char*) data;
+        for (size_t i = 0; i < size; i++) {
+            hash ^= bytes[i];
+            hash *= 1099511628211ULL;
+        }
+    };
+    for (size_t i = 0; i < kinds.size(); i++) {
+        int32_t kind = kinds[i];
+        mix(&kind, sizeof(kind));
+        mix(&coefficients[i], sizeof(double));
+    }
+    int32_t exact = exactMomentum ? 1 : 0;
+    mix(&exact, sizeof(exact));
+    return (long long) (hash & 0x7fffffffffffffffULL);
+}
+
+namespace {
+
+/** Stands in for a platform without a SymPRKIntegrator kernel: creating the kernel explains and throws. */
+class MissingSymPRKKernelFactory : public KernelFactory {
+public:
+    MissingSymPRKKernelFactory(const string& platform, const string& available) : platform(platform), available(available) {
+    }
+    KernelImpl* createKernelImpl(std::string name, const Platform& p, ContextImpl& context) const {
+        throw OpenMMException("SymPRKIntegrator (openmm_symprk's native backend) has no kernel for the "+platform+
+                " platform; this build has kernels for "+available+". Create the Context on one of those, or use "
+                "openmm_symprk.SymplecticIntegrator(..., backend='custom'), whose CustomIntegrator program runs on "
+                "every platform.");
+    }
+private:
+    string platform, available;
+};
+
+}
+
+void SymPRKIntegrator::registerMissingKernelFactories() {
+    static set<string> registered;
+    vector<string> names = {IntegrateSymPRKStepKernel::Name()};
+    string available;
+    for (int i = 0; i < Platform::getNumPlatforms(); i++) {
+        Platform& platform = Platform::getPlatform(i);
+        if (registered.count(platform.getName()) == 0 && platform.supportsKernels(names))
+            available += (available.empty() ? "" : ", ")+platform.getName();
+    }
+    if (available.empty())
+        available = "no platform";
+    for (int i = 0; i < Platform::getNumPlatforms(); i++) {
+        Platform& platform = Platform::getPlatform(i);
+        if (!platform.supportsKernels(names)) {
+            platform.registerKernelFactory(IntegrateSymPRKStepKernel::Name(), new MissingSymPRKKernelFactory(platform.getName(), available));
+            registered.insert(platform.getName());
+        }
+    }
+}
+
 void SymPRKIntegrator::initialize(ContextImpl& contextRef) {
     if (owner != NULL && &contextRef.getOwner() != owner)
         throw OpenMMException("This Integrator is already bound to a context");
+    const System& system = contextRef.getSystem();
+    if (expectedParticles >= 0 && (system.getNumParticles() != expectedParticles ||
+            (system.getNumConstraints() > 0) != expectedConstraints)) {
+        stringstream msg;
+        msg << "SymPRKIntegrator (" << methodName << ") was set up for a System of " << expectedParticles << " particles "
+            << (expectedConstraints ? "with" : "without") << " constraints, but the Context's System has "
+            << system.getNumParticles() << " particles " << (system.getNumConstraints() > 0 ? "with" : "without")
+            << " constraints: create the integrator with system= the System you simulate";
+        throw OpenMMException(msg.str());
+    }
     context = &contextRef;
     owner = &contextRef.getOwner();
     kernel = context->getPlatform().createKernel(IntegrateSymPRKStepKernel::Name(), contextRef);
@@ -144,15 +240,32 @@ void SymPRKIntegrator::step(int steps) {
 }
 
 void SymPRKIntegrator::createCheckpoint(ostream& stream) const {
-    int64_t values[3] = {CHECKPOINT_MAGIC, (int64_t) stepsTaken, (int64_t) getBlowUpStep()};
+    int64_t values[5] = {CHECKPOINT_MAGIC, (int64_t) stepsTaken, (int64_t) getBlowUpStep(),
+                         (int64_t) getProgramSignature(), (int64_t) methodName.size()};
     stream.write((const char*) values, sizeof(values));
+    stream.write(methodName.data(), methodName.size());
 }
 
 void SymPRKIntegrator::loadCheckpoint(istream& stream) {
     int64_t values[3];
     stream.read((char*) values, sizeof(values));
-    if (!stream || values[0] != CHECKPOINT_MAGIC)
-        throw OpenMMException("SymPRKIntegrator: the checkpoint was not written by a SymPRKIntegrator");
+    if (!stream || (values[0] != CHECKPOINT_MAGIC && values[0] != CHECKPOINT_MAGIC_V1))
+        throw OpenMMException("SymPRKIntegrator: the checkpoint was not written by a SymPRKIntegrator (a checkpoint "
+                "of openmm_symprk's CustomIntegrator backend? Load it into SymplecticIntegrator(..., backend='custom') "
+                "with the same method and options as when it was saved)");
+    if (values[0] == CHECKPOINT_MAGIC) {
+        int64_t more[2];
+        stream.read((char*) more, sizeof(more));
+        string name(more[1] > 0 && more[1] < 4096 ? more[1] : 0, ' ');
+        if (!name.empty())
+            stream.read(&name[0], name.size());
+        if (!stream)
+            throw OpenMMException("SymPRKIntegrator: the checkpoint is truncated");
+        if (more[0] != getProgramSignature())
+            throw OpenMMException("SymPRKIntegrator: the checkpoint was written by a SymPRKIntegrator running another program "
+                    "(method '"+name+"'; this one runs '"+methodName+"' with exact momentum "+(exactMomentum ? "on" : "off")+
+                    "): create the integrator with the same method and options as when the checkpoint was saved");
+    }
     stepsTaken = values[1];
     blowUpStep = values[2];
     if (context != NULL)

@@ -17,6 +17,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <limits>
 
 using namespace OpenMM;
 using namespace std;
@@ -320,10 +321,12 @@ void ReferenceIntegrateSymPRKStepKernel::execute(ContextImpl& context, const Sym
             constraints.applyToVelocities(pos, vel, inverseMasses, tol);
     }
 
-    // Record the first step that leaves a velocity NaN, infinite or beyond 1e5 nm/ps (NaN fails every <=).
+    // Record the first step that leaves a velocity NaN, infinite or beyond the blow-up speed (NaN fails every <=).
     if (blowUpStep == 0) {
+        const double maxSpeed = integrator.getMaxSpeed();
+        const double limit = (maxSpeed > 0 ? maxSpeed*maxSpeed : numeric_limits<double>::max());
         for (int i = 0; i < numParticles; i++)
-            if (!(vel[i].dot(vel[i]) <= 1e10)) {
+            if (!(vel[i].dot(vel[i]) <= limit)) {
                 blowUpStep = stepIndex;
                 break;
             }

@@ -21,6 +21,9 @@ void SymPRKIntegratorProxy::serialize(const void* object, SerializationNode& nod
     node.setIntProperty("integrationForceGroups", integrator.getIntegrationForceGroups());
     node.setBoolProperty("exactMomentum", integrator.getExactMomentum());
     node.setStringProperty("method", integrator.getMethodName());
+    node.setDoubleProperty("maxSpeed", integrator.getMaxSpeed());
+    node.setIntProperty("expectedParticles", integrator.getExpectedNumParticles());
+    node.setBoolProperty("expectedConstraints", integrator.getExpectedConstraints());
     SerializationNode& substeps = node.createChildNode("Substeps");
     for (int i = 0; i < integrator.getNumSubsteps(); i++) {
         SerializationNode& s = substeps.createChildNode("Substep");
@@ -49,6 +52,8 @@ void* SymPRKIntegratorProxy::deserialize(const SerializationNode& node) const {
     integrator->setIntegrationForceGroups(node.getIntProperty("integrationForceGroups", 0xFFFFFFFF));
     integrator->setExactMomentum(node.getBoolProperty("exactMomentum", false));
     integrator->setMethodName(node.getStringProperty("method", ""));
+    integrator->setMaxSpeed(node.getDoubleProperty("maxSpeed", 0.0));
+    integrator->setExpectedSystem(node.getIntProperty("expectedParticles", -1), node.getBoolProperty("expectedConstraints", false));
     return integrator;
 }
 

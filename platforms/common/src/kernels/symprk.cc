@@ -2,7 +2,8 @@
  * openmm_symprk native plugin: device code of the SymPRKIntegrator step, written in OpenMM's common compute
  * language (compiled at run time for OpenCL, CUDA or HIP).
  *
- * Host defines: NUM_ATOMS, PADDED_NUM_ATOMS, WORK_GROUP_SIZE (the projection reduction's block size).
+ * Host defines: NUM_ATOMS, PADDED_NUM_ATOMS, WORK_GROUP_SIZE (the projection reduction's block size),
+ * MAX_SPEED2 (the squared blow-up speed).
  * velm.w is the inverse mass (0 for massless particles, which are never moved).  Forces are the
  * platform's 64-bit fixed-point accumulators (scaled by 2^32).  In mixed precision a position is
  * posq + posqCorrection, rebuilt and split again around every update, as OpenMM's own integrators do.
@@ -27,9 +28,9 @@ inline DEVICE void symprkStorePos(GLOBAL real4* RESTRICT posq, GLOBAL real4* RES
 #endif
 }
 
-/** Record the step in *badStep if a velocity is NaN, infinite or beyond 1e5 nm/ps (NaN fails every <=). */
+/** Record the step in *badStep if a velocity is NaN, infinite or beyond the blow-up speed (NaN fails every <=). */
 inline DEVICE void symprkCheckVelocity(mixed4 v, int checkStep, GLOBAL int* RESTRICT badStep) {
-    if (checkStep > 0 && !(v.x*v.x+v.y*v.y+v.z*v.z <= (mixed) 1e10) && badStep[0] == 0)
+    if (checkStep > 0 && !(v.x*v.x+v.y*v.y+v.z*v.z <= (mixed) MAX_SPEED2) && badStep[0] == 0)
         badStep[0] = checkStep;
 }
 

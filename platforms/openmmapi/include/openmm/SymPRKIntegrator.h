@@ -76,9 +76,41 @@ public:
     }
     /**
      * The first step (1-based, counted like getStepsTaken()) at whose end some velocity was NaN, infinite
-     * or faster than 1e5 nm/ps; 0 if none.  Checked on the device at the end of every step.
+     * or faster than getMaxSpeed(); 0 if none (or since clearBlowUp()).  Checked on the device at the end of
+     * every step.
      */
     long long getBlowUpStep() const;
+    /** Forget a recorded blow-up (the Python layer does this when it reports one). */
+    void clearBlowUp();
+    /** Speed (nm/ps) above which a velocity counts as a blow-up; 0 (the default): only NaN and infinity. */
+    double getMaxSpeed() const {
+        return maxSpeed;
+    }
+    /** Set the blow-up speed (nm/ps, >= 0).  Cannot be called once the integrator is bound to a Context. */
+    void setMaxSpeed(double speed);
+    /**
+     * Declare the System this integrator was set up for: initialize() then refuses a Context whose System
+     * has another number of particles, or constraints where none were expected (or the reverse), with a
+     * message saying so.  numParticles < 0 (the default) disables the check.
+     */
+    void setExpectedSystem(int numParticles, bool constraints);
+    int getExpectedNumParticles() const {
+        return expectedParticles;
+    }
+    bool getExpectedConstraints() const {
+        return expectedConstraints;
+    }
+    /**
+     * A hash of the sub-step program and the exact-momentum option.  Checkpoints carry it, and
+     * loadCheckpoint() refuses a checkpoint written by a SymPRKIntegrator running another program.
+     */
+    long long getProgramSignature() const;
+    /**
+     * For every registered platform without a SymPRKIntegrator kernel, register a stand-in whose kernel
+     * creation throws an OpenMMException naming the platform, the platforms that have a kernel, and what to
+     * do instead (called by the Python loader after it has loaded the kernel libraries).
+     */
+    static void registerMissingKernelFactories();
     void step(int steps);
 
 protected:
@@ -100,6 +132,9 @@ private:
     std::string methodName;
     long long stepsTaken;
     mutable long long blowUpStep;
+    double maxSpeed;
+    int expectedParticles;
+    bool expectedConstraints;
     Kernel kernel;
 };
 

@@ -1,0 +1,221 @@
+"""Reporters for ``openmm.app.Simulation``: conservation figures and velocity-carrying trajectories.
+
+    from openmm_symprk.conservation import ConservationReporter, VelocityTRRReporter
+    simulation.reporters.append(ConservationReporter("conservation.csv", 100))
+    simulation.reporters.append(VelocityTRRReporter("traj.trr", 100))
+
+Both use the dict form of ``describeNextReport`` that OpenMM 8 Simulation expects
+(``{'steps', 'periodic', 'include'}``; Simulation 8.6 still converts the old tuple form).  Positions
+are requested unwrapped (``periodic: False``): wrapping molecules into a box would change the angular
+momentum that is being reported.
+
+:class:`ConservationReporter` writes, like ``StateDataReporter``, one line per report: step, time,
+total energy, its drift (slope of a least-squares line through all reports so far, in kJ/mol per ns
+per degree of freedom), |P - P0|, |L - L0|/|L0| (L about the centre of mass, or about the origin),
+and the largest relative constraint violation; every figure is computed in float64 from the State
+(:mod:`openmm_symprk.physics`).  At its first report it warns once, with the reason, about
+anything that keeps the system from conserving what is reported (:mod:`openmm_symprk.systems.checks`:
+the System's issues and thermostatting integrators, one :class:`ConservationWarning` per kind).
+
+:class:`VelocityTRRReporter` writes positions (nm), velocities (nm/ps), step and time to a GROMACS TRR
+file with MDAnalysis' XDR library (no extra dependency); MDAnalysis reads it back with velocities.
+TRR stores float32: figures recomputed from the file are limited to ~1e-7 relative
+(:mod:`openmm_symprk.conservation.analysis`).  :func:`write_topology` writes the matching PDB.
+"""
+from __future__ import annotations
+
+import sys
+
+import numpy as np
+import openmm as mm
+import openmm.app as app
+import openmm.unit as unit
+
+from ..physics import momenta
+from ..systems.checks import conservation_issues, integrator_issues, warn_conservation, warn_once
+from ..systems.properties import constraint_arrays, constraint_violation, degrees_of_freedom, masses
+
+_NM, _NM_PS, _KJ = unit.nanometer, unit.nanometer / unit.picosecond, unit.kilojoule_per_mole
+
+
+def _open(file, append):
+    if file is None or file == "-":
+        return sys.stdout, False
+    if isinstance(file, str):
+        return open(file, "a" if append else "w"), True
+    return file, False
+
+
+class ConservationReporter:
+    """Report energy, momentum and constraint conservation of a Simulation.
+
+    Parameters
+    ----------
+    file : str, file object or None
+        A file name, an open file, or None / "-" for stdout.
+    reportInterval : int
+        Steps between reports.
+    about : "com" or "origin"
+        Point about which L is measured (both are conserved in an isolated system; a CMMotionRemover
+        keeps L about the centre of mass but not about the origin).
+    separator : str
+    append : bool
+        Append to an existing file (no header).
+    warn : bool
+        Warn once, with the reason, if the system cannot conserve the reported quantities.
+
+    ``records`` holds every report as a dict of floats (float64), for programmatic checks.
+    """
+
+    COLUMNS = ("Step", "Time (ps)", "Total Energy (kJ/mol)", "Energy drift (kJ/mol/ns/dof)",
+               "|dP| (amu nm/ps)", "|dL|/|L|", "Constraint error")
+
+    def __init__(self, file, reportInterval: int, about: str = "com", separator: str = ",",
+                 append: bool = False, warn: bool = True):
+        if int(reportInterval) < 1:
+            raise ValueError(f"reportInterval must be a positive number of steps, got {reportInterval!r}")
+        if about not in ("com", "origin"):
+            raise ValueError(f"about must be 'com' or 'origin', got {about!r}")
+        self._interval = int(reportInterval)
+        self._about = about
+        self._sep = separator
+        self._append = append
+        self._warn = warn
+        self._out, self._owns = _open(file, append)
+        self._initialised = False
+        self.records: list = []
+        self.issues: list = []
+
+    # -- the Simulation reporter protocol ------------------------------------------------------
+    def describeNextReport(self, simulation):
+        steps = self._interval - simulation.currentStep % self._interval
+        return {"steps": steps, "periodic": False, "include": ["positions", "velocities", "energy"]}
+
+    def report(self, simulation, state):
+        if not self._initialised:
+            self._initialise(simulation)
+        x = state.getPositions(asNumpy=True).value_in_unit(_NM)
+        v = state.getVelocities(asNumpy=True).value_in_unit(_NM_PS)
+        x, v = np.asarray(x, dtype=np.float64), np.asarray(v, dtype=np.float64)
+        m = self._masses
+        P = momenta.linear_momentum(v, m)
+        L = momenta.angular_momentum(x, v, m, about=self._about)
+        ke = momenta.kinetic_energy(v, m)
+        total = ke + state.getPotentialEnergy().value_in_unit(_KJ)
+        t = state.getTime().value_in_unit(unit.picosecond)
+        step = simulation.currentStep
+        if self._P0 is None:
+            self._P0, self._L0 = P, L
+        self._t.append(t)
+        self._e.append(total)
+        if len(self._t) >= 2 and self._t[-1] > self._t[0]:
+            slope = np.polyfit(np.asarray(self._t) - self._t[0], np.asarray(self._e) - self._e[0], 1)[0]
+            drift = float(slope) * 1000.0 / max(self._dof, 1)  # per ps -> per ns
+        else:
+            drift = float("nan")
+        nL0 = float(np.linalg.norm(self._L0))
+        rec = {"step": step, "time": t, "total_energy": total, "energy_drift": drift,
+               "dP": float(np.linalg.norm(P - self._P0)),
+               "dL_rel": float(np.linalg.norm(L - self._L0) / nL0) if nL0 > 0 else float("nan"),
+               "constraint_error": constraint_violation(x, self._constraints)}
+        self.records.append(rec)
+        vals = [str(step), f"{t:.6g}", f"{total:.10g}", f"{drift:.4g}", f"{rec['dP']:.4g}",
+                f"{rec['dL_rel']:.4g}", f"{rec['constraint_error']:.4g}"]
+        print(self._sep.join(vals), file=self._out)
+        try:
+            self._out.flush()
+        except AttributeError:
+            pass
+
+    # -- helpers ----------------------------------------------------------------------------------
+    def _initialise(self, simulation):
+        self._system = simulation.system
+        self._masses = masses(self._system)
+        self._constraints = constraint_arrays(self._system)
+        self._dof = degrees_of_freedom(self._system)
+        self._P0 = self._L0 = None
+        self._t, self._e = [], []
+        self.issues = conservation_issues(self._system) + integrator_issues(simulation.integrator)
+        if self._warn:
+            warn_conservation(self._system, context="ConservationReporter", stacklevel=4)
+            for key, msg in integrator_issues(simulation.integrator):
+                warn_once(key, f"ConservationReporter: {msg}", stacklevel=4)
+        if not self._append:
+            print("#" + self._sep.join(f'"{c}"' for c in self.COLUMNS), file=self._out)
+        self._initialised = True
+
+    def close(self):
+        if self._owns:
+            self._out.close()
+
+    def __del__(self):
+        try:
+            self.close()
+        except Exception:
+            pass
+
+
+
+class VelocityTRRReporter:
+    """Write positions, velocities, step and time to a GROMACS TRR file (float32, nm and nm/ps).
+
+    MDAnalysis reads it with velocities: ``mda.Universe("top.pdb", "traj.trr")`` (MDAnalysis converts
+    to Angstrom and Angstrom/ps).  ``append=True`` rewrites the existing frames first (the XDR library
+    cannot append in place).  Virtual sites are written like any particle."""
+
+    def __init__(self, file: str, reportInterval: int, append: bool = False, forces: bool = False):
+        from MDAnalysis.lib.formats.libmdaxdr import TRRFile
+
+        if int(reportInterval) < 1:
+            raise ValueError(f"reportInterval must be a positive number of steps, got {reportInterval!r}")
+        self._interval = int(reportInterval)
+        self._forces = forces
+        old = []
+        if append:
+            try:
+                with TRRFile(file, "r") as f:
+                    old = [fr for fr in f]
+            except OSError:
+                old = []
+        self._trr = TRRFile(file, "w")
+        for fr in old:
+            self._trr.write(fr.x if fr.hasx else None, fr.v if fr.hasv else None, fr.f if fr.hasf else None,
+                            fr.box, fr.step, fr.time, fr.lmbda, len(fr.x) if fr.hasx else len(fr.v))
+        self.frames = len(old)
+
+    def describeNextReport(self, simulation):
+        steps = self._interval - simulation.currentStep % self._interval
+        include = ["positions", "velocities"] + (["forces"] if self._forces else [])
+        return {"steps": steps, "periodic": False, "include": include}
+
+    def report(self, simulation, state):
+        x = np.asarray(state.getPositions(asNumpy=True).value_in_unit(_NM), dtype=np.float32)
+        v = np.asarray(state.getVelocities(asNumpy=True).value_in_unit(_NM_PS), dtype=np.float32)
+        f = None
+        if self._forces:
+            f = np.asarray(state.getForces(asNumpy=True).value_in_unit(_KJ / _NM), dtype=np.float32)
+        box = np.zeros((3, 3), dtype=np.float32)
+        if simulation.system.usesPeriodicBoundaryConditions():
+            box = np.asarray(state.getPeriodicBoxVectors(asNumpy=True).value_in_unit(_NM), dtype=np.float32)
+        self._trr.write(x, v, f, box, int(simulation.currentStep), float(state.getTime().value_in_unit(unit.picosecond)),
+                        0.0, len(x))
+        self.frames += 1
+
+    def close(self):
+        if self._trr is not None:
+            self._trr.close()
+            self._trr = None
+
+    def __del__(self):
+        try:
+            self.close()
+        except Exception:
+            pass
+
+
+def write_topology(path: str, topology: app.Topology, positions) -> None:
+    """Write the PDB file that MDAnalysis pairs with a trajectory (``positions`` in nm or a Quantity)."""
+    if not unit.is_quantity(positions):
+        positions = np.asarray(positions) * unit.nanometer
+    with open(path, "w") as fh:
+        app.PDBFile.writeFile(topology, positions, fh, keepIds=True)

@@ -1,0 +1,207 @@
+"""What every integrator of the package shares, whichever backend runs it.
+
+:class:`IntegratorBase` is a mixin placed in front of an ``openmm.Integrator`` class (the CustomIntegrator
+program of :mod:`.custom` or the plugin's SymPRKIntegrator of :mod:`.native`).  It holds, once:
+
+* ``step(n)``: runs the steps and raises :class:`SimulationBlowUpError` naming the first step whose
+  velocities stopped being finite (or exceeded ``max_speed``), the method, the step size and the method's
+  stability limit; the record is cleared when it is reported, so reloading a good state and going on works;
+* ``setStepSize`` with the package's validation, ``describe()``, ``steps_taken``;
+* what the integrator was compiled for (:class:`~openmm_symprk.systems.properties.SystemSignature` of its
+  ``system=``), which each backend checks against the Context it is bound to;
+* copies: ``pickle``, ``copy.copy`` and ``copy.deepcopy`` go through OpenMM's XML serialization (as for
+  OpenMM's own integrators) and give back the same Python class with its conveniences.
+
+Backends implement the hooks ``_blowup_step()``, ``_clear_blowup()``, ``_raw_steps_taken()`` and may
+override ``_before_step()`` / ``_after_step()``.
+"""
+from __future__ import annotations
+
+import math
+import operator
+
+import openmm as mm
+import openmm.unit as unit
+
+from ..methods.catalogue import get_method
+
+__all__ = ["IntegratorBase", "SimulationBlowUpError", "ConvergenceWarning", "SystemMismatchError",
+           "CheckpointMismatchError", "step_size_in_ps", "check_max_speed"]
+
+
+class SimulationBlowUpError(RuntimeError):
+    """The velocities stopped being finite (the step size is beyond the method's stability limit)."""
+
+
+class ConvergenceWarning(RuntimeWarning):
+    """An implicit method's fixed-point iteration hit its iteration cap on some steps."""
+
+
+class SystemMismatchError(ValueError):
+    """The integrator was compiled for another System than the one of the Context it runs."""
+
+
+class CheckpointMismatchError(RuntimeError):
+    """A checkpoint written by another integrator program was loaded into this one."""
+
+
+def step_size_in_ps(step_size) -> float:
+    """Validate a step size: a positive time Quantity, or a positive number taken as picoseconds."""
+    if unit.is_quantity(step_size):
+        if not step_size.unit.is_compatible(unit.picoseconds):
+            raise TypeError(f"step size {step_size} is not a time: give it in time units, e.g. "
+                            f"2*unit.femtoseconds (a plain number is taken as picoseconds)")
+        value = step_size.value_in_unit(unit.picoseconds)
+    else:
+        value = step_size
+    try:
+        value = float(value)
+    except (TypeError, ValueError):
+        raise TypeError(f"step size {step_size!r} is not a time: give e.g. 2*unit.femtoseconds "
+                        f"or a number of picoseconds") from None
+    if not math.isfinite(value) or value <= 0:
+        raise ValueError(f"step size must be positive and finite, got {step_size} "
+                         f"(e.g. 2*unit.femtoseconds or 0.002 ps)")
+    return value
+
+
+def check_max_speed(max_speed) -> float:
+    """``max_speed`` in nm/ps as a float >= 0 (None or 0: only NaN and infinity count as a blow-up)."""
+    if max_speed is None:
+        return 0.0
+    if unit.is_quantity(max_speed):
+        max_speed = max_speed.value_in_unit(unit.nanometer / unit.picosecond)
+    try:
+        value = float(max_speed)
+    except (TypeError, ValueError):
+        raise TypeError(f"max_speed must be a speed in nm/ps (or None), got {max_speed!r}") from None
+    if not math.isfinite(value) or value < 0:
+        raise ValueError(f"max_speed must be a finite speed >= 0 nm/ps (None or 0: only NaN and infinity), "
+                         f"got {max_speed!r}")
+    return value
+
+
+def _restore(cls, xml: str, state: dict):
+    """Rebuild an integrator of ``cls`` from its XML and Python state (pickle, copy, :func:`restore`)."""
+    obj = object.__new__(cls)
+    obj._adopt(mm.XmlSerializer.deserialize(xml))
+    state = dict(state)
+    if isinstance(state.get("method"), str):  # catalogue methods travel by name
+        state["method"] = get_method(state["method"])
+    obj.__dict__.update(state)
+    obj._reset_binding()
+    return obj
+
+
+class IntegratorBase:
+    """Mixin of the package's integrators (see the module docstring)."""
+
+    backend: str = ""
+    method_name: str = "user tableau"
+    method = None  # the catalogue Method, when there is one
+    check_finite: bool = True
+    max_speed: float = 0.0
+    compiled_for = None  # SystemSignature of system=, or None
+
+    # -- the step ---------------------------------------------------------------------------------
+    def step(self, steps):
+        """Advance ``steps`` steps; raise SimulationBlowUpError if the simulation blew up."""
+        try:
+            steps = operator.index(steps)
+        except TypeError:
+            raise TypeError(f"steps must be a whole number of steps, got {steps!r}") from None
+        if steps < 0:
+            raise ValueError(f"steps must be >= 0, got {steps}")
+        self._before_step()
+        try:
+            result = super().step(steps)
+        except mm.OpenMMException as exc:  # CPU/CUDA check coordinates themselves
+            if "nan" not in str(exc).lower():
+                raise
+            self._clear_blowup()
+            raise self._blow_up(self._raw_steps_taken() + 1, "positions became NaN") from exc
+        if self.check_finite:
+            bad = self._blowup_step()
+            if bad:
+                self._clear_blowup()
+                raise self._blow_up(bad, self._blowup_what())
+        self._after_step()
+        return result
+
+    def _before_step(self):
+        """Checks before stepping (a backend's Context checks)."""
+
+    def _after_step(self):
+        """Checks after stepping (a backend's warnings)."""
+
+    def _blowup_what(self) -> str:
+        if self.max_speed:
+            return f"velocities became NaN, infinite or faster than {self.max_speed:g} nm/ps"
+        return "velocities became NaN or infinite"
+
+    def _blow_up(self, step: int, what: str) -> SimulationBlowUpError:
+        return SimulationBlowUpError(
+            f"the simulation blew up at integrator step {step} with method {self.method_name!r} at step size "
+            f"{self.getStepSize()} ({self.backend} backend): {what}. Reduce the step size (largest stable "
+            f"h*omega for this method: {self._stability()}), or minimize the energy first. The Context still "
+            f"holds the non-finite state: reload a checkpoint, or positions and velocities saved before this "
+            f"call, and go on (the blow-up record is cleared).")
+
+    def _stability(self) -> str:
+        try:
+            st = (self.method or get_method(self.method_name)).stability
+        except Exception:
+            return "unknown"
+        return "unbounded" if st is None or math.isinf(st) else f"{st:.4f}"
+
+    # -- OpenMM overrides ---------------------------------------------------------------------------
+    def setStepSize(self, size):
+        return super().setStepSize(step_size_in_ps(size))
+
+    # -- conveniences ------------------------------------------------------------------------------
+    @property
+    def steps_taken(self) -> int:
+        """Steps taken since the integrator was bound (kept in checkpoints)."""
+        return int(self._raw_steps_taken())
+
+    def describe(self) -> str:
+        """The integrator's program: backend, stages, constraint handling, force evaluations per step."""
+        raise NotImplementedError
+
+    # -- copies ---------------------------------------------------------------------------------------
+    def _python_state(self) -> dict:
+        """The Python attributes a copy needs (everything but the C++ object; catalogue methods by name)."""
+        state = {k: v for k, v in self.__dict__.items() if k not in ("this", "thisown")}
+        if state.get("method") is not None:
+            state["method"] = state["method"].name
+        return state
+
+    def _adopt(self, other):
+        """Take over the C++ object of ``other`` (an openmm.Integrator of the same C++ class)."""
+        self.this = other.this
+        other.thisown = False
+        self.thisown = True
+
+    def _reset_binding(self):
+        """Forget per-Context facts (a copy is not bound to any Context)."""
+
+    def __reduce__(self):
+        return _restore, (type(self), mm.XmlSerializer.serialize(self), self._python_state())
+
+    def __copy__(self):
+        return _restore(type(self), mm.XmlSerializer.serialize(self), dict(self._python_state()))
+
+    def __deepcopy__(self, memo):
+        import copy
+
+        return _restore(type(self), mm.XmlSerializer.serialize(self), copy.deepcopy(self._python_state(), memo))
+
+    # -- hooks ------------------------------------------------------------------------------------------
+    def _blowup_step(self) -> int:
+        raise NotImplementedError
+
+    def _clear_blowup(self):
+        raise NotImplementedError
+
+    def _raw_steps_taken(self) -> int:
+        raise NotImplementedError

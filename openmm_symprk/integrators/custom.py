@@ -1,0 +1,248 @@
+"""The CustomIntegrator backend: programs compiled by :mod:`.program`, run by OpenMM's CustomIntegrator.
+
+    from openmm_symprk import PRKIntegrator, PRKTableau
+    integrator = PRKIntegrator(2*unit.femtoseconds, PRKTableau(A, b, A_hat, b_hat), system=system)
+
+:class:`PRKIntegrator` runs any PRK tableau pair, kick/drift splitting or catalogue method;
+:class:`CustomSymplecticIntegrator` is the catalogue-method class that ``SymplecticIntegrator(...,
+backend="custom")`` builds.  Both are plain ``openmm.CustomIntegrator`` s to OpenMM (Simulation, reporters,
+checkpoints, XmlSerializer).  On top of the shared behaviour of :class:`~.base.IntegratorBase` they check,
+at the first step, that the Context has the particle count of their ``system=`` (before anything is read
+out of bounds) and, through the program's probe, that it has constraints only if the program keeps them;
+and before every step that the program's signature (global 0) is still theirs, i.e. that no checkpoint of
+another program was loaded.
+"""
+from __future__ import annotations
+
+import json
+import math
+import warnings
+
+import openmm as mm
+
+from ..methods.catalogue import Method, get_method
+from ..methods.splitting import Splitting
+from ..methods.tableau import PRKTableau, TableauError
+from ..systems.checks import validate_system, warn_once
+from ..systems.properties import masses, signature
+from . import program
+from .base import (CheckpointMismatchError, ConvergenceWarning, IntegratorBase, SystemMismatchError,
+                   check_max_speed, step_size_in_ps)
+from .projection import set_masses
+from .symplectic import SymplecticIntegrator
+
+__all__ = ["PRKIntegrator", "CustomSymplecticIntegrator", "META_PREFIX", "read_metadata", "TimeWarning"]
+
+#: Prefix of the global variable whose name carries the integrator's Python metadata (hex JSON), so that
+#: :func:`openmm_symprk.integrators.restore.restore` can rebuild the class from plain XML.
+META_PREFIX = "symprk_meta_"
+
+
+class TimeWarning(UserWarning):
+    """OpenMM's CustomIntegrator keeps the Context's time on the old step size after setStepSize."""
+
+
+def _is_splitting(tab: PRKTableau) -> bool:
+    try:
+        tab.to_splitting()
+        return True
+    except TableauError:
+        return False
+
+
+def read_metadata(integrator: mm.CustomIntegrator) -> dict | None:
+    """The metadata a program of this package carries in a global variable name, or None."""
+    for i in range(integrator.getNumGlobalVariables()):
+        name = integrator.getGlobalVariableName(i)
+        if name.startswith(META_PREFIX):
+            try:
+                return json.loads(bytes.fromhex(name[len(META_PREFIX):]).decode())
+            except ValueError:
+                return None
+    return None
+
+
+class PRKIntegrator(IntegratorBase, mm.CustomIntegrator):
+    """A CustomIntegrator running any PRK tableau pair, kick/drift splitting or catalogue method.
+
+    Parameters
+    ----------
+    stepSize : time Quantity or float (ps)
+    tableau : PRKTableau, Splitting, catalogue Method, or a catalogue name
+    system : openmm.System, optional
+        The System the integrator will run.  It decides whether RATTLE constraint steps are compiled (without
+        it they are, for splittings: correct for any System and cheap), is checked for anything that breaks
+        conservation (one warning per kind), and is recorded: the first step refuses a Context with another
+        particle count, or with constraints the program cannot keep.
+    constraints : bool, optional
+        Override the constraint decision (``True``/``False``); default: from ``system``.
+    allow_nonsymplectic : bool
+        Accept a tableau that fails Reich's condition (6) (e.g. rk4 as a reference).
+    exact_momentum : bool
+        Project the forces of every kick onto zero net force and torque, so that linear and angular momentum
+        are conserved to double round-off even where forces are summed in single precision.  Needs
+        ``system=`` (it is only right for an isolated System, which is checked, and it uses its masses).
+    check_finite : bool
+        Record the first step whose velocities are not finite; ``step`` raises SimulationBlowUpError.
+    max_speed : float or speed Quantity, optional
+        Also count velocities faster than this (nm/ps) as a blow-up (default: only NaN and infinity).
+    tolerance, max_iterations : implicit methods only: fixed-point tolerance (nm) and iteration cap.
+    """
+
+    backend = "custom"
+
+    def __init__(self, stepSize, tableau, system: mm.System | None = None, constraints: bool | None = None,
+                 allow_nonsymplectic: bool = False, exact_momentum: bool = False, check_finite: bool = True,
+                 max_speed=None, tolerance: float = 1e-12, max_iterations: int = 60, name: str | None = None):
+        dt = step_size_in_ps(stepSize)
+        method = self._resolve(tableau)
+        tab = method.tableau() if isinstance(method, Method) else (
+            PRKTableau.from_splitting(method, name=name) if isinstance(method, Splitting) else method)
+        self.method_name = name or getattr(method, "name", None) or "user tableau"
+        self.method = method if isinstance(method, Method) else None
+        tab.check_symplectic(allow_nonsymplectic)
+        if not (isinstance(tolerance, (int, float)) and tolerance > 0 and math.isfinite(tolerance)):
+            raise ValueError(f"tolerance must be a positive number of nm, got {tolerance!r}")
+        if int(max_iterations) < 1:
+            raise ValueError(f"max_iterations must be at least 1, got {max_iterations!r}")
+        max_speed = check_max_speed(max_speed)
+        if exact_momentum and system is None:
+            raise ValueError("exact_momentum=True needs system= (the System the integrator will run): the projection "
+                             "is only right for an isolated System, which is checked, and it uses the System's masses")
+        splitting = isinstance(method, Splitting) or (isinstance(method, Method) and method.is_splitting) or (
+            isinstance(method, PRKTableau) and _is_splitting(method))
+        if system is not None:
+            validate_system(system, f"{type(self).__name__}({self.method_name})", exact_momentum)
+            sig = signature(system)
+            has_constraints, has_sites = sig.constraints, sig.virtual_sites
+        else:
+            sig, has_sites = None, True
+            has_constraints = splitting  # RATTLE steps are harmless (and cheap) on a System without constraints
+        if constraints is not None:
+            has_constraints = bool(constraints)
+        mm.CustomIntegrator.__init__(self, dt)
+        self.tableau = tab
+        try:
+            self.program_info = program.compile_program(
+                self, method, has_constraints, has_sites, exact_momentum=exact_momentum, check_finite=check_finite,
+                max_speed=max_speed, tolerance=tolerance, max_iterations=int(max_iterations))
+        except program.ConstraintSupportError as exc:
+            raise program.ConstraintSupportError(str(exc).replace("user tableau", self.method_name)) from None
+        self.check_finite = bool(check_finite)
+        self.max_speed = max_speed
+        self.exact_momentum = bool(exact_momentum)
+        self.compiled_for = sig
+        self._masses = masses(system) if (exact_momentum and system is not None) else None
+        self._signature = float(self.program_info.signature)
+        self._reset_binding()
+        meta = {"class": type(self).__name__, "method": self.method_name,
+                "catalogue": self.method.name if self.method is not None else None,
+                "options": {"exact_momentum": self.exact_momentum, "check_finite": self.check_finite,
+                            "max_speed": self.max_speed},
+                "system": None if sig is None else {"n_particles": sig.n_particles, "constraints": sig.constraints,
+                                                    "virtual_sites": sig.virtual_sites,
+                                                    "total_mass": sig.total_mass, "masses_digest": sig.masses_digest}}
+        self.addGlobalVariable(META_PREFIX + json.dumps(meta, separators=(",", ":")).encode().hex(), 0.0)
+
+    @staticmethod
+    def _resolve(tableau):
+        if isinstance(tableau, (PRKTableau, Splitting, Method)):
+            return tableau
+        if isinstance(tableau, str):
+            return get_method(tableau)
+        raise TypeError(f"expected a PRKTableau, Splitting, catalogue method or method name, got {tableau!r}")
+
+    # -- per-Context checks ----------------------------------------------------------------------------
+    def _reset_binding(self):
+        self._checked_context = False
+        self._checked_probe = False
+        self._nonconverged_seen = 0
+
+    def _before_step(self):
+        if not self._checked_context:
+            self._check_context()
+        stored = self.getGlobalVariable(0)
+        if stored != self._signature:
+            raise CheckpointMismatchError(
+                f"{type(self).__name__}({self.method_name}): the Context holds the state of another integrator "
+                f"program (its signature {stored:.0f} is not this program's {self._signature:.0f}): a checkpoint "
+                f"saved with another method, other options (exact_momentum, constraints, max_speed) or the native "
+                f"backend was loaded. Create the integrator as it was when the checkpoint was saved (a native "
+                f"checkpoint needs backend='native'), load the checkpoint into that one, or load a State "
+                f"(positions and velocities) instead.")
+
+    def _check_context(self):
+        """First step on a Context: its particle count against ``system=`` (read from a per-DOF variable the
+        Context sized), then the exact masses for the projection."""
+        n = len(self.getPerDofVariableByName(program.PROBE_PER_DOF))
+        expected = self.compiled_for.n_particles if self.compiled_for is not None else None
+        if n == 1 and expected not in (None, 1):
+            super().step(0)  # raises "not bound to a context" if that is why only one value came back
+        if expected is not None and n != expected:
+            raise SystemMismatchError(
+                f"{type(self).__name__}({self.method_name}) was compiled for a System of {expected} particles, but "
+                f"its Context's System has {n}: create the integrator with system= the System you simulate")
+        if self._masses is not None:
+            set_masses(self, self._masses)
+        self._checked_context = True
+
+    def _after_step(self):
+        if not self._checked_probe:
+            self._checked_probe = True
+            if self.getGlobalVariableByName(program.PROBE_CONSTRAINTS_VAR) > 0 and not self.program_info.constraints:
+                what = ("a general PRK tableau, which cannot keep constraints" if self.program_info.kind != "splitting"
+                        else "a System without constraints (system=, or constraints=False)")
+                raise SystemMismatchError(
+                    f"{type(self).__name__}({self.method_name}) was compiled for {what}, but its Context's System "
+                    f"has constraints: this first step did not keep them. Create the integrator with system= the "
+                    f"System you simulate (a kick/drift method then compiles RATTLE steps).")
+        if self.program_info.kind == "implicit":
+            n = int(self.getGlobalVariableByName(program.NONCONV_VAR))
+            if n > self._nonconverged_seen:
+                warnings.warn(
+                    f"{self.method_name}: the implicit stage iteration reached its cap on {n - self._nonconverged_seen} "
+                    f"step(s) (total {n}); results are less accurate there. Reduce the step size or raise "
+                    f"max_iterations/tolerance.", ConvergenceWarning, stacklevel=3)
+                self._nonconverged_seen = n
+
+    # -- backend hooks -----------------------------------------------------------------------------------
+    def _blowup_step(self) -> int:
+        return int(self.getGlobalVariableByName(program.BAD_VAR))
+
+    def _clear_blowup(self):
+        self.setGlobalVariableByName(program.BAD_VAR, 0.0)
+
+    def _raw_steps_taken(self) -> int:
+        return int(self.getGlobalVariableByName(program.STEP_VAR))
+
+    def setStepSize(self, size):
+        new = step_size_in_ps(size)
+        if self._checked_context and new != self.getStepSize():
+            warn_once("custom-setstepsize-time",
+                      f"{type(self).__name__}: on the Reference and CPU platforms OpenMM's CustomIntegrator keeps "
+                      f"advancing the Context's time by the step size it had when the Context was created (the "
+                      f"dynamics use the new one). Call context.reinitialize(preserveState=True) after setStepSize "
+                      f"to make the time right, or use the native backend.", TimeWarning)
+        return mm.CustomIntegrator.setStepSize(self, new)
+
+    def describe(self) -> str:
+        info = self.program_info
+        lines = [f"{type(self).__name__}: {self.method_name}, step {self.getStepSize()}, CustomIntegrator backend",
+                 f"  program: {info.kind}, {info.stages} {'kicks and drifts' if info.kind == 'splitting' else 'stages'}, "
+                 f"constraints={'RATTLE' if info.constraints else 'none'}, force evaluations per step: "
+                 f"{info.force_evals}, exact momentum: {info.exact_momentum}",
+                 f"  {self.tableau.summary()}" if self.tableau is not None else "  (tableau not restored)"]
+        lines += [f"  {n}" for n in info.notes]
+        return "\n".join(lines)
+
+
+class CustomSymplecticIntegrator(SymplecticIntegrator, PRKIntegrator, backend="custom"):
+    """A catalogue method on the CustomIntegrator backend: what ``SymplecticIntegrator(..., backend="custom")``
+    builds, and what ``backend="auto"`` builds for implicit and general tableaux.  Parameters: those of
+    :class:`~openmm_symprk.integrators.symplectic.SymplecticIntegrator` and :class:`PRKIntegrator`."""
+
+    def __init__(self, stepSize, method="verlet", system: mm.System | None = None, backend: str = "custom",
+                 **options):
+        self._check_backend(backend)
+        m = get_method(method)
+        PRKIntegrator.__init__(self, stepSize, m, system=system, name=m.name, **options)

@@ -1,0 +1,329 @@
+"""Compile a catalogue method, splitting or PRK tableau into an openmm.CustomIntegrator program.
+
+One compiler for everything (docs/openmm_notes.md explains each rule):
+
+* Every program starts with the same header: ``symprk_signature`` (global 0, a hash of the whole
+  program: a checkpoint restores globals by position, so global 0 tells whose checkpoint was loaded),
+  the step counter, the blow-up record, and a one-time probe of the Context (run in the first step:
+  whether its System has constraints, by projecting the velocity field v = x with ConstrainVelocities).
+* Splittings and compositions: kick ``v = v + b*dt*f/m``, drift ``x = x + a*dt*v``.  Adjacent pieces
+  are already merged by :class:`~openmm_symprk.methods.splitting.Splitting`; the forces of a closing kick
+  stay cached and serve the next step's opening kick, so a step costs exactly
+  ``Splitting.force_evaluations()`` evaluations in steady state.
+* Constraints (RATTLE): after every drift ``ConstrainPositions`` and ``v += (x - x_unconstrained)/(a*dt)``,
+  nothing references forces between a drift and its ConstrainPositions, and velocities are projected
+  once at the end of the step.  The velocity projections RATTLE makes after inner kicks are absorbed
+  exactly by the next drift's position projection, whose multipliers act along the same bond vectors,
+  so they are omitted (each one would cost a constraint solve).  The same steps are emitted for a System
+  with virtual sites and no constraints: OpenMM's Common platforms place virtual sites only inside
+  ConstrainPositions.
+* General tableaux (explicit non-splitting, implicit) for unconstrained systems: stage values live in
+  per-DOF variables; implicit stages are solved by fixed-point iteration in a single while block.
+* Optional exact momentum (:mod:`.projection`): projected kicks, and the round-off net momentum and
+  torque of every constraint projection removed (after each RATTLE drift and after the end-of-step
+  velocity projection), with the System's masses in double.
+* The blow-up check: the first step at which some velocity is NaN or infinite (or faster than a given
+  speed) is kept in a global variable.
+"""
+from __future__ import annotations
+
+import hashlib
+from dataclasses import dataclass, field
+
+import numpy as np
+import openmm as mm
+
+from ..methods.splitting import DRIFT, KICK, Splitting
+from ..methods.tableau import PRKTableau, TableauError
+
+#: Global variables every compiled program has, in this order (read by the integrator classes).
+SIGNATURE_VAR = "symprk_signature"
+STEP_VAR = "symprk_step"
+BAD_VAR = "symprk_blowup_step"
+PROBED_VAR = "symprk_probed"
+PROBE_CONSTRAINTS_VAR = "symprk_probe_constraints"
+#: A per-DOF variable the program never sets from Python: its length after binding is the Context's
+#: particle count.
+PROBE_PER_DOF = "symprk_probe"
+NONCONV_VAR = "symprk_nonconverged"
+ITER_VAR = "symprk_iterations"
+#: Squared speed limit used when only NaN and infinity count as a blow-up (inf in single precision too).
+NONFINITE_LIMIT2 = "1e300"
+
+
+class ConstraintSupportError(ValueError):
+    """The method cannot be used on a system with constraints."""
+
+
+@dataclass
+class ProgramInfo:
+    """What the compiler emitted: used by tests, the CLI and the integrator classes."""
+
+    kind: str  # "splitting", "explicit" or "implicit"
+    constraints: bool  # RATTLE constraint steps emitted
+    force_evals: int | None  # per step in steady state (implicit: per fixed-point iteration)
+    stages: int
+    exact_momentum: bool
+    notes: list = field(default_factory=list)
+    signature: int = 0  # the value of global 0 (see the module docstring)
+
+
+def program_signature(integrator: mm.CustomIntegrator) -> int:
+    """A 52-bit hash of the program (every computation and variable name), exact as a float64."""
+    h = hashlib.sha1()
+    for i in range(integrator.getNumComputations()):
+        kind, var, expr = integrator.getComputationStep(i)
+        h.update(f"{kind}|{var}|{expr};".encode())
+    for i in range(integrator.getNumGlobalVariables()):
+        h.update(f"g:{integrator.getGlobalVariableName(i)};".encode())
+    for i in range(integrator.getNumPerDofVariables()):
+        h.update(f"d:{integrator.getPerDofVariableName(i)};".encode())
+    return int.from_bytes(h.digest()[:8], "big") >> 12
+
+
+def _num(c) -> str:
+    """A coefficient as an expression literal that round-trips a float64 exactly."""
+    return repr(float(c))
+
+
+class _Emitter:
+    """Appends computations to a CustomIntegrator, with the shared header, kick and drift rules."""
+
+    def __init__(self, integrator: mm.CustomIntegrator, constraints: bool, exact_momentum: bool,
+                 update_context_state: bool = True):
+        if integrator.getNumComputations() or integrator.getNumGlobalVariables() or integrator.getNumPerDofVariables():
+            raise ValueError("compile into an empty CustomIntegrator: this one already has a program")
+        self.ig = integrator
+        self.constraints = constraints
+        self.exact_momentum = exact_momentum
+        self._vars: set = set()
+        for name in (SIGNATURE_VAR, STEP_VAR, BAD_VAR, PROBED_VAR, PROBE_CONSTRAINTS_VAR):
+            self.glob(name)
+        self.per_dof(PROBE_PER_DOF)
+        if exact_momentum:
+            from .projection import add_projection_variables
+
+            add_projection_variables(integrator)
+        if update_context_state:
+            integrator.addUpdateContextState()
+        self._probe()
+
+    def _probe(self):
+        """Once per Context (first step): does its System have constraints?  ConstrainVelocities changes the
+        velocity field v = x exactly when some constraint exists (the relative velocity of a constrained pair
+        along its bond is then |r|^2 > 0).  Massless particles are left out of the sum."""
+        ig = self.ig
+        ig.beginIfBlock(f"{PROBED_VAR} < 0.5")
+        ig.addComputePerDof(PROBE_PER_DOF, "v")
+        ig.addComputePerDof("v", "x")
+        ig.addConstrainVelocities()
+        ig.addComputeSum(PROBE_CONSTRAINTS_VAR, "select(m, (v - x)^2, 0)")
+        ig.addComputePerDof("v", PROBE_PER_DOF)
+        ig.addComputeGlobal(PROBED_VAR, "1")
+        ig.endBlock()
+
+    def per_dof(self, name: str):
+        if name not in self._vars:
+            self.ig.addPerDofVariable(name, 0.0)
+            self._vars.add(name)
+
+    def glob(self, name: str, value: float = 0.0):
+        if name not in self._vars:
+            self.ig.addGlobalVariable(name, value)
+            self._vars.add(name)
+
+    def acceleration(self, target: str) -> str:
+        """Store the (optionally momentum-projected) acceleration F/m in per-DOF ``target``."""
+        self.per_dof(target)
+        if self.exact_momentum:
+            from .projection import emit_projected_acceleration
+
+            emit_projected_acceleration(self.ig, target)
+        else:
+            self.ig.addComputePerDof(target, "f/m")
+        return target
+
+    def kick(self, c):
+        if self.exact_momentum:
+            a = self.acceleration("symprk_a")
+            self.ig.addComputePerDof("v", f"v + {_num(c)}*dt*{a}")
+        else:
+            self.ig.addComputePerDof("v", f"v + {_num(c)}*dt*f/m")
+
+    def drift(self, c):
+        self.ig.addComputePerDof("x", f"x + {_num(c)}*dt*v")
+        if self.constraints:
+            self.per_dof("symprk_xu")
+            self.ig.addComputePerDof("symprk_xu", "x")
+            self.ig.addConstrainPositions()
+            self.ig.addComputePerDof("v", f"v + (x - symprk_xu)/({_num(c)}*dt)")
+            if self.exact_momentum:
+                from .projection import emit_drift_restoration
+
+                emit_drift_restoration(self.ig, "symprk_xu", f"{_num(c)}*dt")
+
+    def finish(self, check_finite: bool, max_speed: float = 0.0) -> int:
+        """End the step (velocity projection, counter, blow-up check); set and return the signature."""
+        if self.constraints and self.exact_momentum:
+            from .projection import emit_constrain_velocities
+
+            emit_constrain_velocities(self.ig)
+        elif self.constraints:
+            self.ig.addConstrainVelocities()
+        self.ig.addComputeGlobal(STEP_VAR, f"{STEP_VAR} + 1")
+        if check_finite:
+            # Count the degrees of freedom whose speed is NaN (every comparison with NaN is false, so
+            # step(NaN) = 0), infinite or beyond max_speed, and record the first step where any is found.
+            # (Lepton would simplify a NaN self-test s - s to 0.)
+            limit2 = repr(float(max_speed) ** 2) if max_speed else NONFINITE_LIMIT2
+            self.glob("symprk_bad_dofs")
+            self.ig.addComputeSum("symprk_bad_dofs", f"1 - step({limit2} - v*v)")
+            self.ig.addComputeGlobal(
+                BAD_VAR, f"select({BAD_VAR}, {BAD_VAR}, step(symprk_bad_dofs - 0.5)*{STEP_VAR})")
+        signature = program_signature(self.ig)
+        self.ig.setGlobalVariableByName(SIGNATURE_VAR, float(signature))
+        return signature
+
+
+def compile_splitting(integrator, splitting: Splitting, constraints: bool, exact_momentum=False,
+                      check_finite=True, update_context_state=True, max_speed=0.0) -> ProgramInfo:
+    """Emit the program of a kick/drift sequence (RATTLE when ``constraints``)."""
+    em = _Emitter(integrator, constraints, exact_momentum, update_context_state)
+    for label, c in splitting.coefficients(np.float64):
+        if label == KICK:
+            em.kick(c)
+        elif label == DRIFT:
+            em.drift(c)
+        else:
+            raise TableauError(f"a kick/drift splitting cannot contain a {label!r} sub-flow")
+    sig = em.finish(check_finite, max_speed)
+    return ProgramInfo("splitting", constraints, splitting.force_evaluations(), len(splitting), exact_momentum,
+                       signature=sig)
+
+
+def _lincomb(base: str, coeffs, names) -> str:
+    terms = [f"{_num(a)}*{n}" for a, n in zip(coeffs, names) if a != 0]
+    if not terms:
+        return base
+    return f"{base} + dt*({' + '.join(terms)})"
+
+
+def compile_tableau(integrator, tab: PRKTableau, exact_momentum=False, check_finite=True,
+                    update_context_state=True, tolerance=1e-12, max_iterations=60, max_speed=0.0,
+                    place_virtual_sites=False) -> ProgramInfo:
+    """Emit the program of a general PRK pair (unconstrained systems only).
+
+    Per-DOF variables: symprk_x0/v0 (start of step), symprk_k<i> (stage accelerations F(Q_i)/m),
+    symprk_p<i> (stage velocities P_i), symprk_q<i> (implicit stage positions).  ``place_virtual_sites``
+    ends the step with a ConstrainPositions (which only places virtual sites in an unconstrained System)."""
+    em = _Emitter(integrator, False, exact_momentum, update_context_state)
+    s = tab.stages
+    A, Ah, b, bh = (np.asarray(m, dtype=np.float64) for m in (tab.A, tab.A_hat, tab.b, tab.b_hat))
+    for v in ("symprk_x0", "symprk_v0"):
+        em.per_dof(v)
+    integrator.addComputePerDof("symprk_x0", "x")
+    integrator.addComputePerDof("symprk_v0", "v")
+    k = [f"symprk_k{i}" for i in range(s)]
+    p = [f"symprk_p{i}" for i in range(s)]
+    for n in k + p:
+        em.per_dof(n)
+    order = tab.explicit_order
+    notes = []
+    need_k = [bool(np.any(Ah[:, i]) or bh[i]) for i in range(s)]
+    if order is not None:
+        x_is_start = True  # x currently holds x_n (forces at x_n may still be cached)
+        for i in range(s):
+            if order == "p-first":
+                integrator.addComputePerDof(p[i], _lincomb("symprk_v0", Ah[i, :i], k[:i]))
+                rowA, names = A[i, :i + 1], p[:i + 1]
+            else:
+                rowA, names = A[i, :i], p[:i]
+            if np.any(rowA):
+                integrator.addComputePerDof("x", _lincomb("symprk_x0", rowA, names))
+                x_is_start = False
+            elif not x_is_start:
+                integrator.addComputePerDof("x", "symprk_x0")
+                x_is_start = True
+            if need_k[i]:
+                em.acceleration(k[i])
+            if order == "q-first":
+                integrator.addComputePerDof(p[i], _lincomb("symprk_v0", Ah[i, :i + 1], k[:i + 1]))
+        kind = "explicit"
+        evals = int(sum(need_k))
+    else:
+        q = [f"symprk_q{i}" for i in range(s)]
+        for n in q:
+            em.per_dof(n)
+        em.per_dof("symprk_qn")
+        for g in (ITER_VAR, "symprk_err", "symprk_dq", "symprk_go", NONCONV_VAR):
+            em.glob(g)
+        c = A.sum(axis=1)
+        for i in range(s):  # predictor: Q_i = x_n + c_i h v_n
+            integrator.addComputePerDof(q[i], f"symprk_x0 + {_num(c[i])}*dt*symprk_v0")
+        integrator.addComputeGlobal(ITER_VAR, "0")
+        integrator.addComputeGlobal("symprk_go", "1")
+        integrator.beginWhileBlock("symprk_go > 0.5")
+        for i in range(s):
+            integrator.addComputePerDof("x", q[i])
+            em.acceleration(k[i])
+        for i in range(s):
+            integrator.addComputePerDof(p[i], _lincomb("symprk_v0", Ah[i], k))
+        integrator.addComputeGlobal("symprk_err", "0")
+        for i in range(s):
+            integrator.addComputePerDof("symprk_qn", _lincomb("symprk_x0", A[i], p))
+            integrator.addComputeSum("symprk_dq", f"(symprk_qn - {q[i]})^2")
+            integrator.addComputeGlobal("symprk_err", "max(symprk_err, symprk_dq)")
+            integrator.addComputePerDof(q[i], "symprk_qn")
+        integrator.addComputeGlobal(ITER_VAR, f"{ITER_VAR} + 1")
+        # continue while the largest squared change exceeds tol^2 and the cap is not reached
+        integrator.addComputeGlobal(
+            "symprk_go", f"step(symprk_err - {_num(tolerance ** 2)})*step({max_iterations} - 0.5 - {ITER_VAR})")
+        integrator.endBlock()
+        integrator.addComputeGlobal(
+            NONCONV_VAR, f"{NONCONV_VAR} + step(symprk_err - {_num(tolerance ** 2)})")
+        kind = "implicit"
+        evals = s
+        notes.append(f"implicit stages: fixed-point iteration to {tolerance:g} nm (sum over all degrees of "
+                     f"freedom of the squared change), at most {max_iterations} iterations; "
+                     f"{s} force evaluations per iteration")
+    integrator.addComputePerDof("x", _lincomb("symprk_x0", b, p))
+    integrator.addComputePerDof("v", _lincomb("symprk_v0", bh, k))
+    if place_virtual_sites:
+        integrator.addConstrainPositions()
+    sig = em.finish(check_finite, max_speed)
+    return ProgramInfo(kind, False, evals, s, exact_momentum, notes, signature=sig)
+
+
+def compile_program(integrator, method, constraints: bool, virtual_sites: bool = False, **options) -> ProgramInfo:
+    """Compile a catalogue Method, a Splitting or a PRKTableau into ``integrator``'s program.
+
+    ``constraints``: the System has constraints (RATTLE steps; compositions are taken over the RATTLE base;
+    general tableaux are refused).  ``virtual_sites``: it has virtual sites (splittings get the RATTLE steps,
+    whose ConstrainPositions places them; general tableaux end the step with one)."""
+    from ..methods.catalogue import Method
+
+    if isinstance(method, Method):
+        name = method.name
+        if method.is_splitting:
+            method = method.constrained_splitting if constraints else method.splitting
+        else:
+            method = method.tableau()
+    else:
+        name = getattr(method, "name", "user tableau")
+    if isinstance(method, PRKTableau):
+        try:
+            method = method.to_splitting()
+        except TableauError:
+            pass
+    common = ("exact_momentum", "check_finite", "update_context_state", "max_speed")
+    if isinstance(method, Splitting):
+        keep = {k: v for k, v in options.items() if k in common}
+        return compile_splitting(integrator, method, constraints or virtual_sites, **keep)
+    if constraints:
+        raise ConstraintSupportError(
+            f"method {name!r} is a general (non-splitting) PRK tableau and cannot keep constraints: the "
+            f"system has constraints (rigid water, HBonds, ...). Use a kick/drift method instead, e.g. "
+            f"'verlet' (RATTLE), 'yoshida-4' or 'blanes-moan-srkn6b-4', or create the system with "
+            f"constraints=None and rigidWater=False.")
+    keep = {k: v for k, v in options.items() if k in common + ("tolerance", "max_iterations")}
+    return compile_tableau(integrator, method, place_virtual_sites=virtual_sites, **keep)

@@ -1,0 +1,9 @@
+"""Shared physics on plain arrays (nm, ps, Da; pure numpy, no OpenMM): one definition of each quantity.
+
+:mod:`.momenta` -- centre of mass, linear momentum, angular momentum and inertia tensor *about a stated
+point* (there is no default: "com" and "origin" give different numbers, and both are conserved in an
+isolated system).  Massless particles (virtual sites) carry no momentum and drop out of every sum.
+"""
+from .momenta import angular_momentum, centre_of_mass, inertia_tensor, kinetic_energy, linear_momentum
+
+__all__ = ["angular_momentum", "centre_of_mass", "inertia_tensor", "kinetic_energy", "linear_momentum"]

@@ -1,0 +1,318 @@
+"""The bench's scene registry: each scene models no more than the question it answers.
+
+A :class:`BenchScene` is a System plus one shared initial state (positions and velocities, nm and
+nm/ps) and what the bench may measure on it: which quantities are invariants, whether an exact solution
+exists, whether it is for accuracy or for speed only.  Scenes are built once per sweep, saved in the
+output folder and shipped to the workers as a :meth:`BenchScene.payload`, so every run of a sweep (and
+of a resumed sweep) starts from bit-identical coordinates.
+
+``SCENES`` maps the registry names to their builders; each builder's docstring says why its model is
+enough for its question and no more.  :func:`user_scene` wraps a System of your own.
+"""
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import warnings
+from dataclasses import dataclass, field
+
+import numpy as np
+import openmm as mm
+import openmm.app as app
+import openmm.unit as unit
+
+from ...systems.prepare import maxwell_boltzmann, minimise
+from ...systems.properties import constraint_arrays, degrees_of_freedom, masses
+from . import toys
+
+#: Every invariant an isolated system has.
+ALL_INVARIANTS = ("energy", "momentum", "angular_momentum")
+
+
+@dataclass
+class BenchScene:
+    name: str
+    system: mm.System
+    positions: np.ndarray
+    velocities: np.ndarray
+    description: str
+    purpose: str = "accuracy"  # "accuracy": errors and stability; "speed": wall time only
+    platform: str = "Reference"
+    invariants: tuple = ALL_INVARIANTS
+    temperature: float = 300.0  # K, for the Langevin comparison row
+    exact: dict | None = None  # toy metadata: errors are taken against toys.exact_state
+    linear: dict | None = None  # {"omega_max": w}: the harmonic toy, stability decided exactly
+    why: str = ""
+    meta: dict = field(default_factory=dict)
+
+    # -- derived ---------------------------------------------------------------------------
+    @property
+    def n_atoms(self) -> int:
+        return self.system.getNumParticles()
+
+    @property
+    def n_dof(self) -> int:
+        return degrees_of_freedom(self.system)
+
+    def masses(self) -> np.ndarray:
+        if "_masses" not in self.__dict__:
+            self.__dict__["_masses"] = masses(self.system)
+        return self.__dict__["_masses"]
+
+    def constraints(self):
+        """(i, j, d) arrays of the distance constraints."""
+        return constraint_arrays(self.system)
+
+    # -- transport -------------------------------------------------------------------------
+    def payload(self) -> dict:
+        """Everything a worker needs, as picklable plain data (the System as XML)."""
+        xml = mm.XmlSerializer.serialize(self.system)
+        info = {k: getattr(self, k) for k in ("name", "description", "purpose", "platform", "temperature",
+                                              "exact", "linear", "why", "meta")}
+        info["invariants"] = list(self.invariants)
+        pos = np.ascontiguousarray(self.positions, dtype=np.float64)
+        vel = np.ascontiguousarray(self.velocities, dtype=np.float64)
+        h = hashlib.sha1(xml.encode())
+        h.update(pos.tobytes())
+        h.update(vel.tobytes())
+        h.update(json.dumps(_plain(info), sort_keys=True).encode())
+        return {"xml": xml, "positions": pos, "velocities": vel, "info": info, "fingerprint": h.hexdigest()[:16]}
+
+    @classmethod
+    def from_payload(cls, payload: dict) -> "BenchScene":
+        info = dict(payload["info"])
+        info["invariants"] = tuple(info["invariants"])
+        system = mm.XmlSerializer.deserialize(payload["xml"])
+        return cls(system=system, positions=np.asarray(payload["positions"]),
+                   velocities=np.asarray(payload["velocities"]), **info)
+
+    def save(self, folder: str) -> str:
+        """Write the payload as <folder>/<name>.xml + .npz + .json; returns the JSON path."""
+        os.makedirs(folder, exist_ok=True)
+        p = self.payload()
+        base = os.path.join(folder, self.name)
+        _atomic_write(base + ".xml", p["xml"])
+        tmp = base + ".tmp.npz"
+        np.savez(tmp, positions=p["positions"], velocities=p["velocities"])
+        os.replace(tmp, base + ".npz")
+        _atomic_write(base + ".json", json.dumps({"info": _plain(p["info"]), "fingerprint": p["fingerprint"]},
+                                                 indent=1))
+        return base + ".json"
+
+    @classmethod
+    def load(cls, folder: str, name: str) -> "BenchScene":
+        base = os.path.join(folder, name)
+        with open(base + ".json") as fh:
+            meta = json.load(fh)
+        with open(base + ".xml") as fh:
+            xml = fh.read()
+        arrays = np.load(base + ".npz")
+        return cls.from_payload({"xml": xml, "positions": arrays["positions"], "velocities": arrays["velocities"],
+                                 "info": meta["info"]})
+
+
+def _plain(obj):
+    """JSON-ready copy (numpy arrays to lists)."""
+    if isinstance(obj, dict):
+        return {k: _plain(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_plain(v) for v in obj]
+    if isinstance(obj, np.ndarray):
+        return obj.tolist()
+    if isinstance(obj, np.generic):
+        return obj.item()
+    return obj
+
+
+def _atomic_write(path: str, text: str):
+    tmp = path + ".tmp"
+    with open(tmp, "w") as fh:
+        fh.write(text)
+    os.replace(tmp, path)
+
+
+def _why(fn) -> str:
+    return " ".join((fn.__doc__ or "").split())
+
+
+# -- the analytic toys ---------------------------------------------------------------------------
+def harmonic(n: int = 256, omega_max: float = toys.OMEGA_OH, seed: int = 11) -> BenchScene:
+    """Independent harmonic oscillators, frequencies spread evenly up to an O-H stretch (700/ps).
+
+    Linear forces have an exact solution, so every error is the integrator's own; a spectrum reaching
+    down to zero is enough to turn "largest stable step" into the linear stability interval (stable for
+    every h*omega up to the limit), and nothing else is needed for that question.  External wells:
+    energy and angular momentum about the origin are invariants, linear momentum is not."""
+    omega = toys.harmonic_frequencies(n, omega_max)
+    x0, v0 = toys.harmonic_initial_state(omega, seed)
+    return BenchScene("harmonic", toys.harmonic_system(omega), x0, v0,
+                      f"{n} harmonic oscillators, omega up to {omega_max:g}/ps (exact solution)",
+                      invariants=("energy", "angular_momentum"),
+                      exact={"toy": "harmonic", "omega": omega, "x0": x0, "v0": v0},
+                      linear={"omega_max": float(omega_max)}, why=_why(harmonic))
+
+
+def anharmonic(n: int = 64, seed: int = 13) -> BenchScene:
+    """Independent hardening Duffing oscillators (quartic term as large as the quadratic one).
+
+    Nonlinear forces reach the order conditions that a harmonic force cannot see (on q'' = -q every
+    consistent splitting of a given symmetric structure looks alike), and the cn-function solution keeps
+    the answer exact.  Separable quartic wells: energy is the only invariant."""
+    a, b, amp = toys.duffing_parameters(n)
+    x0, v0, u0 = toys.duffing_initial_state(a, b, amp, seed)
+    return BenchScene("anharmonic", toys.duffing_system(a, b), x0, v0,
+                      f"{n} Duffing oscillators (x 3 axes), frequencies up to ~700/ps (exact solution)",
+                      invariants=("energy",), exact={"toy": "duffing", "a": a, "b": b, "amp": amp, "u0": u0},
+                      why=_why(anharmonic))
+
+
+# -- molecular scenes (built from the core scenes) -----------------------------------------------
+def _from_core(scene, name, why, **kw) -> BenchScene:
+    return BenchScene(name, scene.system, np.array(scene.positions), np.array(scene.velocities), scene.description,
+                      why=why, **kw)
+
+
+def water_rigid(n_waters: int = 64) -> BenchScene:
+    """A spinning cluster of rigid TIP3P waters in vacuum (SETTLE, no cutoff, no CMMotionRemover).
+
+    Rigid water is the common production model; with SETTLE the fastest motion left is libration, so
+    this is where 2-4 fs steps are used.  In vacuum, without a box, energy, linear momentum and angular
+    momentum are all invariants; a cluster of 64 molecules has a liquid-like local structure and costs
+    little on the Reference platform."""
+    from ...systems.scenes import water_cluster
+
+    return _from_core(water_cluster(n_waters, rigid=True), "water-rigid", _why(water_rigid))
+
+
+def water_flexible(n_waters: int = 64) -> BenchScene:
+    """The same cluster with flexible waters (harmonic O-H bonds and H-O-H angle, no constraints).
+
+    The O-H stretch (period about 9 fs) is the fastest motion in biomolecular MD: this is where large
+    steps fail and where the stability of a method per force evaluation decides what step it can take."""
+    from ...systems.scenes import water_cluster
+
+    return _from_core(water_cluster(n_waters, rigid=False), "water-flexible", _why(water_flexible))
+
+
+def villin() -> BenchScene:
+    """The villin headpiece (OpenMM's bundled test.pdb) in vacuum, amber14, HBonds constraints (CCMA).
+
+    A real protein: torsions, 1-4 terms and a few hundred constraints solved iteratively (CCMA at
+    tolerance 1e-10), the case where compositions keep their order under constraints and other
+    splittings drop to order 2.  Vacuum and no cutoff keep every invariant and the cost at a few ms per
+    force evaluation on the Reference platform; solvent would only add cost here."""
+    from ...systems.scenes import protein_vacuum
+
+    return _from_core(protein_vacuum(), "villin", _why(villin))
+
+
+def water_box_pme(box_nm: float = 3.9, seed: int = 17) -> BenchScene:
+    """A periodic box of rigid TIP3P water (~5800 atoms), PME, 0.9 nm cutoff: speed only.
+
+    This is the shape of a production run, so it is what the wall-time ratios to VerletIntegrator are
+    measured on (CPU platform).  Periodic boxes break rotational symmetry and the PME grid makes the
+    energy approximate, so no accuracy or stability figure is taken here: the other scenes answer those."""
+    ff = app.ForceField("amber14-all.xml", "amber14/tip3p.xml")
+    mod = app.Modeller(app.Topology(), [])
+    mod.addSolvent(ff, model="tip3p", boxSize=mm.Vec3(box_nm, box_nm, box_nm) * unit.nanometer)
+    system = ff.createSystem(mod.topology, nonbondedMethod=app.PME, nonbondedCutoff=0.9 * unit.nanometer,
+                             constraints=app.HBonds, rigidWater=True, removeCMMotion=False)
+    pos = minimise(system, mod.positions, "CPU", tolerance=10.0, max_iterations=100)
+    vel = maxwell_boltzmann(system, pos, 300.0, seed)
+    return BenchScene("water-box-pme", system, pos, vel,
+                      f"periodic TIP3P box, {system.getNumParticles()} atoms, PME (speed only)",
+                      purpose="speed", platform="CPU", invariants=("energy", "momentum"), why=_why(water_box_pme))
+
+
+#: Registry: name -> builder.  Default sweeps use all of them.
+SCENES = {
+    "harmonic": harmonic,
+    "anharmonic": anharmonic,
+    "water-rigid": water_rigid,
+    "water-flexible": water_flexible,
+    "villin": villin,
+    "water-box-pme": water_box_pme,
+}
+
+
+def build(name: str, **params) -> BenchScene:
+    try:
+        builder = SCENES[name]
+    except KeyError:
+        raise ValueError(f"unknown bench scene {name!r}; known: {', '.join(SCENES)} "
+                         f"(or pass your own System with --system-xml/--pdb)") from None
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return builder(**params)
+
+
+# -- helpers and user scenes ---------------------------------------------------------------------
+def _invariants_of(system) -> tuple:
+    from ...systems.checks import conservation_issues
+
+    keys = {k for k, _ in conservation_issues(system)}
+    inv = []
+    if not keys - {"periodic", "cmmotionremover"}:
+        inv.append("energy")
+    if not keys - {"periodic"}:
+        inv.append("momentum")
+    if not keys:
+        inv.append("angular_momentum")
+    return tuple(inv)
+
+
+def user_scene(name: str = "user", system_xml: str | None = None, state: str | None = None,
+               pdb: str | None = None, forcefields=(), temperature: float = 300.0, seed: int = 23,
+               platform: str | None = None, minimize: bool = True) -> BenchScene:
+    """Your own system: a serialized System XML with positions (PDB or serialized State XML), or a PDB
+    plus force-field file names (e.g. ``amber14-all.xml amber14/tip3pfb.xml``).
+
+    PDB + force fields are built with no cutoff in vacuum and PME with a box, HBonds constraints and no
+    CMMotionRemover.  Velocities come from the State XML if it has them, else Maxwell-Boltzmann at
+    ``temperature`` (seeded).  Which invariants are reported follows the System (periodic boxes, motion
+    removers and thermostats remove them); the default platform is Reference without a box, CPU with one."""
+    velocities = None
+    if system_xml:
+        with open(system_xml) as fh:
+            system = mm.XmlSerializer.deserialize(fh.read())
+        if state and state.endswith(".xml"):
+            with open(state) as fh:
+                st = mm.XmlSerializer.deserialize(fh.read())
+            positions = np.array(st.getPositions(asNumpy=True).value_in_unit(unit.nanometer))
+            try:
+                velocities = np.array(st.getVelocities(asNumpy=True).value_in_unit(unit.nanometer / unit.picosecond))
+                if not np.any(velocities):
+                    velocities = None
+            except Exception:
+                velocities = None
+        elif state or pdb:
+            positions = np.array(app.PDBFile(state or pdb).getPositions(asNumpy=True).value_in_unit(unit.nanometer))
+        else:
+            raise ValueError("a System XML needs positions: pass a PDB file or a serialized State XML")
+        minimize = minimize and velocities is None
+    elif pdb:
+        if not forcefields:
+            raise ValueError("a PDB file needs force-field names (e.g. amber14-all.xml amber14/tip3pfb.xml) "
+                             "or a serialized System XML")
+        pdbfile = app.PDBFile(pdb)
+        ff = app.ForceField(*forcefields)
+        periodic = pdbfile.topology.getPeriodicBoxVectors() is not None
+        system = ff.createSystem(pdbfile.topology, nonbondedMethod=app.PME if periodic else app.NoCutoff,
+                                 constraints=app.HBonds, removeCMMotion=False)
+        positions = np.array(pdbfile.getPositions(asNumpy=True).value_in_unit(unit.nanometer))
+    else:
+        raise ValueError("a user scene needs --system-xml (with --state or --pdb) or --pdb with --forcefield")
+    if system.getNumParticles() != len(positions):
+        raise ValueError(f"the System has {system.getNumParticles()} particles but the positions have "
+                         f"{len(positions)}")
+    periodic = system.usesPeriodicBoundaryConditions()
+    platform = platform or ("CPU" if periodic else "Reference")
+    if minimize:
+        positions = minimise(system, positions, platform)
+    if velocities is None:
+        velocities = maxwell_boltzmann(system, positions, temperature, seed)
+    return BenchScene(name, system, positions, velocities,
+                      f"user system ({system.getNumParticles()} atoms, {system.getNumConstraints()} constraints"
+                      f"{', periodic' if periodic else ''})", platform=platform, invariants=_invariants_of(system),
+                      temperature=temperature, why="Supplied by the user.")

@@ -1,0 +1,318 @@
+"""One run of the bench: one method at one step size on one scene, from the scene's shared state.
+
+:class:`RunSpec` names the run; :func:`execute` turns (spec, scene payload) into a plain-dict record and
+never raises for a failing integrator (blow-up, NaN, unsupported method, OpenMM error): the failure is
+the record.  What a record holds (units nm, ps, Da, kJ/mol):
+
+* ``energy_error``: max |E - E0| over the samples; ``energy_error_per_dof`` divides it by the degrees of
+  freedom; ``drift_per_ns_per_dof``: slope of a least-squares line through E(t) - E0, per ns, per DOF.
+* ``dP``: max |P - P0|; ``dL_rel``: max |L - L0| / |L0| (about the origin) -- only where the scene has
+  that invariant (None otherwise).
+* ``constraint_error``: max relative bond-length error max |r - d| / d.
+* ``traj_error``: RMS position error (nm) at the final time against the exact solution (toys); for the
+  molecular scenes the sweep fills it in against the reference run (see :mod:`.sweep`).
+* ``force_evals_per_step`` (from ``integrator.program_info.force_evals``; OpenMM's integrators: 1) and
+  ``force_evals_per_ps``; ``wall_per_step`` and ``wall_per_ps`` (seconds) from uninterrupted ``step(n)``
+  calls after the measured segment (sampling clears OpenMM's force cache, so it is not timed), alternated
+  with the same calls of OpenMM's VerletIntegrator on the same scene: ``wall_vs_verlet_paired`` is the
+  ratio of the two minima (see :func:`_time`).
+* ``failed`` / ``failure``: blow-up ("blow-up: ..."), energy error above the scene's threshold, or a
+  constraint error above 1e-3 (see :mod:`.stability`); ``status`` is "ok", "failed", "unsupported"
+  (the method cannot run this system, e.g. an implicit tableau with constraints) or "error".
+
+The comparison rows ``openmm-verlet`` (VerletIntegrator) and ``openmm-langevin``
+(LangevinMiddleIntegrator, 1/ps, the scene temperature, seed 1) are leapfrog integrators whose state
+velocities lag half a step: they start from v(-h/2) = v0 - (h/2) F(x0)/m (then constrained), which
+gives them the same position trajectory as velocity Verlet from (x0, v0).
+"""
+from __future__ import annotations
+
+import math
+import time
+import traceback
+import warnings
+from dataclasses import asdict, dataclass
+
+import numpy as np
+import openmm as mm
+import openmm.unit as unit
+
+from ...physics import angular_momentum, linear_momentum
+from ..timing import interleaved
+from ...systems.properties import constraint_violation
+from . import measure
+from .registry import BenchScene
+
+#: The comparison rows: OpenMM's own integrators.
+OPENMM_ROWS = ("openmm-verlet", "openmm-langevin")
+#: Constraint tolerance for every run (SETTLE ignores it; CCMA iterates to it).
+CONSTRAINT_TOLERANCE = 1e-10
+#: Failure thresholds (see stability.py for their rationale).
+KT300 = 0.0083144626 * 300.0
+ENERGY_THRESHOLD_KT = 0.1  # kT(300 K) per degree of freedom
+CONSTRAINT_THRESHOLD = 1e-3  # relative bond-length error
+SPEED_LIMIT = 1e5  # nm/ps: a velocity above this is a blow-up
+
+
+@dataclass(frozen=True)
+class RunSpec:
+    scene: str
+    method: str
+    step_fs: float
+    n_steps: int
+    n_samples: int = 50
+    role: str = "run"  # "run", "reference", "probe" (stability: stop at the first failure), "linear-probe"
+    platform: str | None = None  # None: the scene's platform
+    timing_s: float = 0.0  # seconds of uninterrupted stepping to time (0: no timing)
+    threads: int = 1  # CPU platform threads
+    seed: int = 1
+
+    @property
+    def h_ps(self) -> float:
+        return self.step_fs * 1e-3
+
+    @property
+    def length_ps(self) -> float:
+        return self.n_steps * self.h_ps
+
+    def to_dict(self) -> dict:
+        return asdict(self)
+
+
+def label(method: str) -> str:
+    return {"openmm-verlet": "OpenMM Verlet", "openmm-langevin": "OpenMM Langevin"}.get(method, method)
+
+
+def platform_properties(name: str, threads: int) -> dict:
+    if name == "CPU":
+        return {"Threads": str(threads)}
+    if name in ("OpenCL", "CUDA", "HIP"):
+        return {"Precision": "double" if name == "OpenCL" else "mixed"}
+    return {}
+
+
+class Unsupported(Exception):
+    """The method cannot run on this system."""
+
+
+def make_integrator(method: str, h_ps: float, scene: BenchScene, seed: int = 1, temperature=None):
+    """(integrator, force evaluations per step, leapfrog?) for a row name."""
+    if method == "openmm-verlet":
+        ig, evals, leapfrog = mm.VerletIntegrator(h_ps), 1, True
+    elif method == "openmm-langevin":
+        t = scene.temperature if temperature is None else temperature
+        ig = mm.LangevinMiddleIntegrator(t * unit.kelvin, 1.0 / unit.picosecond, h_ps)
+        ig.setRandomNumberSeed(seed)
+        evals, leapfrog = 1, True
+    else:
+        from ...methods.catalogue import get_method
+        from ...integrators import SymplecticIntegrator
+        from ...integrators import ConstraintSupportError
+
+        m = get_method(method)
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                ig = SymplecticIntegrator(h_ps, m.name, system=scene.system, allow_nonsymplectic=True)
+        except ConstraintSupportError as exc:
+            raise Unsupported(str(exc)) from None
+        evals, leapfrog = ig.program_info.force_evals, False
+    ig.setConstraintTolerance(CONSTRAINT_TOLERANCE)
+    return ig, evals, leapfrog
+
+
+def make_context(scene: BenchScene, integrator, platform: str, threads: int = 1):
+    plat = mm.Platform.getPlatformByName(platform)
+    return mm.Context(scene.system, integrator, plat, platform_properties(platform, threads))
+
+
+def set_initial_state(ctx, scene: BenchScene, x0, v0, h_ps: float, leapfrog: bool):
+    ctx.setPositions(x0)
+    if leapfrog:
+        f = ctx.getState(getForces=True).getForces(asNumpy=True).value_in_unit(
+            unit.kilojoule_per_mole / unit.nanometer)
+        m = scene.masses()
+        inv = np.where(m > 0, 1.0 / np.where(m > 0, m, 1.0), 0.0)
+        v0 = v0 - 0.5 * h_ps * np.asarray(f) * inv[:, None]
+    ctx.setVelocities(v0)
+    if leapfrog and scene.system.getNumConstraints():
+        ctx.applyVelocityConstraints(CONSTRAINT_TOLERANCE)
+
+
+def base_record(spec: RunSpec, scene: BenchScene, platform: str) -> dict:
+    rec = spec.to_dict()
+    rec.update(label=label(spec.method), platform=platform, length_ps=spec.length_ps, n_atoms=scene.n_atoms,
+               n_dof=scene.n_dof, status="ok", failed=False, failure=None, fail_time_ps=None, steps_done=0,
+               force_evals_per_step=None, force_evals_per_ps=None, energy_error=None, energy_error_per_dof=None,
+               drift_per_ns_per_dof=None, dP=None, dL_rel=None, constraint_error=None, traj_error=None,
+               wall_per_step=None, wall_per_ps=None, timing_steps=0, trace_t=[], trace_de_per_dof=[],
+               E0=None, setup_s=None, blew_up=False)
+    return rec
+
+
+def _failure(rec, reason, t):
+    """Record the first failure; a later blow-up is appended to it."""
+    if not rec["failed"]:
+        rec.update(failed=True, failure=reason, fail_time_ps=t, status="failed")
+    elif reason.startswith("blow-up") and "blow-up" not in rec["failure"]:
+        rec["failure"] += f"; then {reason} at {t:.4g} ps"
+
+
+def execute(spec: RunSpec, scene: BenchScene) -> tuple[dict, dict]:
+    """Run ``spec`` on ``scene``; returns (record, arrays).  ``arrays`` holds the final positions of
+    molecular accuracy runs (for the trajectory error against the reference), else it is empty."""
+    if spec.role == "linear-probe":
+        raise ValueError("linear probes are run by stability.run_spec, not by runs.execute")
+    platform = spec.platform or scene.platform
+    rec = base_record(spec, scene, platform)
+    arrays = {}
+    t_setup = time.perf_counter()
+    try:
+        ig, evals, leapfrog = make_integrator(spec.method, spec.h_ps, scene, spec.seed)
+        rec["force_evals_per_step"] = evals
+        rec["force_evals_per_ps"] = evals / spec.h_ps
+        ctx = make_context(scene, ig, platform, spec.threads)
+        set_initial_state(ctx, scene, scene.positions, scene.velocities, spec.h_ps, leapfrog)
+    except Unsupported as exc:
+        rec.update(status="unsupported", failure=str(exc).split(". ")[0])
+        return rec, arrays
+    except Exception as exc:  # a broken run is a record, never a crashed sweep
+        rec.update(status="error", failure=f"{type(exc).__name__}: {exc}", traceback=traceback.format_exc())
+        return rec, arrays
+    rec["setup_s"] = time.perf_counter() - t_setup
+    try:
+        _measure(spec, scene, ctx, ig, rec, arrays)
+    except Exception as exc:
+        if is_blowup(exc):  # e.g. in the timing segment
+            rec["blew_up"] = True
+            _failure(rec, _blowup_reason(exc), rec["steps_done"] * spec.h_ps)
+        else:
+            rec.update(status="error", failure=f"{type(exc).__name__}: {exc}", traceback=traceback.format_exc())
+    finally:
+        del ctx
+    return rec, arrays
+
+
+def is_blowup(exc) -> bool:
+    from ...integrators import SimulationBlowUpError
+
+    return isinstance(exc, (SimulationBlowUpError, FloatingPointError)) or (
+        isinstance(exc, mm.OpenMMException) and "nan" in str(exc).lower())
+
+
+def _blowup_reason(exc) -> str:
+    import re
+
+    msg = str(exc)
+    if isinstance(exc, mm.OpenMMException):
+        return "blow-up: OpenMM reports NaN coordinates"
+    what = re.search(r": (velocities[^.]*?|positions[^.]*?)\. ", msg)
+    step = re.search(r"step (\d+)", msg)
+    return f"blow-up: {what.group(1) if what else 'non-finite state'}" + (f" (step {step.group(1)})" if step else "")
+
+
+def _measure(spec, scene, ctx, ig, rec, arrays):
+    m = scene.masses()
+    cons = scene.constraints()
+    n_dof = scene.n_dof
+    inv = set(scene.invariants)
+    x, v, e0 = measure.read_state(ctx)
+    p0, l0 = linear_momentum(v, m), angular_momentum(x, v, m, about="origin")
+    rec["E0"] = e0
+    threshold = ENERGY_THRESHOLD_KT * KT300 * n_dof
+    stop_early = spec.role == "probe"
+    ts, des = [0.0], [0.0]
+    worst_e = worst_p = worst_l = worst_c = 0.0
+    marks = sorted({max(1, round(k * spec.n_steps / spec.n_samples)) for k in range(1, spec.n_samples + 1)})
+    done = 0
+    t_loop = time.perf_counter()
+    for mark in marks:
+        try:
+            ig.step(mark - done)
+        except Exception as exc:
+            if not is_blowup(exc):
+                raise
+            rec["blew_up"] = True
+            _failure(rec, _blowup_reason(exc), (done + 1) * spec.h_ps)
+            break
+        done = mark
+        rec["steps_done"] = done
+        t = done * spec.h_ps
+        x, v, e = measure.read_state(ctx)
+        if not measure.finite(x, v, e) or np.max(np.abs(v)) > SPEED_LIMIT:
+            rec["blew_up"] = True
+            _failure(rec, "blow-up: non-finite or runaway state", t)
+            break
+        de = e - e0
+        ts.append(t)
+        des.append(de / n_dof)
+        worst_e = max(worst_e, abs(de))
+        if "momentum" in inv:
+            worst_p = max(worst_p, float(np.linalg.norm(linear_momentum(v, m) - p0)))
+        if "angular_momentum" in inv:
+            worst_l = max(worst_l, float(np.linalg.norm(angular_momentum(x, v, m, about="origin") - l0)
+                                         / np.linalg.norm(l0)))
+        worst_c = max(worst_c, constraint_violation(x, cons))
+        if spec.method != "openmm-langevin" and "energy" in inv and abs(de) > threshold:
+            _failure(rec, f"energy error above {ENERGY_THRESHOLD_KT:g} kT per DOF", t)
+        if worst_c > CONSTRAINT_THRESHOLD:
+            _failure(rec, f"constraint error above {CONSTRAINT_THRESHOLD:g}", t)
+        if rec["failed"] and stop_early:
+            break
+    loop_s = time.perf_counter() - t_loop
+    rec.update(energy_error=worst_e, energy_error_per_dof=worst_e / n_dof,
+               drift_per_ns_per_dof=measure.drift_rate(ts, des) * 1e3,
+               dP=worst_p if "momentum" in inv else None,
+               dL_rel=worst_l if "angular_momentum" in inv else None,
+               constraint_error=worst_c, trace_t=ts, trace_de_per_dof=des)
+    if rec.get("blew_up"):
+        # the measured maxima only cover the samples before the blow-up: do not report them as errors
+        rec.update(energy_error=None, energy_error_per_dof=None, drift_per_ns_per_dof=None, dP=None, dL_rel=None)
+    completed = done == spec.n_steps and not rec.get("blew_up")
+    if completed:
+        if scene.exact is not None:
+            from .toys import exact_state
+
+            xe, _ = exact_state(scene.exact, spec.length_ps)
+            rec["traj_error"] = measure.rms_deviation(x, xe)
+        elif scene.purpose == "accuracy" and spec.role in ("run", "reference"):
+            arrays["positions"] = x
+    if spec.timing_s > 0 and completed and done:
+        _time(spec, scene, ig, rec, loop_s / done)
+
+
+#: Timing: rounds of (this integrator, then OpenMM's VerletIntegrator); the minimum of each is kept.
+TIMING_ROUNDS = 2
+#: Step of the paired VerletIntegrator timing (its cost per step does not depend on the step size).
+VERLET_TIMING_STEP_FS = 0.5
+
+
+def _steps_for(seconds, per_step):
+    return int(min(100_000, max(10, math.ceil(seconds / max(per_step, 1e-9)))))
+
+
+def _time(spec, scene, ig, rec, per_step_estimate):
+    """Wall time per step of ``ig`` (continuing from where the measured run ended) and of a fresh OpenMM
+    VerletIntegrator on the same scene and platform, taking turns (:func:`..timing.interleaved`): the
+    fastest block of each is kept, so that load from other processes cancels out of the ratio as far as
+    it can."""
+    n_time = _steps_for(spec.timing_s / (2 * TIMING_ROUNDS), per_step_estimate)
+    platform = spec.platform or scene.platform
+    v_ig, _, _ = make_integrator("openmm-verlet", VERLET_TIMING_STEP_FS * 1e-3, scene)
+    v_ctx = make_context(scene, v_ig, platform, spec.threads)
+    set_initial_state(v_ctx, scene, scene.positions, scene.velocities, VERLET_TIMING_STEP_FS * 1e-3, True)
+    v_ig.step(2)  # warm up (kernels, force cache)
+    t0 = time.perf_counter()
+    v_ig.step(10)
+    n_verlet = _steps_for(spec.timing_s / (2 * TIMING_ROUNDS), (time.perf_counter() - t0) / 10)
+    try:
+        t = interleaved({"own": ig.step, "verlet": v_ig.step}, {"own": n_time, "verlet": n_verlet}, TIMING_ROUNDS)
+    except Exception as exc:
+        if not is_blowup(exc):
+            raise
+        return  # the run blew up while being timed: no timing
+    finally:
+        del v_ctx
+    best, verlet = t["own"].best, t["verlet"].best
+    rec.update(wall_per_step=best, wall_per_ps=best / spec.h_ps, timing_steps=n_time * TIMING_ROUNDS,
+               verlet_wall_per_step=verlet, wall_vs_verlet_paired=best / verlet)

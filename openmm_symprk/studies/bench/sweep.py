@@ -1,0 +1,249 @@
+"""Scenes x methods x step sizes, run in parallel and kept on disk as they finish.
+
+    from openmm_symprk.studies.bench import presets
+    from openmm_symprk.studies.bench.sweep import run_sweep
+    results = run_sweep(presets.quick(), "bench-results/quick", workers=2)
+
+Jobs are generators that yield :class:`~.runs.RunSpec` s and receive their records: a plain run is one
+spec; a stability search (:func:`~.stability.driver`) yields probe after probe.  Every record is stored
+(:class:`~.store.Store`) the moment it arrives, before anything else happens, so an interrupted sweep
+(Ctrl-C, a crash, a killed job) keeps every finished run; ``resume=True`` replays the jobs, takes every
+stored record from disk instead of recomputing it (a stability search replays its probes in the same
+order, so it continues where it stopped) and submits only what is missing.  Runs whose record says
+"error" (an exception, not an integrator failure) are retried.
+
+On an interruption the queued runs are dropped, the running ones get a few seconds to finish (what
+finishes is stored), then the worker processes are stopped.  Scripts that call :func:`run_sweep` with
+``workers > 1`` need the usual ``if __name__ == "__main__":`` guard (workers are spawned).
+
+Up to ``workers + 1`` runs are in flight at a time, the most expensive ready one first (estimated from
+steps x force evaluations x the scene's cost per evaluation), so that long runs do not trail at the end.
+"""
+from __future__ import annotations
+
+import heapq
+import itertools
+import json
+import os
+import time
+import warnings
+
+from . import presets
+from .executors import make_executor
+from .runs import OPENMM_ROWS, RunSpec
+from .store import Store, run_key, write_json
+
+
+class SweepExistsError(RuntimeError):
+    """The output folder already holds finished runs and resume was not asked for."""
+
+
+class _Job:
+    def __init__(self, kind, gen, scene, method, estimate=1, cost=1.0):
+        self.kind, self.gen, self.scene, self.method = kind, gen, scene, method
+        self.estimate, self.cost = estimate, cost
+        self.count, self.done, self.result = 0, False, None
+
+    @property
+    def remaining(self):
+        return 0 if self.done else max(1, self.estimate - self.count)
+
+
+def _single(spec):
+    rec = yield spec
+    return rec
+
+
+def _evals(method):
+    if method in OPENMM_ROWS:
+        return 1
+    from ...methods.catalogue import get_method
+
+    return get_method(method).force_evals
+
+
+# -- scenes --------------------------------------------------------------------------------------
+def prepare_scenes(config: dict, out: str, reuse: bool = True, log=print) -> dict:
+    """Build (or, with ``reuse``, load the saved copy of) every scene of ``config``."""
+    from .registry import BenchScene, build, user_scene
+
+    folder = os.path.join(out, "scenes")
+    result = {}
+    for name, sc in config["scenes"].items():
+        params = sc.get("params", {})
+        path = os.path.join(folder, name + ".json")
+        scene = None
+        if reuse and os.path.exists(path):
+            with open(path) as fh:
+                saved = json.load(fh)["info"].get("meta", {}).get("params")
+            if saved == json.loads(json.dumps(params)):
+                scene = BenchScene.load(folder, name)
+        if scene is None:
+            t = time.perf_counter()
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                scene = user_scene(name=name, **params) if sc.get("builder") == "user" else build(name, **params)
+            scene.name = name
+            scene.meta = dict(scene.meta, params=params)
+            scene.save(folder)
+            log(f"built scene {name}: {scene.description} ({time.perf_counter() - t:.1f} s)")
+        if sc.get("platform"):
+            scene.platform = sc["platform"]
+        result[name] = scene
+    return result
+
+
+# -- plan ----------------------------------------------------------------------------------------
+def plan(config: dict, scenes: dict) -> list:
+    """The jobs of a sweep: runs, one reference run per molecular accuracy scene, stability searches."""
+    presets.check(config)
+    jobs = []
+    timing = config.get("timing_s", 0.5)
+    threads = config.get("threads", 1)
+    methods = config["methods"]
+    for name, sc in config["scenes"].items():
+        scene = scenes[name]
+        eval_s = sc.get("eval_s", 1e-3)
+        length = sc["length_ps"]
+        for h in sc["steps_fs"]:
+            n = round(length * 1e3 / h)
+            for m in methods:
+                spec = RunSpec(name, m, float(h), n, sc.get("samples", 50), "run", timing_s=timing, threads=threads)
+                jobs.append(_Job("run", _single(spec), name, m, cost=n * _evals(m) * eval_s))
+        if scene.purpose == "accuracy" and scene.exact is None:
+            ref = config.get("reference", presets.REFERENCE)
+            h_min = min(sc["steps_fs"])
+            n = round(length * 1e3 / h_min) * int(ref["factor"])
+            spec = RunSpec(name, ref["method"], length * 1e3 / n, n, sc.get("samples", 50), "reference",
+                           threads=threads)
+            jobs.append(_Job("reference", _single(spec), name, ref["method"],
+                             cost=n * _evals(ref["method"]) * eval_s * 2))
+        st = sc.get("stability")
+        if st and scene.purpose == "accuracy":
+            from .stability import driver
+
+            for m in methods:
+                est = 20 if st.get("linear") else 11
+                steps = 1 if st.get("linear") else st["probe_steps"]
+                jobs.append(_Job("stability", driver(name, m, st, threads=threads), name, m, estimate=est,
+                                 cost=steps * _evals(m) * (eval_s if not st.get("linear") else 4096 * 3e-7)))
+    return jobs
+
+
+# -- execution -----------------------------------------------------------------------------------
+def _run_jobs(jobs, store, executor, fingerprints, progress=True, on_result=None):
+    from tqdm import tqdm
+
+    counter = itertools.count()
+    ready, inflight = [], {}
+    stats = {"computed": 0, "reused": 0}
+    bar = tqdm(total=sum(j.remaining for j in jobs), desc="bench", unit="run", disable=not progress,
+               dynamic_ncols=True)
+
+    def tick():
+        bar.total = bar.n + sum(j.remaining for j in jobs)
+        bar.update(1)
+
+    def advance(job, rec):
+        while True:
+            try:
+                spec = next(job.gen) if rec is None else job.gen.send(rec)
+            except StopIteration as stop:
+                job.done, job.result = True, stop.value
+                return
+            key = run_key(spec.to_dict(), fingerprints[spec.scene])
+            stored = store.get(key)
+            if stored is None or stored.get("status") == "error":
+                heapq.heappush(ready, (-job.cost, next(counter), job, spec, key))
+                return
+            stats["reused"] += 1
+            job.count += 1
+            tick()
+            rec = stored
+
+    for job in jobs:
+        advance(job, None)
+    try:
+        while ready or inflight:
+            while ready and len(inflight) < executor.workers + 1:
+                _, _, job, spec, key = heapq.heappop(ready)
+                inflight[executor.submit(spec.to_dict(), spec.scene)] = (job, spec, key)
+            for fut in executor.wait(set(inflight)):
+                job, spec, key = inflight.pop(fut)
+                rec = _result(fut, spec)
+                store.put(key, rec[0], rec[1])
+                stats["computed"] += 1
+                job.count += 1
+                tick()
+                if on_result is not None:
+                    on_result(store.get(key))
+                advance(job, store.get(key))
+    except BaseException:
+        executor.shutdown(cancel=True, inflight=list(inflight))
+        for fut, (job, spec, key) in inflight.items():  # keep what finished while stopping
+            if fut.done() and not fut.cancelled():
+                try:
+                    rec, arrays = fut.result()
+                except BaseException:  # noqa: BLE001
+                    continue
+                if store.get(key) is None:
+                    store.put(key, rec, arrays)
+                    stats["computed"] += 1
+        bar.close()
+        raise
+    bar.close()
+    return stats
+
+
+def _result(fut, spec):
+    try:
+        return fut.result()
+    except Exception as exc:  # a worker that died or a bug: record it, keep the sweep going
+        import traceback
+
+        rec = dict(spec.to_dict(), status="error", failed=False, failure=f"{type(exc).__name__}: {exc}",
+                   traceback=traceback.format_exc())
+        return rec, {}
+
+
+# -- the whole sweep -----------------------------------------------------------------------------
+def run_sweep(config: dict, out: str, workers: int = 2, scheduler: str | None = None, resume: bool = False,
+              charts: bool = True, progress: bool = True, on_result=None, log=print) -> dict:
+    """Run (or continue) a sweep; write ``<out>/results.json``, ``<out>/summary.txt`` and the charts.
+
+    Returns the results dict (see :func:`.aggregate.aggregate`), with ``stats`` = runs computed now and
+    runs taken from disk."""
+    from .aggregate import aggregate, format_summary
+
+    os.makedirs(out, exist_ok=True)
+    store = Store(out)
+    if not resume and len(store):
+        raise SweepExistsError(f"{out} already holds {len(store)} finished runs: pass resume=True (--resume) to "
+                               f"continue that sweep, or choose another output folder")
+    scenes = prepare_scenes(config, out, reuse=resume, log=log)
+    payloads = {name: sc.payload() for name, sc in scenes.items()}
+    fingerprints = {name: p["fingerprint"] for name, p in payloads.items()}
+    jobs = plan(config, scenes)
+    executor = make_executor(payloads, workers, scheduler)
+    t0 = time.perf_counter()
+    try:
+        stats = _run_jobs(jobs, store, executor, fingerprints, progress, on_result)
+    except KeyboardInterrupt:
+        log(f"interrupted: {len(store)} finished runs are kept in {out}; rerun with --resume to continue")
+        raise
+    executor.shutdown()
+    stats["seconds"] = time.perf_counter() - t0
+    results = aggregate(config, scenes, jobs, store)
+    results["stats"] = stats
+    results["out"] = out
+    write_json(os.path.join(out, "results.json"), results)
+    with open(os.path.join(out, "summary.txt"), "w") as fh:
+        fh.write(format_summary(results) + "\n")
+    if charts:
+        from .charts import make_charts
+
+        results["charts"] = make_charts(results, os.path.join(out, "charts"))
+        write_json(os.path.join(out, "results.json"), results)
+    log(f"{stats['computed']} runs computed, {stats['reused']} taken from {out}, {stats['seconds']:.0f} s; "
+        f"results in {os.path.join(out, 'results.json')}")
+    return results

@@ -1,0 +1,156 @@
+"""Benchmark of the native backend against OpenMM's VerletIntegrator and the CustomIntegrator path.
+
+    python -m openmm_symprk.studies.native_speed            # CPU platform, both systems (a few minutes)
+    python -m openmm_symprk.studies.native_speed --quick    # fewer steps
+
+Prints, per system, the time per step of OpenMM's VerletIntegrator and, for each method, of the native
+integrator and of the CustomIntegrator (``openmm_symprk.SymplecticIntegrator``), with the ratios
+
+    verlet:       t_native / t_VerletIntegrator                          (target <= 0.9)
+    higher order: t_native / (force evaluations per step * t_VerletIntegrator)   (target <= 1)
+
+Systems: a rigid TIP3P water cluster in vacuum (no cutoff) and a periodic rigid TIP3P water box of about
+6,000 atoms (app.Modeller.addSolvent, PME, 1 nm cutoff).  Each timing is the best of ``--repeats`` runs
+of ``--steps`` steps after a warm-up, the integrators interleaved so that machine noise hits all alike.
+Not a test: nothing is asserted.
+"""
+from __future__ import annotations
+
+import argparse
+
+import openmm as mm
+import openmm.app as app
+import openmm.unit as unit
+
+from .timing import interleaved
+
+DEFAULT_METHODS = ("verlet", "omelyan-2", "yoshida-4", "blanes-moan-srkn6b-4", "kahan-li-6")
+
+
+def water_cluster_system(n_waters: int):
+    from ..systems.scenes import water_cluster
+
+    sc = water_cluster(n_waters, minimize=True)
+    return f"rigid water cluster, vacuum, {sc.n_atoms} atoms", sc.system, sc.positions, sc.velocities
+
+
+def water_box_system(box_nm: float):
+    from ..systems.prepare import maxwell_boltzmann, minimise
+
+    ff = app.ForceField("amber14/tip3p.xml")
+    mod = app.Modeller(app.Topology(), [])
+    mod.addSolvent(ff, model="tip3p", boxSize=mm.Vec3(box_nm, box_nm, box_nm) * unit.nanometer)
+    system = ff.createSystem(mod.topology, nonbondedMethod=app.PME, nonbondedCutoff=1.0 * unit.nanometer,
+                             constraints=app.HBonds, rigidWater=True, removeCMMotion=False)
+    pos = minimise(system, mod.positions, "CPU", tolerance=10.0, max_iterations=200)
+    vel = maxwell_boltzmann(system, pos, 300.0, seed=7)
+    return f"rigid TIP3P water box, PME 1 nm, {system.getNumParticles()} atoms", system, pos, vel
+
+
+def _contexts(system, pos, vel, platform, properties, entries):
+    out = {}
+    for key, make in entries:
+        ig = make()
+        ctx = mm.Context(system, ig, mm.Platform.getPlatformByName(platform), properties)
+        ctx.setPositions(pos)
+        ctx.setVelocities(vel)
+        ig.step(3)  # warm-up: kernels compiled, forces cached
+        out[key] = (ctx, ig)
+    return out
+
+
+def measure(system, pos, vel, methods, platform="CPU", properties=None, steps=100, repeats=3, dt_fs=2.0,
+            custom=True, log=print) -> dict:
+    """Seconds per step for every integrator; keys 'openmm-verlet', 'native:<m>', 'custom:<m>'."""
+    from ..integrators import SymplecticIntegrator, native_available
+
+    dt = dt_fs * unit.femtoseconds
+    entries = [("openmm-verlet", lambda: mm.VerletIntegrator(dt))]
+    for m in methods:
+        if native_available():
+            entries.append((f"native:{m}", lambda m=m: SymplecticIntegrator(dt, m, system=system, backend="native")))
+        if custom:
+            entries.append((f"custom:{m}", lambda m=m: SymplecticIntegrator(dt, m, system=system, backend="custom")))
+    ctxs = _contexts(system, pos, vel, platform, properties or {}, entries)
+
+    def stepper(ctx, ig):
+        def advance(n):
+            ig.step(n)
+            ctx.getState(getPositions=True)  # finish queued work (OpenCL)
+        return advance
+
+    timings = interleaved({k: stepper(ctx, ig) for k, (ctx, ig) in ctxs.items()}, steps, rounds=repeats)
+    return {k: t.best for k, t in timings.items()}
+
+
+def format_table(title, best, methods) -> str:
+    from ..methods.catalogue import methods as catalogue
+
+    base = best["openmm-verlet"]
+    lines = [title, f"  OpenMM VerletIntegrator: {base * 1e3:.3f} ms/step",
+             f"  {'method':22s} {'f/step':>6s} {'native ms':>10s} {'native ratio':>12s} {'custom ms':>10s} {'custom ratio':>12s}"]
+    for m in methods:
+        fe = catalogue[m].force_evals
+        nat = best.get(f"native:{m}")
+        cus = best.get(f"custom:{m}")
+        row = f"  {m:22s} {fe:6d} "
+        row += f"{nat * 1e3:10.3f} {nat / (fe * base):12.3f} " if nat is not None else f"{'-':>10s} {'-':>12s} "
+        row += f"{cus * 1e3:10.3f} {cus / (fe * base):12.3f}" if cus is not None else f"{'-':>10s} {'-':>12s}"
+        lines.append(row)
+    lines.append("  ratio = time per step / (force evaluations per step x VerletIntegrator time per step)")
+    return "\n".join(lines)
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(prog="python -m openmm_symprk.studies.native_speed",
+                                 description=__doc__.split("\n\n")[0])
+    ap.add_argument("--platform", default="CPU")
+    ap.add_argument("--precision", default=None, help="OpenCL/CUDA precision property (single, mixed, double)")
+    ap.add_argument("--methods", default=",".join(DEFAULT_METHODS))
+    ap.add_argument("--cluster-waters", type=int, default=216)
+    ap.add_argument("--box-nm", type=float, default=3.9, help="edge of the PME water box (3.9 nm: ~6,000 atoms)")
+    ap.add_argument("--steps", type=int, default=None)
+    ap.add_argument("--repeats", type=int, default=3)
+    ap.add_argument("--systems", default="cluster,box")
+    ap.add_argument("--no-custom", action="store_true", help="skip the CustomIntegrator timings")
+    ap.add_argument("--quick", action="store_true", help="fewer steps and repeats (a rough look)")
+    ap.add_argument("--no-forces", action="store_true",
+                    help="remove every force (constraints stay): times the integrators' own work alone")
+    args = ap.parse_args(argv)
+    from .. import plugin
+
+    if not plugin.available():
+        print(f"native backend unavailable: {plugin.unavailable_reason()}")
+        return 1
+    if args.platform not in plugin.platforms():
+        print(f"no native kernel for platform {args.platform} (have: {', '.join(plugin.platforms())})")
+        return 1
+    methods = [m.strip() for m in args.methods.split(",") if m.strip()]
+    props = {"Precision": args.precision} if args.precision else {}
+    import os
+
+    print(f"load average before: {os.getloadavg()[0]:.2f} (other processes on this machine skew every timing)")
+    print(f"openmm {mm.version.full_version}, platform {args.platform} {props or ''}, "
+          f"threads: {mm.Platform.getPlatformByName(args.platform).getPropertyDefaultValue('Threads') if args.platform == 'CPU' else '-'}")
+    for which in args.systems.split(","):
+        if which == "cluster":
+            title, system, pos, vel = water_cluster_system(args.cluster_waters)
+            steps = args.steps or (50 if args.quick else 200)
+        elif which == "box":
+            title, system, pos, vel = water_box_system(args.box_nm)
+            steps = args.steps or (20 if args.quick else 100)
+        else:
+            raise SystemExit(f"unknown system {which!r} (cluster, box)")
+        if args.no_forces:
+            while system.getNumForces():
+                system.removeForce(0)
+            title += ", no forces (integrator work only)"
+        best = measure(system, pos, vel, methods, args.platform, props, steps=steps,
+                       repeats=1 if args.quick else args.repeats, custom=not args.no_custom)
+        print(format_table(f"{title}: {steps} steps x best of {1 if args.quick else args.repeats}", best, methods))
+    print(f"load average after: {os.getloadavg()[0]:.2f}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

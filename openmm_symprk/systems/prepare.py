@@ -1,0 +1,75 @@
+"""Initial states for a System: energy minimisation, constrained velocities, seeded Maxwell-Boltzmann
+velocities (optionally spun about the centre of mass).  Units: nm, nm/ps, K."""
+from __future__ import annotations
+
+import numpy as np
+import openmm as mm
+import openmm.unit as unit
+
+from ..physics import centre_of_mass
+from .properties import has_constraints, masses
+
+#: Gas constant in kJ/mol/K (OpenMM's value).
+R_KJ = unit.MOLAR_GAS_CONSTANT_R.value_in_unit(unit.kilojoule_per_mole / unit.kelvin)
+
+__all__ = ["minimise", "constrain_velocities", "maxwell_boltzmann", "R_KJ"]
+
+
+def _context(system, platform="Reference", properties=None):
+    plat = mm.Platform.getPlatformByName(platform) if isinstance(platform, str) else platform
+    return mm.Context(system, mm.VerletIntegrator(0.001), plat, properties or {})
+
+
+def _nm(positions) -> np.ndarray:
+    if unit.is_quantity(positions):
+        positions = positions.value_in_unit(unit.nanometer)
+    return np.array([[float(c) for c in p] for p in positions]) if not isinstance(positions, np.ndarray) \
+        else np.asarray(positions, dtype=np.float64)
+
+
+def minimise(system: mm.System, positions, platform="Reference", tolerance: float = 10.0,
+             max_iterations: int = 200, properties=None) -> np.ndarray:
+    """Constrained, energy-minimised positions (nm): constraints applied to 1e-10, then OpenMM's
+    LocalEnergyMinimizer to ``tolerance`` kJ/mol/nm or ``max_iterations`` iterations."""
+    ctx = _context(system, platform, properties)
+    try:
+        ctx.setPositions(_nm(positions))
+        if has_constraints(system):
+            ctx.applyConstraints(1e-10)
+        mm.LocalEnergyMinimizer.minimize(ctx, tolerance, max_iterations)
+        return np.array(ctx.getState(getPositions=True).getPositions(asNumpy=True).value_in_unit(unit.nanometer))
+    finally:
+        del ctx
+
+
+def constrain_velocities(system: mm.System, positions, velocities, tolerance: float = 1e-12) -> np.ndarray:
+    """Velocities with their components along the constraints removed (so a state starts on the manifold)."""
+    if not has_constraints(system):
+        return np.asarray(velocities, dtype=np.float64)
+    ctx = _context(system)
+    try:
+        ctx.setPositions(_nm(positions))
+        ctx.setVelocities(np.asarray(velocities, dtype=np.float64))
+        ctx.applyVelocityConstraints(tolerance)
+        return np.array(ctx.getState(getVelocities=True).getVelocities(asNumpy=True).value_in_unit(
+            unit.nanometer / unit.picosecond))
+    finally:
+        del ctx
+
+
+def maxwell_boltzmann(system: mm.System, positions, temperature: float, seed: int,
+                      angular_velocity=None) -> np.ndarray:
+    """Seeded Maxwell-Boltzmann velocities at ``temperature`` (K) with zero net momentum, plus a rigid rotation
+    omega x (r - r_cm) when ``angular_velocity`` (rad/ps, 3 components) is given, then constrained (nm/ps).
+    Massless particles get zero velocity.  ``seed``: an int, or a numpy Generator to draw from."""
+    rng = np.random.default_rng(seed)
+    m = masses(system)
+    x = _nm(positions)
+    kT = R_KJ * temperature
+    v = rng.normal(size=(len(m), 3)) * np.sqrt(kT / np.where(m > 0, m, 1.0))[:, None]
+    v[m == 0] = 0.0
+    v -= (m[:, None] * v).sum(0) / m.sum()
+    if angular_velocity is not None:
+        spin = np.cross(np.asarray(angular_velocity, dtype=float), x - centre_of_mass(x, m))
+        v += np.where(m[:, None] > 0, spin, 0.0)
+    return constrain_velocities(system, x, v)

@@ -1,0 +1,199 @@
+"""Minimal scenes: each models no more than the effect it is there to show.
+
+* :func:`water_cluster` -- TIP3P waters in vacuum (no box, no cutoff, no CMMotionRemover), rigid
+  (SETTLE) or flexible, spun up about the centre of mass.  Isolated, so energy, linear momentum and
+  angular momentum are all conserved quantities; rigid water is enough for rotation, flexible water is
+  where large steps fail.
+* :func:`morse_molecule` -- a small flexible molecule with Morse bonds and a cosine angle term: nonlinear
+  forces in a handful of atoms, the smallest OpenMM system that measures convergence orders.
+
+Every scene returns a :class:`Scene` (system, topology, positions, velocities) built from a seed, so
+all runs of a study start from one shared state.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import openmm as mm
+import openmm.app as app
+import openmm.unit as unit
+
+from .prepare import constrain_velocities, maxwell_boltzmann, minimise
+from .properties import masses
+
+#: TIP3P geometry (nm, radians)
+_R_OH = 0.09572
+_THETA = np.deg2rad(104.52)
+
+
+@dataclass
+class Scene:
+    name: str
+    system: mm.System
+    topology: app.Topology
+    positions: np.ndarray  # nm, (N, 3)
+    velocities: np.ndarray  # nm/ps, (N, 3)
+    description: str = ""
+
+    @property
+    def n_atoms(self) -> int:
+        return self.system.getNumParticles()
+
+    def masses(self) -> np.ndarray:
+        return masses(self.system)
+
+    def context(self, integrator, platform="Reference", properties=None):
+        """A Context at the scene's initial state on the named platform."""
+        plat = mm.Platform.getPlatformByName(platform) if isinstance(platform, str) else platform
+        ctx = mm.Context(self.system, integrator, plat, properties or {})
+        ctx.setPositions(self.positions)
+        ctx.setVelocities(self.velocities)
+        return ctx
+
+
+def _water_topology(n):
+    top = app.Topology()
+    chain = top.addChain()
+    O, H = app.element.oxygen, app.element.hydrogen
+    for _ in range(n):
+        res = top.addResidue("HOH", chain)
+        o = top.addAtom("O", O, res)
+        h1 = top.addAtom("H1", H, res)
+        h2 = top.addAtom("H2", H, res)
+        top.addBond(o, h1)
+        top.addBond(o, h2)
+    return top
+
+
+def _random_rotation(rng):
+    q = rng.normal(size=4)
+    q /= np.linalg.norm(q)
+    a, b, c, d = q
+    return np.array([[a*a + b*b - c*c - d*d, 2*(b*c - a*d), 2*(b*d + a*c)],
+                     [2*(b*c + a*d), a*a - b*b + c*c - d*d, 2*(c*d - a*b)],
+                     [2*(b*d - a*c), 2*(c*d + a*b), a*a - b*b - c*c + d*d]])
+
+
+def water_cluster(n_waters: int = 27, rigid: bool = True, temperature: float = 150.0,
+                  angular_velocity=(0.0, 0.0, 2.0), spacing: float = 0.31, seed: int = 1,
+                  minimize: bool = True) -> Scene:
+    """TIP3P waters on a jittered cubic grid in vacuum, rigid (SETTLE) or flexible.
+
+    ``angular_velocity`` (rad/ps) spins the cluster about its centre of mass, so that the angular
+    momentum is far from zero and its conservation is a sharp test."""
+    if n_waters < 1:
+        raise ValueError(f"n_waters must be at least 1, got {n_waters}")
+    rng = np.random.default_rng(seed)
+    side = int(np.ceil(n_waters ** (1 / 3)))
+    sites = np.array([(i, j, k) for i in range(side) for j in range(side) for k in range(side)], float)[:n_waters]
+    local = np.array([[0.0, 0.0, 0.0],
+                      [_R_OH, 0.0, 0.0],
+                      [_R_OH * np.cos(_THETA), _R_OH * np.sin(_THETA), 0.0]])
+    pos = []
+    for s in sites:
+        R = _random_rotation(rng)
+        centre = s * spacing + rng.uniform(-0.02, 0.02, 3)
+        pos.extend(centre + local @ R.T)
+    pos = np.array(pos)
+    top = _water_topology(n_waters)
+    ff = app.ForceField("tip3p.xml")
+    system = ff.createSystem(top, nonbondedMethod=app.NoCutoff, constraints=None, rigidWater=rigid,
+                             removeCMMotion=False)
+    if not rigid:
+        _add_flexible_water_terms(system, n_waters)
+    if minimize:
+        pos = minimise(system, pos, tolerance=1.0)
+    vel = maxwell_boltzmann(system, pos, temperature, rng, angular_velocity)
+    kind = "rigid (SETTLE)" if rigid else "flexible"
+    return Scene(f"water-cluster-{n_waters}{'' if rigid else '-flexible'}", system, top, np.array(pos), vel,
+                 f"{n_waters} {kind} TIP3P waters in vacuum, spinning at {tuple(angular_velocity)} rad/ps")
+
+
+def _add_flexible_water_terms(system, n_waters):
+    """Harmonic O-H bonds and H-O-H angle (flexible TIP3P, CHARMM-like constants)."""
+    bonds = mm.HarmonicBondForce()
+    angles = mm.HarmonicAngleForce()
+    for w in range(n_waters):
+        o = 3 * w
+        bonds.addBond(o, o + 1, _R_OH, 462750.4)
+        bonds.addBond(o, o + 2, _R_OH, 462750.4)
+        angles.addAngle(o + 1, o, o + 2, _THETA, 836.8)
+    system.addForce(bonds)
+    system.addForce(angles)
+
+
+def morse_molecule(seed: int = 3, temperature: float = 300.0, angular_velocity=(0.0, 1.0, 3.0)) -> Scene:
+    """A bent 4-atom chain with Morse bonds, cosine angles and a 1-4 Lennard-Jones pair, in vacuum.
+
+    Every force is nonlinear and the molecule is tiny, so a convergence study takes seconds while still
+    exercising all the order conditions of a general (nonlinear, several-DOF) problem."""
+    rng = np.random.default_rng(seed)
+    system = mm.System()
+    masses = [12.0, 14.0, 12.0, 16.0]
+    for m in masses:
+        system.addParticle(m)
+    morse = mm.CustomBondForce("D*(1 - exp(-a*(r - r0)))^2")
+    for p in ("D", "a", "r0"):
+        morse.addPerBondParameter(p)
+    for i in range(3):
+        morse.addBond(i, i + 1, [400.0, 20.0, 0.15])
+    angle = mm.CustomAngleForce("k*(cos(theta) - cos(theta0))^2")
+    angle.addPerAngleParameter("k")
+    angle.addPerAngleParameter("theta0")
+    angle.addAngle(0, 1, 2, [200.0, np.deg2rad(110.0)])
+    angle.addAngle(1, 2, 3, [200.0, np.deg2rad(115.0)])
+    lj = mm.CustomBondForce("4*eps*((sig/r)^12 - (sig/r)^6)")
+    lj.addPerBondParameter("eps")
+    lj.addPerBondParameter("sig")
+    lj.addBond(0, 3, [0.5, 0.25])
+    for f in (morse, angle, lj):
+        system.addForce(f)
+    top = app.Topology()
+    res = top.addResidue("MOL", top.addChain())
+    for i, el in enumerate((app.element.carbon, app.element.nitrogen, app.element.carbon, app.element.oxygen)):
+        top.addAtom(f"A{i}", el, res)
+    pos = np.array([[0.0, 0.0, 0.0], [0.15, 0.0, 0.0], [0.2, 0.14, 0.0], [0.35, 0.16, 0.05]])
+    pos += rng.normal(scale=0.005, size=pos.shape)
+    vel = maxwell_boltzmann(system, pos, temperature, rng, angular_velocity)
+    return Scene("morse-molecule", system, top, pos, vel, "4-atom Morse chain in vacuum (nonlinear, unconstrained)")
+
+
+def constrained_molecule(seed: int = 3) -> Scene:
+    """:func:`morse_molecule` with its three bonds replaced by distance constraints (RATTLE scene)."""
+    sc = morse_molecule(seed)
+    system = sc.system
+    system.removeForce(0)  # the Morse bonds
+    for i in range(3):
+        d = float(np.linalg.norm(sc.positions[i + 1] - sc.positions[i]))
+        system.addConstraint(i, i + 1, d)
+    vel = constrain_velocities(system, sc.positions, sc.velocities)
+    return Scene("constrained-molecule", system, sc.topology, sc.positions, vel,
+                 "4-atom chain with 3 distance constraints, angle and 1-4 terms (nonlinear, constrained)")
+
+
+def _openmm_data(name):
+    import os
+
+    return os.path.join(os.path.dirname(app.__file__), "data", name)
+
+
+def protein_vacuum(constraints=app.HBonds, temperature: float = 300.0, angular_velocity=(0.0, 0.0, 0.5),
+                   seed: int = 5, minimize: bool = True) -> Scene:
+    """The villin headpiece from OpenMM's bundled test.pdb, solvent removed, in vacuum (amber14, no
+    cutoff, no CMMotionRemover), HBonds constrained by default: a real protein whose conservation
+    exercises CCMA constraints, with no periodic box to break rotational symmetry."""
+    pdb = app.PDBFile(_openmm_data("test.pdb"))
+    mod = app.Modeller(pdb.topology, pdb.positions)
+    mod.deleteWater()
+    mod.delete([r for r in mod.topology.residues() if len(r) == 1])  # counter-ions
+    ff = app.ForceField("amber14-all.xml")
+    system = ff.createSystem(mod.topology, nonbondedMethod=app.NoCutoff, constraints=constraints,
+                             removeCMMotion=False)
+    pos = np.array(mod.positions.value_in_unit(unit.nanometer))
+    if minimize:
+        pos = minimise(system, pos, tolerance=10.0)
+    vel = maxwell_boltzmann(system, pos, temperature, seed, angular_velocity)
+    return Scene("villin-vacuum", system, mod.topology, np.array(pos), vel,
+                 f"villin headpiece (test.pdb, {system.getNumParticles()} atoms) in vacuum, amber14, "
+                 f"{system.getNumConstraints()} constraints")

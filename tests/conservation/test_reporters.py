@@ -1,0 +1,104 @@
+"""ConservationReporter and VelocityTRRReporter in an app.Simulation."""
+import io
+
+import numpy as np
+import openmm as mm
+import openmm.app as app
+import pytest
+
+import openmm_symprk.conservation.reporters as reporters
+import openmm_symprk.systems.checks as systemcheck
+from openmm_symprk import SymplecticIntegrator
+from openmm_symprk.conservation.reporters import ConservationReporter, VelocityTRRReporter, write_topology
+from openmm_symprk.systems.checks import ConservationWarning
+
+
+def _simulation(scene, system=None, integrator=None):
+    system = system or scene.system
+    integrator = integrator or SymplecticIntegrator(0.002, "verlet", system=scene.system)
+    sim = app.Simulation(scene.topology, system, integrator, mm.Platform.getPlatformByName("Reference"))
+    sim.context.setPositions(scene.positions)
+    sim.context.setVelocities(scene.velocities)
+    return sim
+
+
+def test_describe_next_report_is_dict(water8, tmp_path):
+    """OpenMM 8.6 Simulation takes the dict form {'steps', 'periodic', 'include'}."""
+    sim = _simulation(water8)
+    for rep in (ConservationReporter(io.StringIO(), 30), VelocityTRRReporter(str(tmp_path / "d.trr"), 30)):
+        d = rep.describeNextReport(sim)
+        assert d["steps"] == 30 and d["periodic"] is False
+        assert {"positions", "velocities"} <= set(d["include"])
+
+
+def test_conservation_reporter_output_parses(water8, tmp_path):
+    path = tmp_path / "cons.csv"
+    sim = _simulation(water8)
+    rep = ConservationReporter(str(path), 50)
+    sim.reporters.append(rep)
+    sim.step(200)
+    rep.close()
+    text = path.read_text().splitlines()
+    assert text[0].startswith('#"Step"') and len(text[0].split(",")) == 7
+    data = np.loadtxt(path, delimiter=",", comments="#")
+    assert data.shape == (4, 7)
+    assert list(data[:, 0]) == [50, 100, 150, 200]
+    assert np.allclose(data[:, 1], [0.1, 0.2, 0.3, 0.4])
+    assert np.isnan(data[0, 3]) and np.all(np.isfinite(data[1:, 3]))
+    assert np.all(data[:, 4] < 1e-10)  # |dP|, Reference
+    assert np.all(data[:, 5] < 1e-12)  # |dL|/|L|, Reference
+    assert np.all(data[:, 6] < 1e-6)  # constraint error
+    assert rep.records[-1]["dL_rel"] == pytest.approx(data[-1, 5], rel=1e-3)
+
+
+def test_conservation_reporter_stdout(water8, capsys):
+    sim = _simulation(water8)
+    sim.reporters.append(ConservationReporter(None, 10))
+    sim.step(20)
+    out = capsys.readouterr().out.splitlines()
+    assert out[0].startswith("#") and len(out) == 3
+
+
+def test_warns_once_with_reason(water8, monkeypatch):
+    system = mm.XmlSerializer.clone(water8.system)
+    system.addForce(mm.CMMotionRemover())
+    with pytest.warns(ConservationWarning) as rec:
+        for _ in range(2):
+            sim = _simulation(water8, system=system,
+                              integrator=mm.LangevinMiddleIntegrator(150, 1.0, 0.002))
+            rep = ConservationReporter(io.StringIO(), 10)
+            sim.reporters.append(rep)
+            sim.step(20)
+            assert {k for k, _ in rep.issues} == {"cmmotionremover", "langevinmiddleintegrator"}
+    msgs = [str(w.message) for w in rec if issubclass(w.category, ConservationWarning)]
+    assert sum("CMMotionRemover" in m for m in msgs) == 1, msgs
+    assert sum("heat bath" in m for m in msgs) == 1, msgs
+    assert all(m.startswith("ConservationReporter:") for m in msgs)
+
+
+@pytest.mark.filterwarnings("ignore:Reload offsets")
+def test_trr_reporter_round_trip(water8, tmp_path):
+    import MDAnalysis as mda
+
+    trr, pdb = str(tmp_path / "t.trr"), str(tmp_path / "t.pdb")
+    sim = _simulation(water8)
+    rep = VelocityTRRReporter(trr, 25)
+    sim.reporters.append(rep)
+    sim.step(100)
+    rep.close()
+    write_topology(pdb, water8.topology, water8.positions)
+    st = sim.context.getState(getPositions=True, getVelocities=True)
+    u = mda.Universe(pdb, trr)
+    assert len(u.trajectory) == 4
+    ts = u.trajectory[-1]
+    assert ts.has_velocities and ts.data["step"] == 100 and ts.time == pytest.approx(0.2, rel=1e-6)
+    x = st.getPositions(asNumpy=True)._value * 10
+    v = st.getVelocities(asNumpy=True)._value * 10
+    assert np.allclose(ts.positions, x, rtol=1e-6, atol=1e-5)  # float32
+    assert np.allclose(ts.velocities, v, rtol=1e-6, atol=1e-5)
+    # append rewrites the old frames and continues
+    rep2 = VelocityTRRReporter(trr, 25, append=True)
+    sim.reporters[0] = rep2
+    sim.step(50)
+    rep2.close()
+    assert len(mda.Universe(pdb, trr).trajectory) == 6

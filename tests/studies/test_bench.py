@@ -1,0 +1,150 @@
+"""``symprk bench``: the quick pipeline end to end, resumability, stability intervals, failure records.
+
+No timing is asserted anywhere: wall-time ratios are reported by the bench, never tested."""
+import json
+import math
+import os
+
+import pytest
+
+from openmm_symprk.studies.bench import presets, stability
+from openmm_symprk.studies.bench import registry as scenes
+from openmm_symprk.studies.bench.runs import RunSpec, execute
+from openmm_symprk.studies.bench.sweep import SweepExistsError, run_sweep
+from openmm_symprk.methods.catalogue import methods
+
+
+def _mtimes(out):
+    folder = os.path.join(out, "runs")
+    return {f: os.stat(os.path.join(folder, f)).st_mtime_ns for f in os.listdir(folder) if f.endswith(".json")}
+
+
+def _small_config():
+    """Two cheap scenes, no stability: for the interruption test."""
+    cfg = presets.select(presets.quick(), scenes=["harmonic", "water-rigid"], stability=False)
+    cfg["scenes"]["harmonic"]["stability"] = presets.quick()["scenes"]["harmonic"]["stability"]
+    cfg["methods"] = ["openmm-verlet", "verlet", "yoshida-4"]
+    return cfg
+
+
+def test_quick_pipeline_end_to_end_and_resume(tmp_path):
+    from openmm_symprk.studies.bench.cli import main
+
+    out = str(tmp_path / "quick")
+    assert main(["--quick", "--out", out, "--workers", "2", "--no-progress"]) == 0
+    with open(os.path.join(out, "results.json")) as fh:
+        res = json.load(fh)
+    cfg = presets.quick()
+    n_runs = sum(len(sc["steps_fs"]) for sc in cfg["scenes"].values()) * len(cfg["methods"])
+    assert len(res["runs"]) == n_runs
+    assert {r["method"] for r in res["runs"]} == set(cfg["methods"])
+    assert len(res["references"]) == 1  # water-rigid; the toys have exact solutions
+    # every record has its measurements (or is a recorded failure)
+    for r in res["runs"]:
+        assert r["status"] in ("ok", "failed"), r
+        if r["status"] == "ok" and not r["failed"]:
+            assert r["traj_error"] is not None and r["traj_error"] >= 0
+            assert r["energy_error_per_dof"] is not None
+            assert r["force_evals_per_ps"] > 0 and r["wall_per_ps"] > 0 and r["wall_vs_verlet"] > 0
+    water = [r for r in res["runs"] if r["scene"] == "water-rigid" and r["method"] == "verlet"]
+    assert all(r["dL_rel"] < 1e-9 and r["dP"] < 1e-8 and r["constraint_error"] < 1e-6 for r in water)
+    # a higher-order method is more accurate at the same step on the molecular scene
+    by = {(r["method"], r["step_fs"]): r for r in res["runs"] if r["scene"] == "water-rigid"}
+    assert by[("yoshida-4", 1.0)]["traj_error"] < by[("verlet", 1.0)]["traj_error"]
+    # stability searches ran and failures were recorded, not raised
+    assert {s["scene"] for s in res["stability"]} == {"harmonic", "water-rigid"}
+    assert any(r["failed"] for r in res["runs"])  # harmonic at 3 fs is beyond Verlet's limit (2.86 fs)
+    charts = res["charts"]
+    for name in ("bench_work_precision_water-rigid.png", "bench_stability.png", "bench_energy_harmonic.png",
+                 "bench_speed.png"):
+        path = os.path.join(out, "charts", name)
+        assert path in charts and os.path.getsize(path) > 10_000
+    assert os.path.getsize(os.path.join(out, "summary.txt")) > 0
+
+    # a second call without --resume refuses to mix sweeps; with it, nothing is recomputed
+    assert main(["--quick", "--out", out, "--no-progress"]) == 2
+    before = _mtimes(out)
+    again = run_sweep(cfg, out, workers=2, resume=True, charts=False, progress=False, log=lambda *a: None)
+    assert again["stats"]["computed"] == 0
+    assert again["stats"]["reused"] == len(before)
+    assert _mtimes(out) == before
+    assert main(["--summary", "--out", out]) == 0
+
+
+def test_interrupted_sweep_continues_and_loses_nothing(tmp_path):
+    out = str(tmp_path / "interrupted")
+    cfg = _small_config()
+    seen = []
+
+    def stop_after_five(rec):
+        seen.append(rec["key"])
+        if len(seen) == 5:
+            raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        run_sweep(cfg, out, workers=2, charts=False, progress=False, on_result=stop_after_five, log=lambda *a: None)
+    kept = _mtimes(out)
+    assert len(kept) >= 5 and {k + ".json" for k in seen} <= set(kept)
+    with pytest.raises(SweepExistsError):
+        run_sweep(cfg, out, workers=2, charts=False, progress=False, log=lambda *a: None)
+    res = run_sweep(cfg, out, workers=2, resume=True, charts=False, progress=False, log=lambda *a: None)
+    assert res["stats"]["reused"] == len(kept)
+    assert res["stats"]["computed"] > 0
+    after = _mtimes(out)
+    assert {k: after[k] for k in kept} == kept  # nothing that was stored was recomputed
+    # the resumed sweep equals an uninterrupted one in what it holds
+    assert len(res["runs"]) == sum(len(s["steps_fs"]) for s in cfg["scenes"].values()) * len(cfg["methods"])
+    assert all(s["status"] == "ok" for s in res["stability"])
+
+
+def test_harmonic_stability_reproduces_catalogue_intervals():
+    """Bisection on the harmonic toy (the compiled OpenMM programs) against METHODS.md, within 1 %."""
+    scene = scenes.build("harmonic", n=8)
+    settings = stability.linear_settings(scene.linear["omega_max"], rel_tol=1e-3)
+    checked = []
+    for name in ["openmm-verlet"] + [m.name for m in methods.values()]:
+        cat = stability.catalogue_stability(name)
+        if cat is None or not math.isfinite(cat):
+            continue
+        res = stability.largest_stable_step(scene, name, settings)
+        assert res["status"] == "ok", res
+        x = res["x_stable"]
+        assert abs(x / cat - 1) < 0.01, (name, x, cat)
+        checked.append(name)
+    assert len(checked) >= 20
+
+
+def test_failing_runs_are_recorded_not_raised():
+    flex = scenes.build("water-flexible", n_waters=4)
+    rec, _ = execute(RunSpec("water-flexible", "verlet", 8.0, 200, 10, timing_s=0.01), flex)
+    assert rec["status"] == "failed" and rec["failed"] and rec["blew_up"]
+    assert rec["failure"].startswith(("blow-up", "energy"))
+    assert rec["traj_error"] is None and rec["wall_per_ps"] is None
+    rec, _ = execute(RunSpec("water-flexible", "openmm-verlet", 8.0, 200, 10), flex)
+    assert rec["status"] == "failed"
+    rigid = scenes.build("water-rigid", n_waters=4)
+    rec, _ = execute(RunSpec("water-rigid", "gauss-2", 1.0, 10, 2), rigid)
+    assert rec["status"] == "unsupported" and "constraints" in rec["failure"]
+    rec, _ = execute(RunSpec("water-rigid", "no-such-method", 1.0, 10, 2), rigid)
+    assert rec["status"] == "error" and "no-such-method" in rec["failure"]
+    # a stability search on a scene where everything fails at the first probe still returns a result
+    res = stability.largest_stable_step(flex, "verlet", {"h0_fs": 8.0, "cap_fs": 16.0, "grow": 2.0,
+                                                         "rel_tol": 0.1, "probe_steps": 50, "samples": 5})
+    assert res["status"] == "ok" and res["h_fail_fs"] is not None
+
+
+def test_step_sizes_must_divide_the_run_length():
+    cfg = presets.select(presets.quick(), scenes=["harmonic"], steps_fs=[0.7])
+    with pytest.raises(ValueError, match="does not divide"):
+        presets.check(cfg)
+
+
+def test_dask_scheduler(tmp_path):
+    distributed = pytest.importorskip("dask.distributed")
+    cfg = presets.select(presets.quick(), scenes=["anharmonic"], methods=["verlet", "yoshida-4"], stability=False)
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=False,
+                                  dashboard_address=None) as cluster:
+        res = run_sweep(cfg, str(tmp_path / "dask"), scheduler=cluster.scheduler_address, charts=False,
+                        progress=False, log=lambda *a: None)
+    assert res["stats"]["computed"] == 4
+    assert all(r["status"] == "ok" for r in res["runs"] if r["step_fs"] == 1.0)
