@@ -9,8 +9,9 @@
 import openmm.unit as unit
 
 from openmm_symprk import PRKIntegrator, PRKTableau, Splitting, TableauError
-from openmm_symprk.numerics import measure_order, stability_interval
-from openmm_symprk.scenes import morse_molecule
+from openmm_symprk.methods.reference import measure_order
+from openmm_symprk.methods.stability import stability_interval
+from openmm_symprk.systems.scenes import morse_molecule
 
 # 1. a splitting, coefficients as exact strings
 b = "0.1931833275037835739600"

@@ -14,7 +14,7 @@ import openmm.app as app
 import openmm.unit as unit
 
 from openmm_symprk import SymplecticIntegrator
-from openmm_symprk.scenes import water_cluster
+from openmm_symprk.systems.scenes import water_cluster
 
 method = sys.argv[1] if len(sys.argv) > 1 else "yoshida-4"
 platform = sys.argv[2] if len(sys.argv) > 2 else "Reference"

@@ -6,7 +6,7 @@ Draws the body angular momentum x(t) of a rigid water molecule (an asymmetric to
 |x| = |x0| for several methods against the exact curve (Jacobi elliptic functions), plus the error and
 the drift of |x| over time, and prints the measured figures:
 
-* the pure-numpy integrators of openmm_symprk.rigidbody: measured orders and conservation;
+* the pure-numpy integrators of openmm_symprk.rigid.lie_poisson: measured orders and conservation;
 * a rigid water run by openmm_symprk.SymplecticIntegrator (RATTLE) on OpenMM's Reference platform,
   with verlet and yoshida-4: error against the exact solution, measured order, drift of the space-frame
   angular momentum;
@@ -26,8 +26,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from openmm_symprk import rigidbody as rb  # noqa: E402
-from openmm_symprk.rigid_molecules import (free_rigid_body, hydrogen_peroxide, rigid_water,  # noqa: E402
+from openmm_symprk.rigid import lie_poisson as rb  # noqa: E402
+from openmm_symprk.rigid.molecules import (free_rigid_body, hydrogen_peroxide, rigid_water,  # noqa: E402
                                            run_free_rigid_body)
 
 OMEGA = [6.0, -14.0, 9.0]  # body angular velocity at t = 0 (1/ps, principal axes, ascending moments)

@@ -150,6 +150,17 @@ class _Emitter:
         else:
             self.ig.addComputePerDof("v", f"v + {_num(c)}*dt*f/m")
 
+    def project_velocities(self):
+        """A velocity projection inside a step (see Splitting.projected_drifts)."""
+        if not self.constraints:
+            return
+        if self.exact_momentum:
+            from .projection import emit_constrain_velocities
+
+            emit_constrain_velocities(self.ig)
+        else:
+            self.ig.addConstrainVelocities()
+
     def drift(self, c):
         self.ig.addComputePerDof("x", f"x + {_num(c)}*dt*v")
         if self.constraints:
@@ -189,10 +200,13 @@ def compile_splitting(integrator, splitting: Splitting, constraints: bool, exact
                       check_finite=True, update_context_state=True, max_speed=0.0) -> ProgramInfo:
     """Emit the program of a kick/drift sequence (RATTLE when ``constraints``)."""
     em = _Emitter(integrator, constraints, exact_momentum, update_context_state)
-    for label, c in splitting.coefficients(np.float64):
+    projected = set(splitting.projected_drifts())
+    for i, (label, c) in enumerate(splitting.coefficients(np.float64)):
         if label == KICK:
             em.kick(c)
         elif label == DRIFT:
+            if i in projected:
+                em.project_velocities()
             em.drift(c)
         else:
             raise TableauError(f"a kick/drift splitting cannot contain a {label!r} sub-flow")

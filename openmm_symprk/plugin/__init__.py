@@ -5,6 +5,10 @@ process, and says why the native backend is unavailable when it is, with the one
 It imports nothing else of the package; :mod:`openmm_symprk.integrators.native` builds the integrator
 class on the SWIG class it exposes.
 
+``SYMPRK_NATIVE_PLATFORMS`` (comma-separated platform names, e.g. ``Reference,CPU``) limits the platforms
+whose kernels are loaded; the others then report why, and the native integrator refuses them with a clear
+error (``backend="auto"`` then picks the CustomIntegrator program, which runs everywhere).
+
 Build outputs here: ``lib/libOpenMMSymPRK*.so``, ``symprk_swig.py`` + ``symprk_swig_ext*.so``,
 ``_build_info.json`` (what was built, against which openmm, and why a platform kernel was skipped), or
 ``_build_error.txt`` when the build failed.
@@ -87,9 +91,15 @@ def _load() -> type:
         st.reason = f"the native plugin's Python module does not import: {exc}"
         return st
     present = set(_platform_names())
+    wanted = os.environ.get("SYMPRK_NATIVE_PLATFORMS", "").strip()
+    wanted = {p.strip() for p in wanted.split(",") if p.strip()} if wanted else None
     for platform, name in st.build_info.get("libraries", {}).items():
         if platform == "api" or not (set(SERVES.get(platform, (platform,))) & present):
             continue  # a kernel library is loaded only where OpenMM has its platform (CUDA needs libOpenMMCUDA)
+        if wanted is not None and not (set(SERVES.get(platform, (platform,))) & wanted):
+            st.plugin_errors[platform] = (f"not loaded: SYMPRK_NATIVE_PLATFORMS={os.environ['SYMPRK_NATIVE_PLATFORMS']} "
+                                          f"leaves it out")
+            continue
         try:
             mm.Platform.loadPluginLibrary(os.path.join(HERE, "lib", name))
         except Exception as exc:
@@ -118,7 +128,7 @@ def fix_hint(reason: str | None = None) -> str:
     reason = unavailable_reason() if reason is None else reason
     if "no C++ compiler" in reason:
         return f"install a C++17 compiler (e.g. `apt-get install g++`), then run `{REBUILD}`"
-    if "SYMPRK_NATIVE=0" in reason:
+    if "SYMPRK_NATIVE=0: native build disabled" in reason:
         return f"unset SYMPRK_NATIVE and run `{REBUILD}`"
     return f"run `{REBUILD}` and read the warning it prints (add -v to see the build log)"
 
@@ -136,10 +146,15 @@ def platforms() -> list:
     return [p for p in _platform_names() if _has_kernel(p)]
 
 
+def _library_of(platform: str) -> str:
+    return next((lib for lib, served in SERVES.items() if platform in served), platform)
+
+
 def _has_kernel(platform: str) -> bool:
     """A real kernel (not the stand-in that only raises a clear error) serves ``platform``."""
-    built = {p for lib in _State.build_info.get("libraries", {}) if lib != "api" for p in SERVES.get(lib, (lib,))}
-    return platform in built and platform not in _State.plugin_errors and _supports(platform)
+    lib = _library_of(platform)
+    return (lib in _State.build_info.get("libraries", {}) and lib not in _State.plugin_errors
+            and _supports(platform))
 
 
 def details() -> dict:
@@ -152,7 +167,7 @@ def details() -> dict:
         elif _has_kernel(p):
             out[p] = "native"
         else:
-            lib = next((k for k, served in SERVES.items() if p in served), p)
+            lib = _library_of(p)
             out[p] = (st.plugin_errors.get(lib) or st.build_info.get("skipped", {}).get(lib)
                       or f"openmm_symprk has no kernel for the {p} platform")
     return out

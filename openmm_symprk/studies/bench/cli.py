@@ -26,6 +26,35 @@ def _list(values):
     return out
 
 
+def _positive_float(text):
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
+    if not value > 0:
+        raise argparse.ArgumentTypeError(f"must be positive, got {text}")
+    return value
+
+
+def _check_platform(name):
+    import openmm as mm
+
+    names = [mm.Platform.getPlatform(i).getName() for i in range(mm.Platform.getNumPlatforms())]
+    if name not in names:
+        raise ValueError(f"unknown OpenMM platform {name!r}; this installation has {', '.join(names)}")
+
+
+def _check_out(out: str):
+    """The output folder must be a folder we can write (not a file, not read-only)."""
+    if os.path.exists(out) and not os.path.isdir(out):
+        raise ValueError(f"--out {out} is a file; give a folder for the sweep's results")
+    parent = out
+    while parent and not os.path.exists(parent):
+        parent = os.path.dirname(parent)
+    if not os.access(parent or ".", os.W_OK):
+        raise ValueError(f"--out {out}: {os.path.abspath(parent or '.')} is not writable")
+
+
 def build_parser() -> argparse.ArgumentParser:
     from .registry import SCENES
 
@@ -40,7 +69,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--methods", nargs="+", metavar="NAME",
                    help="rows: catalogue names (symprk methods) and/or openmm-verlet, openmm-langevin")
     p.add_argument("--steps-fs", nargs="+", metavar="H", help="step sizes (fs) for every selected scene")
-    p.add_argument("--length-ps", type=float, help="run length (ps) for every selected scene")
+    p.add_argument("--length-ps", type=_positive_float, help="run length (ps) for every selected scene")
     p.add_argument("--no-stability", action="store_true", help="skip the stability searches")
     p.add_argument("--workers", type=int, default=2, help="local worker processes (<= 1: in this process)")
     p.add_argument("--scheduler", metavar="ADDRESS",
@@ -80,7 +109,17 @@ def make_config(args) -> dict:
             scenes = [args.name]
         elif args.name not in scenes:
             scenes.append(args.name)
-    steps = [float(h) for h in _list(args.steps_fs)] if args.steps_fs else None
+    steps = None
+    if args.steps_fs:
+        try:
+            steps = [float(h) for h in _list(args.steps_fs)]
+        except ValueError:
+            raise ValueError(f"--steps-fs takes numbers of femtoseconds, got {' '.join(args.steps_fs)}") from None
+        bad = [h for h in steps if not h > 0]
+        if bad:
+            raise ValueError(f"--steps-fs must be positive, got {', '.join(f'{h:g}' for h in bad)}")
+    if args.platform:
+        _check_platform(args.platform)
     cfg = presets.select(base, scenes=scenes, methods=_list(args.methods), steps_fs=steps,
                          length_ps=args.length_ps, stability=not args.no_stability)
     if args.platform:
@@ -104,14 +143,15 @@ def main(argv=None) -> int:
         with open(path) as fh:
             print(format_summary(json.load(fh)))
         return 0
-    from .sweep import SweepExistsError, run_sweep
+    from .sweep import SweepExistsError, SweepLockedError, run_sweep
 
     try:
+        _check_out(out)
         cfg = make_config(args)
         results = run_sweep(cfg, out, workers=args.workers, scheduler=args.scheduler, resume=args.resume,
                             charts=not args.no_charts, progress=not args.no_progress)
-    except (SweepExistsError, ValueError, ImportError, FileNotFoundError) as exc:
-        print(f"symprk bench: {exc}", file=sys.stderr)
+    except (SweepExistsError, SweepLockedError, ValueError, ImportError, OSError) as exc:
+        print(f"symprk bench: error: {exc}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
         return 130

@@ -38,6 +38,31 @@ class SweepExistsError(RuntimeError):
     """The output folder already holds finished runs and resume was not asked for."""
 
 
+class SweepLockedError(RuntimeError):
+    """Another sweep is running on the same output folder."""
+
+
+class _FolderLock:
+    """An exclusive lock on ``<out>/.lock`` for the life of a sweep (released when the process ends)."""
+
+    def __init__(self, out: str):
+        import fcntl
+
+        self.fh = open(os.path.join(out, ".lock"), "w")
+        try:
+            fcntl.flock(self.fh, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            self.fh.close()
+            raise SweepLockedError(f"another symprk bench is running on {out}: wait for it, or use another --out") \
+                from None
+
+    def release(self):
+        import fcntl
+
+        fcntl.flock(self.fh, fcntl.LOCK_UN)
+        self.fh.close()
+
+
 class _Job:
     def __init__(self, kind, gen, scene, method, estimate=1, cost=1.0):
         self.kind, self.gen, self.scene, self.method = kind, gen, scene, method
@@ -213,9 +238,17 @@ def run_sweep(config: dict, out: str, workers: int = 2, scheduler: str | None = 
 
     Returns the results dict (see :func:`.aggregate.aggregate`), with ``stats`` = runs computed now and
     runs taken from disk."""
+    os.makedirs(out, exist_ok=True)
+    lock = _FolderLock(out)
+    try:
+        return _sweep(config, out, workers, scheduler, resume, charts, progress, on_result, log)
+    finally:
+        lock.release()
+
+
+def _sweep(config, out, workers, scheduler, resume, charts, progress, on_result, log) -> dict:
     from .aggregate import aggregate, format_summary
 
-    os.makedirs(out, exist_ok=True)
     store = Store(out)
     if not resume and len(store):
         raise SweepExistsError(f"{out} already holds {len(store)} finished runs: pass resume=True (--resume) to "

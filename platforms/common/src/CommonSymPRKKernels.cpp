@@ -7,7 +7,9 @@
 #include "openmm/internal/ContextImpl.h"
 #include <algorithm>
 #include <climits>
+#include <cmath>
 #include <map>
+#include <vector>
 
 using namespace OpenMM;
 using namespace std;
@@ -145,6 +147,17 @@ void CommonIntegrateSymPRKStepKernel::execute(ContextImpl& context, const SymPRK
             lastVelocityStep = s;
     const int check = (int) min(stepIndex, (long long) INT_MAX);
 
+    // Velocity projections before every drift whose |coefficient| exceeds the previous drift's (the rule of
+    // openmm_symprk.methods.splitting.Splitting.projected_drifts; see the Reference kernel).
+    vector<bool> projectBefore(numSubsteps, false);
+    double previousDrift = 0.0;
+    for (int s = 0; s < numSubsteps; s++)
+        if (integrator.getSubstepKind(s) == SymPRKIntegrator::Drift) {
+            double c = integrator.getSubstepCoefficient(s);
+            projectBefore[s] = (hasConstraints && previousDrift != 0.0 && fabs(c) > fabs(previousDrift));
+            previousDrift = c;
+        }
+
     if (context.updateContextState())
         forcesAreValid = false;
     for (int s = 0; s < numSubsteps; s++) {
@@ -169,6 +182,8 @@ void CommonIntegrateSymPRKStepKernel::execute(ContextImpl& context, const SymPRK
             }
         }
         else {
+            if (projectBefore[s])
+                projectVelocities(tol, exact);
             if (hasConstraints) {
                 setMixedArg(driftDeltaKernel, 0, cdt);
                 driftDeltaKernel->execute(numAtoms);
@@ -193,23 +208,28 @@ void CommonIntegrateSymPRKStepKernel::execute(ContextImpl& context, const SymPRK
             forcesAreValid = false;
         }
     }
-    if (hasConstraints) {
-        if (exact) {
-            cc.getVelm().copyTo(vBefore);
-            integration.applyVelocityConstraints(tol);
-            rigidSumsKernel->setArg(0, 1);
-            setMixedArg(rigidSumsKernel, 1, 1.0);
-            rigidSumsKernel->execute(projectionBlockSize, projectionBlockSize);
-            rigidApplyKernel->execute(numAtoms);
-        }
-        else
-            integration.applyVelocityConstraints(tol);
-    }
+    if (hasConstraints)
+        projectVelocities(tol, exact);
     cc.setTime(cc.getTime()+dt);
     cc.setStepCount(cc.getStepCount()+1);
     cc.reorderAtoms();
     if (cc.getAtomsWereReordered())
         forcesAreValid = false;
+}
+
+void CommonIntegrateSymPRKStepKernel::projectVelocities(double tol, bool exact) {
+    IntegrationUtilities& integration = cc.getIntegrationUtilities();
+    if (!exact) {
+        integration.applyVelocityConstraints(tol);
+        return;
+    }
+    // Exact momentum: remove the round-off net momentum and torque of the velocity-constraint impulses.
+    cc.getVelm().copyTo(vBefore);
+    integration.applyVelocityConstraints(tol);
+    rigidSumsKernel->setArg(0, 1);
+    setMixedArg(rigidSumsKernel, 1, 1.0);
+    rigidSumsKernel->execute(projectionBlockSize, projectionBlockSize);
+    rigidApplyKernel->execute(cc.getNumAtoms());
 }
 
 double CommonIntegrateSymPRKStepKernel::computeKineticEnergy(ContextImpl& context, const SymPRKIntegrator& integrator) {

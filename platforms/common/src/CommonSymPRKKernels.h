@@ -33,6 +33,7 @@ public:
     void setBlowUpStep(ContextImpl& context, long long step);
 private:
     void setMixedArg(ComputeKernel& kernel, int index, double value);
+    void projectVelocities(double tol, bool exact);
     ComputeContext& cc;
     bool hasInitializedKernels, hasConstraints;
     int projectionBlockSize;

@@ -194,6 +194,25 @@ void ReferenceIntegrateSymPRKStepKernel::removeRigidChange(const vector<Vec3>& p
     });
 }
 
+void ReferenceIntegrateSymPRKStepKernel::projectVelocities(vector<Vec3>& pos, vector<Vec3>& vel, double tol, bool exact) {
+    ReferenceConstraintAlgorithm& constraints = *data.constraints;
+    if (!exact) {
+        constraints.applyToVelocities(pos, vel, inverseMasses, tol);
+        return;
+    }
+    // Exact momentum: remove the round-off net momentum and torque of the velocity-constraint impulses.
+    vBefore = vel;
+    constraints.applyToVelocities(pos, vel, inverseMasses, tol);
+    Vec3 dP, dL;
+    for (int i = 0; i < numParticles; i++)
+        if (masses[i] != 0.0) {
+            Vec3 impulse = (vel[i]-vBefore[i])*masses[i];
+            dP += impulse;
+            dL += pos[i].cross(impulse);
+        }
+    removeRigidChange(pos, vel, dP, dL);
+}
+
 void ReferenceIntegrateSymPRKStepKernel::execute(ContextImpl& context, const SymPRKIntegrator& integrator, bool& forcesAreValid, long long stepIndex) {
     vector<Vec3>& pos = *data.positions;
     vector<Vec3>& vel = *data.velocities;
@@ -254,7 +273,18 @@ void ReferenceIntegrateSymPRKStepKernel::execute(ContextImpl& context, const Sym
             vsites.computePositions(*system, pos, data.periodicBoxVectors);
         forcesAreValid = false;
     };
+    // Velocity projections inside the step, before every drift whose |coefficient| exceeds the previous drift's
+    // (the rule of openmm_symprk.methods.splitting.Splitting.projected_drifts): a no-op in exact arithmetic that
+    // keeps the constraint solver's residual from being amplified from drift to drift.
     const int numSubsteps = integrator.getNumSubsteps();
+    vector<bool> projectBefore(numSubsteps, false);
+    double previousDrift = 0.0;
+    for (int s = 0; s < numSubsteps; s++)
+        if (integrator.getSubstepKind(s) == SymPRKIntegrator::Drift) {
+            double c = integrator.getSubstepCoefficient(s);
+            projectBefore[s] = (hasConstraints && previousDrift != 0.0 && fabs(c) > fabs(previousDrift));
+            previousDrift = c;
+        }
     for (int s = 0; s < numSubsteps; ) {
         const double cdt = integrator.getSubstepCoefficient(s)*dt;
         if (integrator.getSubstepKind(s) == SymPRKIntegrator::Kick) {
@@ -262,7 +292,8 @@ void ReferenceIntegrateSymPRKStepKernel::execute(ContextImpl& context, const Sym
                 context.calcForcesAndEnergy(true, false, groups);
                 forcesAreValid = true;
             }
-            const bool fuse = (s+1 < numSubsteps);  // kinds alternate: the next sub-step is a drift
+            // kinds alternate: the next sub-step is a drift, which shares this pass unless it projects first
+            const bool fuse = (s+1 < numSubsteps && !projectBefore[s+1]);
             const double cdtDrift = (fuse ? integrator.getSubstepCoefficient(s+1)*dt : 0.0);
             if (exact) {
                 computeProjection(pos, force);
@@ -296,6 +327,8 @@ void ReferenceIntegrateSymPRKStepKernel::execute(ContextImpl& context, const Sym
                 s += 1;
         }
         else {
+            if (projectBefore[s])
+                projectVelocities(pos, vel, tol, exact);
             parallelFor([&] (int t, int start, int end) {
                 for (int i = start; i < end; i++)
                     driftAtom(i, cdt);
@@ -304,22 +337,8 @@ void ReferenceIntegrateSymPRKStepKernel::execute(ContextImpl& context, const Sym
             s += 1;
         }
     }
-    if (hasConstraints) {
-        if (exact) {
-            vBefore = vel;
-            constraints.applyToVelocities(pos, vel, inverseMasses, tol);
-            Vec3 dP, dL;
-            for (int i = 0; i < numParticles; i++)
-                if (masses[i] != 0.0) {
-                    Vec3 impulse = (vel[i]-vBefore[i])*masses[i];
-                    dP += impulse;
-                    dL += pos[i].cross(impulse);
-                }
-            removeRigidChange(pos, vel, dP, dL);
-        }
-        else
-            constraints.applyToVelocities(pos, vel, inverseMasses, tol);
-    }
+    if (hasConstraints)
+        projectVelocities(pos, vel, tol, exact);
 
     // Record the first step that leaves a velocity NaN, infinite or beyond the blow-up speed (NaN fails every <=).
     if (blowUpStep == 0) {

@@ -35,6 +35,7 @@ private:
     void parallelFor(const std::function<void(int, int, int)>& task);
     void computeProjection(const std::vector<Vec3>& pos, const std::vector<Vec3>& force);
     void removeRigidChange(const std::vector<Vec3>& pos, std::vector<Vec3>& vel, Vec3 dP, Vec3 dL);
+    void projectVelocities(std::vector<Vec3>& pos, std::vector<Vec3>& vel, double tol, bool exact);
     static Vec3 solveInertia(Vec3 diag, Vec3 offdiag, Vec3 rhs);
     ReferencePlatform::PlatformData& data;
     const System* system;

@@ -1,0 +1,120 @@
+"""The ``symprk`` command: what it prints, and one clear line and a non-zero exit for every bad input."""
+import json
+import subprocess
+import sys
+
+import pytest
+
+from openmm_symprk import plugin
+from openmm_symprk.cli import main
+
+
+def _run(argv, capsys):
+    rc = main(argv)
+    out = capsys.readouterr()
+    return rc, out.out, out.err
+
+
+def test_demo_prints_every_row_with_its_backend(capsys):
+    rc, out, _ = _run(["demo", "--waters", "8", "--steps", "40", "--method", "verlet", "yoshida-4"], capsys)
+    assert rc == 0
+    rows = [line.split() for line in out.splitlines() if line.startswith(("OpenMM VerletIntegrator ", "symprk "))]
+    assert [r[:3] for r in rows] == [["OpenMM", "VerletIntegrator", "OpenMM"],
+                                     ["symprk", "verlet", "native" if plugin.available() else "custom"],
+                                     ["symprk", "yoshida-4", "native" if plugin.available() else "custom"]]
+    ratio = float(rows[0][-1])
+    assert ratio == 1.0 and int(rows[2][-2]) == 3  # the time ratio of Verlet itself; f/step of yoshida-4
+    for r in rows:
+        assert float(r[4]) < 1e-9  # |dP| of a 40-step run of an isolated cluster
+
+
+def test_demo_custom_backend(capsys):
+    rc, out, _ = _run(["demo", "--waters", "4", "--steps", "10", "--method", "omelyan-2", "--backend", "custom"], capsys)
+    assert rc == 0 and "symprk omelyan-2" in out and " custom " in out
+
+
+@pytest.mark.parametrize("argv,message", [
+    (["demo", "--platform", "Nosuch"], "unknown OpenMM platform 'Nosuch'; this installation has Reference"),
+    (["demo", "--waters", "2", "--steps", "50", "--step-fs", "100", "--method", "verlet"], "blew up at integrator step"),
+    (["demo", "--method", "verlett"], "Did you mean 'verlet'"),
+    (["methods", "pefrll"], "Did you mean 'pefrl'"),
+])
+def test_errors_are_one_line_and_exit_2(argv, message, capsys):
+    rc, _, err = _run(argv, capsys)
+    assert rc == 2 and message in err and len(err.strip().splitlines()) == 1 and "Traceback" not in err
+
+
+@pytest.mark.parametrize("argv,message", [(["demo", "--steps", "0"], "must be positive, got 0"),
+                                          (["demo", "--step-fs", "-1"], "must be positive, got -1"),
+                                          (["demo", "--waters", "x"], "'x' is not a number")])
+def test_bad_numbers_are_refused_by_the_parser(argv, message, capsys):
+    with pytest.raises(SystemExit) as exc:
+        main(argv)
+    assert exc.value.code == 2 and message in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("content,name,message", [
+    ("{not json", "t.json", "is not valid JSON"),
+    ('{"A": [[0]]}', "t.json", "must hold a table with A and b"),
+    ("A = [[0.0", "t.toml", "is not valid TOML"),
+    ('{"A": [[0, 0], [1, 0]], "b": [0.5]}', "t.json", "b has 1 stages"),
+])
+def test_check_reports_malformed_files(content, name, message, tmp_path, capsys):
+    path = tmp_path / name
+    path.write_text(content)
+    rc, _, err = _run(["check", str(path)], capsys)
+    assert rc == 2 and message in err
+
+
+def test_check_a_good_tableau(tmp_path, capsys):
+    path = tmp_path / "leapfrog.json"
+    path.write_text(json.dumps({"A": [[0, 0], [0.5, 0.5]], "b": [0.5, 0.5], "A_hat": [[0.5, 0], [0.5, 0]],
+                                "b_hat": [0.5, 0.5]}))
+    rc, out, _ = _run(["check", str(path)], capsys)
+    assert rc == 0 and "symplectic for MD (condition (6)): True" in out and "measured order on Henon-Heiles: 2.0" in out
+    assert main(["check", str(tmp_path / "missing.json")]) == 2
+
+
+def test_methods_and_info(capsys):
+    rc, out, _ = _run(["methods", "pefrl"], capsys)
+    assert rc == 0 and "pefrl" in out and "sequence (applied left to right)" in out
+    rc, out, _ = _run(["info"], capsys)
+    assert rc == 0 and "platform Reference" in out and "catalogue: 28 methods" in out
+    rc, _, err = _run(["info", "--require-native", "Nosuch"], capsys)
+    assert rc == 2 and "does not serve Nosuch" in err
+
+
+@pytest.mark.parametrize("argv,message", [
+    (["--steps-fs", "0", "--quick"], "--steps-fs must be positive"),
+    (["--platform", "Nosuch", "--quick"], "unknown OpenMM platform 'Nosuch'"),
+    (["--scenes", "nosuch", "--quick"], "unknown scene"),
+])
+def test_bench_errors(argv, message, tmp_path, capsys):
+    rc = main(["bench", "--out", str(tmp_path / "b"), "--no-progress", *argv])
+    err = capsys.readouterr().err
+    assert rc == 2 and message in err and "Traceback" not in err
+
+
+def test_bench_out_must_be_a_writable_folder(tmp_path, capsys):
+    afile = tmp_path / "results.txt"
+    afile.write_text("x")
+    assert main(["bench", "--quick", "--out", str(afile), "--no-progress"]) == 2
+    assert "is a file" in capsys.readouterr().err
+
+
+def test_two_sweeps_on_one_folder_are_refused(tmp_path):
+    from openmm_symprk.studies.bench.sweep import SweepLockedError, _FolderLock
+
+    lock = _FolderLock(str(tmp_path))
+    code = ("import sys; from openmm_symprk.studies.bench.sweep import _FolderLock, SweepLockedError\n"
+            "try:\n    _FolderLock(sys.argv[1])\nexcept SweepLockedError as e:\n    print(e); sys.exit(3)\n")
+    res = subprocess.run([sys.executable, "-c", code, str(tmp_path)], capture_output=True, text=True)
+    assert res.returncode == 3 and "another symprk bench is running" in res.stdout
+    lock.release()
+    assert subprocess.run([sys.executable, "-c", code, str(tmp_path)]).returncode == 0
+    assert SweepLockedError
+
+
+def test_console_script_is_installed():
+    res = subprocess.run([sys.executable, "-m", "openmm_symprk.cli", "methods"], capture_output=True, text=True)
+    assert res.returncode == 0 and "sofroniou-spaletta-10" in res.stdout

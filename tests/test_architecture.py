@@ -1,0 +1,142 @@
+"""The package's layout, checked from the source: layers import downward only, no import cycles (lazy imports
+included), no private names imported across modules, and the pure numerics never import OpenMM."""
+import ast
+import os
+import subprocess
+import sys
+
+import pytest
+
+import openmm_symprk
+
+ROOT = os.path.dirname(openmm_symprk.__file__)
+#: Layer of each sub-package (a module may import from lower layers and from its own sub-package).
+LAYERS = {"methods": 0, "physics": 0, "plugin": 0, "systems": 1, "integrators": 2, "conservation": 3, "rigid": 3,
+          "studies": 4, "cli": 5}
+PURE = ("methods", "physics")
+
+
+def _modules():
+    out = {}
+    for folder, dirs, files in os.walk(ROOT):
+        dirs[:] = [d for d in dirs if not d.startswith((".", "_"))]
+        for f in files:
+            if f.endswith(".py") and f != "symprk_swig.py":  # the SWIG-generated wrapper is a build output
+                path = os.path.join(folder, f)
+                rel = os.path.relpath(path, os.path.dirname(ROOT))[:-3].replace(os.sep, ".")
+                out[rel[:-len(".__init__")] if rel.endswith(".__init__") else rel] = path
+    return out
+
+
+MODULES = _modules()
+
+
+def _imports(name, path):
+    """(target module, imported names, lazy?) for every import of the package inside ``name``."""
+    tree = ast.parse(open(path).read())
+    is_pkg = path.endswith("__init__.py")
+    top_level = {id(n) for n in tree.body}
+    found = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.ImportFrom):
+            if node.level:
+                base = name.split(".") if is_pkg else name.split(".")[:-1]
+                base = base[:len(base) - node.level + 1]
+                target = ".".join(base + ([node.module] if node.module else []))
+            else:
+                target = node.module or ""
+            if target.split(".")[0] == "openmm_symprk":
+                for alias in node.names:
+                    full = f"{target}.{alias.name}"
+                    found.append((full if full in MODULES else target, alias.name, id(node) not in top_level))
+        elif isinstance(node, ast.Import):
+            for alias in node.names:
+                if alias.name.split(".")[0] == "openmm_symprk":
+                    found.append((alias.name, None, id(node) not in top_level))
+    return found
+
+
+def _layer(module):
+    parts = module.split(".")
+    return LAYERS.get(parts[1]) if len(parts) > 1 else None
+
+
+def test_layers_import_downward_only():
+    wrong = []
+    for name, path in MODULES.items():
+        mine = _layer(name)
+        if mine is None:
+            continue  # the package's facade, openmm_symprk/__init__.py
+        for target, _, _ in _imports(name, path):
+            theirs = _layer(target)
+            if target == "openmm_symprk" and not name.startswith("openmm_symprk.cli"):
+                wrong.append(f"{name} imports the package facade")
+            elif theirs is not None and theirs >= mine and target.split(".")[1] != name.split(".")[1]:
+                wrong.append(f"{name} (layer {mine}) imports {target} (layer {theirs})")
+    assert not wrong, "\n".join(wrong)
+
+
+def test_no_import_cycles_lazy_imports_included():
+    graph = {m: set() for m in MODULES}
+    for name, path in MODULES.items():
+        for target, _, _ in _imports(name, path):
+            if target in MODULES and target != name and not name.startswith(target + "."):
+                graph[name].add(target)
+    index, low, stack, on, cycles = {}, {}, [], set(), []
+
+    def visit(v):
+        index[v] = low[v] = len(index)
+        stack.append(v)
+        on.add(v)
+        for w in graph[v]:
+            if w not in index:
+                visit(w)
+                low[v] = min(low[v], low[w])
+            elif w in on:
+                low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            comp = []
+            while True:
+                w = stack.pop()
+                on.discard(w)
+                comp.append(w)
+                if w == v:
+                    break
+            if len(comp) > 1:
+                cycles.append(sorted(comp))
+
+    sys.setrecursionlimit(10000)
+    for v in graph:
+        if v not in index:
+            visit(v)
+    assert not cycles, cycles
+
+
+def test_no_private_names_imported_across_modules():
+    private = [f"{name} <- {target}.{alias}" for name, path in MODULES.items()
+               for target, alias, _ in _imports(name, path)
+               if alias and alias.startswith("_") and not alias.startswith("__") and target != name]
+    assert not private, private
+
+
+@pytest.mark.parametrize("package", PURE)
+def test_pure_numerics_do_not_import_openmm(package):
+    for name, path in MODULES.items():
+        if name.split(".")[1:2] == [package]:
+            tree = ast.parse(open(path).read())
+            for node in ast.walk(tree):
+                mods = [a.name for a in node.names] if isinstance(node, ast.Import) else (
+                    [node.module or ""] if isinstance(node, ast.ImportFrom) and not node.level else [])
+                assert not any(m.split(".")[0] in ("openmm", "simtk") for m in mods), (name, mods)
+    # and at run time: importing the package's pure layers loads no OpenMM module
+    code = (f"import importlib.util, sys; sys.modules['openmm'] = None\n"
+            f"spec = importlib.util.spec_from_file_location('pure', {os.path.join(ROOT, package, '__init__.py')!r}, "
+            f"submodule_search_locations=[{os.path.join(ROOT, package)!r}])\n"
+            f"mod = importlib.util.module_from_spec(spec); sys.modules['pure'] = mod; spec.loader.exec_module(mod)\n")
+    res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert res.returncode == 0, res.stderr[-2000:]
+
+
+def test_few_modules_at_the_package_root():
+    root = sorted(f for f in os.listdir(ROOT) if f.endswith(".py"))
+    assert root == ["__init__.py", "cli.py"], root
