@@ -156,10 +156,11 @@ def build_parser():
 
 #: sub-commands whose own argument parser lives in another module (argv passed through untouched)
 DELEGATED = {"bench": "openmm_symprk.studies.bench.cli", "conservation": "openmm_symprk.studies.conservation_table",
-             "speed": "openmm_symprk.studies.native_speed"}
+             "speed": "openmm_symprk.studies.native_speed", "gpucheck": "openmm_symprk.studies.gpucheck"}
 DELEGATED_HELP = {"bench": "work-precision and stability sweeps (symprk bench --help)",
                   "conservation": "conservation table: platform x method x projection (symprk conservation --help)",
-                  "speed": "native backend vs OpenMM's VerletIntegrator, time per step (symprk speed --help)"}
+                  "speed": "native backend vs OpenMM's VerletIntegrator, time per step (symprk speed --help)",
+                  "gpucheck": "the native backend on CUDA: same program, conservation, speed (needs a GPU)"}
 
 
 def _user_errors():

@@ -20,10 +20,12 @@ the System's issues and thermostatting integrators, one :class:`ConservationWarn
 :class:`VelocityTRRReporter` writes positions (nm), velocities (nm/ps), step and time to a GROMACS TRR
 file with MDAnalysis' XDR library (no extra dependency); MDAnalysis reads it back with velocities.
 TRR stores float32: figures recomputed from the file are limited to ~1e-7 relative
-(:mod:`openmm_symprk.conservation.analysis`).  :func:`write_topology` writes the matching PDB.
+(:mod:`openmm_symprk.conservation.analysis`).  Each frame is complete on disk when ``report()`` returns, so
+the file can be read while the simulation runs.  :func:`write_topology` writes the matching PDB.
 """
 from __future__ import annotations
 
+import os
 import sys
 
 import numpy as np
@@ -159,29 +161,37 @@ class ConservationReporter:
 class VelocityTRRReporter:
     """Write positions, velocities, step and time to a GROMACS TRR file (float32, nm and nm/ps).
 
-    MDAnalysis reads it with velocities: ``mda.Universe("top.pdb", "traj.trr")`` (MDAnalysis converts
-    to Angstrom and Angstrom/ps).  ``append=True`` rewrites the existing frames first (the XDR library
-    cannot append in place).  Virtual sites are written like any particle."""
+    Every frame is on disk, complete and readable, when ``report()`` returns: a TRR file is a sequence of
+    self-contained frames, so each report is encoded by MDAnalysis' XDR library into a one-frame buffer and
+    appended to the trajectory with a flush.  Another process (a notebook, a monitor) can read the file while
+    the simulation runs; ``append=True`` (a restart) adds frames after the existing ones without rewriting
+    them.  MDAnalysis reads it with velocities: ``mda.Universe("top.pdb", "traj.trr")`` (MDAnalysis converts
+    to Angstrom and Angstrom/ps), or :func:`openmm_symprk.conservation.analysis.universe`.  Virtual sites are
+    written like any particle."""
 
     def __init__(self, file: str, reportInterval: int, append: bool = False, forces: bool = False):
-        from MDAnalysis.lib.formats.libmdaxdr import TRRFile
+        import tempfile
+
+        from MDAnalysis.lib.formats.libmdaxdr import TRRFile  # noqa: F401 (fail here, not at the first report)
 
         if int(reportInterval) < 1:
             raise ValueError(f"reportInterval must be a positive number of steps, got {reportInterval!r}")
         self._interval = int(reportInterval)
         self._forces = forces
-        old = []
-        if append:
-            try:
-                with TRRFile(file, "r") as f:
-                    old = [fr for fr in f]
-            except OSError:
-                old = []
-        self._trr = TRRFile(file, "w")
-        for fr in old:
-            self._trr.write(fr.x if fr.hasx else None, fr.v if fr.hasv else None, fr.f if fr.hasf else None,
-                            fr.box, fr.step, fr.time, fr.lmbda, len(fr.x) if fr.hasx else len(fr.v))
-        self.frames = len(old)
+        self.path = str(file)
+        self.frames = self._count_frames() if append else 0
+        with open(self.path, "ab" if append else "wb"):
+            pass  # create (or keep) the file now: a bad path fails here, not after the first segment
+        fd, self._buffer = tempfile.mkstemp(suffix=".trr", prefix="symprk-frame-")
+        os.close(fd)
+
+    def _count_frames(self) -> int:
+        from MDAnalysis.lib.formats.libmdaxdr import TRRFile
+
+        if not os.path.exists(self.path) or os.path.getsize(self.path) == 0:
+            return 0
+        with TRRFile(self.path, "r") as f:
+            return len(f.offsets)
 
     def describeNextReport(self, simulation):
         steps = self._interval - simulation.currentStep % self._interval
@@ -189,6 +199,8 @@ class VelocityTRRReporter:
         return {"steps": steps, "periodic": False, "include": include}
 
     def report(self, simulation, state):
+        from MDAnalysis.lib.formats.libmdaxdr import TRRFile
+
         x = np.asarray(state.getPositions(asNumpy=True).value_in_unit(_NM), dtype=np.float32)
         v = np.asarray(state.getVelocities(asNumpy=True).value_in_unit(_NM_PS), dtype=np.float32)
         f = None
@@ -197,14 +209,22 @@ class VelocityTRRReporter:
         box = np.zeros((3, 3), dtype=np.float32)
         if simulation.system.usesPeriodicBoundaryConditions():
             box = np.asarray(state.getPeriodicBoxVectors(asNumpy=True).value_in_unit(_NM), dtype=np.float32)
-        self._trr.write(x, v, f, box, int(simulation.currentStep), float(state.getTime().value_in_unit(unit.picosecond)),
+        with TRRFile(self._buffer, "w") as frame:
+            frame.write(x, v, f, box, int(simulation.currentStep), float(state.getTime().value_in_unit(unit.picosecond)),
                         0.0, len(x))
+        with open(self._buffer, "rb") as src:
+            data = src.read()
+        with open(self.path, "ab") as out:
+            out.write(data)
+            out.flush()
+            os.fsync(out.fileno())
         self.frames += 1
 
     def close(self):
-        if self._trr is not None:
-            self._trr.close()
-            self._trr = None
+        """Remove the one-frame buffer (the trajectory itself is always complete)."""
+        if getattr(self, "_buffer", None) and os.path.exists(self._buffer):
+            os.remove(self._buffer)
+        self._buffer = None
 
     def __del__(self):
         try:

@@ -57,7 +57,7 @@ class Method:
 
         A composition of position Verlet (DKD) loses its order under constraints, because the
         drift-first step with SHAKE projections is not the symmetric RATTLE step; the same weights
-        composed over velocity Verlet (RATTLE, KDK) keep the order (THEORY.md section 2) at the same
+        composed over velocity Verlet (RATTLE, KDK) keep the order (docs/theory.md, section 2) at the same
         force-evaluation count.  Every other splitting is compiled as it is."""
         if self.family == "composition" and self.base != "verlet":
             return compose(methods["verlet"].splitting, self.weights)

@@ -7,7 +7,7 @@ For q' = f(p), p' = g(q) (separable H; in MD f = M^-1 p, g = F(q)) an s-stage PR
 
 Reich (1994), Thm 2.1: the method conserves every bilinear invariant q^T W p (angular momentum) and is
 symplectic if (6) B Ahat + A^T Bhat - b bhat^T = 0 and (7) b = bhat.  For separable H, (6) alone
-gives symplecticity and conservation of angular momentum (THEORY.md section 1).
+gives symplecticity and conservation of angular momentum (docs/theory.md, section 1).
 """
 from __future__ import annotations
 
@@ -161,7 +161,7 @@ class PRKTableau:
     # -- conversions --------------------------------------------------------------------
     @classmethod
     def from_splitting(cls, splitting: Splitting | Sequence, name=None, dtype=np.float64) -> "PRKTableau":
-        """PRK form of a kick/drift sequence (THEORY.md section 1).
+        """PRK form of a kick/drift sequence (docs/theory.md, section 1).
 
         The sequence is padded to pairs K(beta_1) D(alpha_1) ... K(beta_s) D(alpha_s); then
         A[i,j] = alpha_j (j < i), b = alpha, A_hat[i,j] = beta_j (j <= i), b_hat = beta."""

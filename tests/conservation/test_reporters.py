@@ -96,9 +96,41 @@ def test_trr_reporter_round_trip(water8, tmp_path):
     v = st.getVelocities(asNumpy=True)._value * 10
     assert np.allclose(ts.positions, x, rtol=1e-6, atol=1e-5)  # float32
     assert np.allclose(ts.velocities, v, rtol=1e-6, atol=1e-5)
-    # append rewrites the old frames and continues
+    # append continues after the old frames without rewriting them: the first bytes are untouched
+    before = open(trr, "rb").read()
     rep2 = VelocityTRRReporter(trr, 25, append=True)
+    assert rep2.frames == 4
     sim.reporters[0] = rep2
     sim.step(50)
     rep2.close()
+    assert open(trr, "rb").read().startswith(before)
     assert len(mda.Universe(pdb, trr).trajectory) == 6
+
+
+_READER = """
+import sys, warnings
+warnings.simplefilter("ignore")
+from openmm_symprk.conservation.analysis import AngularMomentum
+import MDAnalysis as mda
+u = mda.Universe(sys.argv[1], sys.argv[2])
+L = AngularMomentum(u.atoms).run()
+print(len(u.trajectory), u.trajectory[-1].data["step"], float(abs(L.results.relative_drift).max()))
+"""
+
+
+def test_trr_is_readable_by_another_process_after_every_report(water8, tmp_path):
+    """No close(), no garbage collection: after each report the file on disk holds every frame so far."""
+    import subprocess
+    import sys
+
+    trr, pdb = str(tmp_path / "live.trr"), str(tmp_path / "live.pdb")
+    write_topology(pdb, water8.topology, water8.positions)
+    sim = _simulation(water8)
+    sim.reporters.append(VelocityTRRReporter(trr, 10))
+    for n in (1, 3):
+        sim.step(10 * n - sim.currentStep)
+        res = subprocess.run([sys.executable, "-c", _READER, pdb, trr], capture_output=True, text=True, timeout=120)
+        assert res.returncode == 0, res.stderr[-2000:]
+        frames, step, drift = res.stdout.split()
+        assert int(frames) == n and int(step) == 10 * n
+        assert float(drift) < 1e-5  # the float32 floor of a stored trajectory, not a broken frame

@@ -34,7 +34,7 @@ def test_reich_residuals_exact_values():
     iiia_iiib = methods["lobatto-iiia-iiib-3"].tableau()
     assert iiia_iiib.residual_6 < 1e-15 and iiia_iiib.residual_7 == 0.0
     assert iiia_iiib.is_symplectic_general
-    # Lobatto IIIA paired with itself: the residual of (6) is 1/36 (METHODS.md)
+    # Lobatto IIIA paired with itself: the residual of (6) is 1/36 (the catalogue's reference value)
     bad = PRKTableau(LOBATTO_IIIA, B3, LOBATTO_IIIA, B3)
     assert bad.residual_6 == pytest.approx(1 / 36, rel=1e-14)
     assert not bad.is_symplectic

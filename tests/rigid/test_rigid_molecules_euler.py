@@ -1,6 +1,6 @@
 """Cross-validation: a free rigid molecule in OpenMM (RATTLE) against the exact Euler solution.
 
-Reich's section 5 (THEORY.md §3) reduces RATTLE on SO(3) to a Lie-Poisson map of the body angular
+Reich's section 5 (docs/theory.md, section 3) reduces RATTLE on SO(3) to a Lie-Poisson map of the body angular
 momentum.  Here the constrained Cartesian system is run by SymplecticIntegrator on the Reference platform,
 the body-frame angular momentum is read from positions and velocities, and compared with
 openmm_symprk.rigidbody.exact_solution (Jacobi elliptic functions).

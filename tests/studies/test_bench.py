@@ -77,7 +77,7 @@ def test_interrupted_sweep_continues_and_loses_nothing(tmp_path):
     seen = []
 
     def stop_after_five(rec):
-        seen.append(rec["key"])
+        seen.append(rec.key)
         if len(seen) == 5:
             raise KeyboardInterrupt
 
@@ -98,7 +98,7 @@ def test_interrupted_sweep_continues_and_loses_nothing(tmp_path):
 
 
 def test_harmonic_stability_reproduces_catalogue_intervals():
-    """Bisection on the harmonic toy (the compiled OpenMM programs) against METHODS.md, within 1 %."""
+    """Bisection on the harmonic toy (the compiled OpenMM programs) against the catalogue's intervals, within 1 %."""
     scene = scenes.build("harmonic", n=8)
     settings = stability.linear_settings(scene.linear["omega_max"], rel_tol=1e-3)
     checked = []
@@ -107,8 +107,8 @@ def test_harmonic_stability_reproduces_catalogue_intervals():
         if cat is None or not math.isfinite(cat):
             continue
         res = stability.largest_stable_step(scene, name, settings)
-        assert res["status"] == "ok", res
-        x = res["x_stable"]
+        assert res.status == "ok", res
+        x = res.x_stable
         assert abs(x / cat - 1) < 0.01, (name, x, cat)
         checked.append(name)
     assert len(checked) >= 20
@@ -117,20 +117,20 @@ def test_harmonic_stability_reproduces_catalogue_intervals():
 def test_failing_runs_are_recorded_not_raised():
     flex = scenes.build("water-flexible", n_waters=4)
     rec, _ = execute(RunSpec("water-flexible", "verlet", 8.0, 200, 10, timing_s=0.01), flex)
-    assert rec["status"] == "failed" and rec["failed"] and rec["blew_up"]
-    assert rec["failure"].startswith(("blow-up", "energy"))
-    assert rec["traj_error"] is None and rec["wall_per_ps"] is None
+    assert rec.status == "failed" and rec.failed and rec.blew_up
+    assert rec.failure.startswith(("blow-up", "energy"))
+    assert rec.traj_error is None and rec.wall_per_ps is None
     rec, _ = execute(RunSpec("water-flexible", "openmm-verlet", 8.0, 200, 10), flex)
-    assert rec["status"] == "failed"
+    assert rec.status == "failed"
     rigid = scenes.build("water-rigid", n_waters=4)
     rec, _ = execute(RunSpec("water-rigid", "gauss-2", 1.0, 10, 2), rigid)
-    assert rec["status"] == "unsupported" and "constraints" in rec["failure"]
+    assert rec.status == "unsupported" and "constraints" in rec.failure
     rec, _ = execute(RunSpec("water-rigid", "no-such-method", 1.0, 10, 2), rigid)
-    assert rec["status"] == "error" and "no-such-method" in rec["failure"]
+    assert rec.status == "error" and "no-such-method" in rec.failure
     # a stability search on a scene where everything fails at the first probe still returns a result
     res = stability.largest_stable_step(flex, "verlet", {"h0_fs": 8.0, "cap_fs": 16.0, "grow": 2.0,
                                                          "rel_tol": 0.1, "probe_steps": 50, "samples": 5})
-    assert res["status"] == "ok" and res["h_fail_fs"] is not None
+    assert res.status == "ok" and res.h_fail_fs is not None
 
 
 def test_step_sizes_must_divide_the_run_length():
@@ -146,5 +146,24 @@ def test_dask_scheduler(tmp_path):
                                   dashboard_address=None) as cluster:
         res = run_sweep(cfg, str(tmp_path / "dask"), scheduler=cluster.scheduler_address, charts=False,
                         progress=False, log=lambda *a: None)
-    assert res["stats"]["computed"] == 4
-    assert all(r["status"] == "ok" for r in res["runs"] if r["step_fs"] == 1.0)
+    assert res.stats["computed"] == 4
+    assert all(r["status"] == "ok" for r in res.runs if r["step_fs"] == 1.0)
+
+
+def test_records_are_typed_and_versioned(tmp_path):
+    from openmm_symprk.studies.bench.records import SCHEMA_VERSION, RunRecord, SchemaError
+    from openmm_symprk.studies.bench.store import Store
+
+    rec = RunRecord("harmonic", "verlet", 1.0, 10)
+    with pytest.raises(AttributeError, match="no field.*energy_eror"):
+        rec.update(energy_eror=1.0)
+    store = Store(str(tmp_path))
+    store.put("k", rec.update(energy_error=0.5))
+    back = store.get("k")
+    assert isinstance(back, RunRecord) and back.energy_error == 0.5 and back.key == "k"
+    data = back.to_json()
+    assert data["schema"] == SCHEMA_VERSION
+    with pytest.raises(SchemaError, match="schema 1"):
+        RunRecord.from_json(dict(data, schema=1))
+    with pytest.raises(SchemaError, match="unknown field.*bogus"):
+        RunRecord.from_json(dict(data, bogus=1))

@@ -118,3 +118,13 @@ def test_two_sweeps_on_one_folder_are_refused(tmp_path):
 def test_console_script_is_installed():
     res = subprocess.run([sys.executable, "-m", "openmm_symprk.cli", "methods"], capture_output=True, text=True)
     assert res.returncode == 0 and "sofroniou-spaletta-10" in res.stdout
+
+
+def test_gpucheck_says_why_it_cannot_run_without_cuda(capsys):
+    from openmm_symprk.studies.gpucheck import cuda_unavailable_reason
+
+    if not cuda_unavailable_reason():
+        pytest.skip("a CUDA platform with the native kernel is here: run `symprk gpucheck` itself")
+    assert main(["gpucheck", "--quick"]) == 1
+    err = capsys.readouterr().err
+    assert err.startswith("symprk gpucheck: ") and ("CUDA platform" in err or "CUDA kernel" in err)

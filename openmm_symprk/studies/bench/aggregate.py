@@ -20,6 +20,7 @@ from statistics import median
 import numpy as np
 
 from .measure import rms_deviation
+from .records import SCHEMA_VERSION
 from .runs import label
 
 #: Accuracy targets for "which method is cheapest": RMS trajectory error (nm) ...
@@ -29,9 +30,10 @@ ENERGY_TARGETS = (1e-2, 1e-3, 1e-4, 1e-6)
 
 
 def aggregate(config, scenes, jobs, store) -> dict:
-    runs = [j.result for j in jobs if j.kind == "run" and j.result]
-    refs = {j.scene: j.result for j in jobs if j.kind == "reference" and j.result}
-    stab = [j.result for j in jobs if j.kind == "stability" and j.result]
+    """The results document (plain JSON data, ``schema`` = records.SCHEMA_VERSION) from the finished jobs."""
+    runs = [j.result.to_json() for j in jobs if j.kind == "run" and j.result]
+    refs = {j.scene: j.result.to_json() for j in jobs if j.kind == "reference" and j.result}
+    stab = [j.result.to_json() for j in jobs if j.kind == "stability" and j.result]
     for name, ref in refs.items():
         ref_x = (store.arrays(ref["key"]) or {}).get("positions")
         ref["ref_ok"] = ref_x is not None and ref.get("status") == "ok"
@@ -62,7 +64,7 @@ def aggregate(config, scenes, jobs, store) -> dict:
     import openmm
 
     accurate = [r for r in runs if scenes[r["scene"]].purpose == "accuracy"]
-    return {"config": config, "machine": {"python": _platform.python_version(), "openmm": openmm.__version__,
+    return {"schema": SCHEMA_VERSION, "config": config, "machine": {"python": _platform.python_version(), "openmm": openmm.__version__,
                                           "cpu": _platform.processor() or _platform.machine(),
                                           "cores": _cores()},
             "scenes": scene_info, "runs": runs, "references": list(refs.values()), "stability": stab,

@@ -164,7 +164,7 @@ def stability_chart(results, path) -> str | None:
                 crit = next(r["criterion"] for r in rows if r["scene"] == sc)
                 ax.set_title(f"{sc} ({crit})", fontsize=9, loc="left")
     fig.suptitle("Largest stable step by bisection.  Failure: blow-up, |E - E0| > 0.1 kT per DOF, or a constraint "
-                 "error > 1e-3.\nRed ticks: METHODS.md stability interval h*omega / omega_max (harmonic toy).",
+                 "error > 1e-3.\nRed ticks: catalogue stability interval h*omega / omega_max (harmonic toy).",
                  fontsize=9)
     fig.tight_layout(rect=(0, 0, 1, 0.97))
     fig.savefig(path, dpi=110)

@@ -41,6 +41,7 @@ from ...physics import angular_momentum, linear_momentum
 from ..timing import interleaved
 from ...systems.properties import constraint_violation
 from . import measure
+from .records import RunRecord
 from .registry import BenchScene
 
 #: The comparison rows: OpenMM's own integrators.
@@ -139,26 +140,20 @@ def set_initial_state(ctx, scene: BenchScene, x0, v0, h_ps: float, leapfrog: boo
         ctx.applyVelocityConstraints(CONSTRAINT_TOLERANCE)
 
 
-def base_record(spec: RunSpec, scene: BenchScene, platform: str) -> dict:
-    rec = spec.to_dict()
-    rec.update(label=label(spec.method), platform=platform, length_ps=spec.length_ps, n_atoms=scene.n_atoms,
-               n_dof=scene.n_dof, status="ok", failed=False, failure=None, fail_time_ps=None, steps_done=0,
-               force_evals_per_step=None, force_evals_per_ps=None, energy_error=None, energy_error_per_dof=None,
-               drift_per_ns_per_dof=None, dP=None, dL_rel=None, constraint_error=None, traj_error=None,
-               wall_per_step=None, wall_per_ps=None, timing_steps=0, trace_t=[], trace_de_per_dof=[],
-               E0=None, setup_s=None, blew_up=False)
-    return rec
+def base_record(spec: RunSpec, scene: BenchScene, platform: str) -> RunRecord:
+    return RunRecord(**dict(spec.to_dict(), platform=platform), label=label(spec.method), length_ps=spec.length_ps,
+                     n_atoms=scene.n_atoms, n_dof=scene.n_dof)
 
 
 def _failure(rec, reason, t):
     """Record the first failure; a later blow-up is appended to it."""
-    if not rec["failed"]:
+    if not rec.failed:
         rec.update(failed=True, failure=reason, fail_time_ps=t, status="failed")
-    elif reason.startswith("blow-up") and "blow-up" not in rec["failure"]:
-        rec["failure"] += f"; then {reason} at {t:.4g} ps"
+    elif reason.startswith("blow-up") and "blow-up" not in rec.failure:
+        rec.failure += f"; then {reason} at {t:.4g} ps"
 
 
-def execute(spec: RunSpec, scene: BenchScene) -> tuple[dict, dict]:
+def execute(spec: RunSpec, scene: BenchScene) -> tuple[RunRecord, dict]:
     """Run ``spec`` on ``scene``; returns (record, arrays).  ``arrays`` holds the final positions of
     molecular accuracy runs (for the trajectory error against the reference), else it is empty."""
     if spec.role == "linear-probe":
@@ -169,8 +164,8 @@ def execute(spec: RunSpec, scene: BenchScene) -> tuple[dict, dict]:
     t_setup = time.perf_counter()
     try:
         ig, evals, leapfrog = make_integrator(spec.method, spec.h_ps, scene, spec.seed)
-        rec["force_evals_per_step"] = evals
-        rec["force_evals_per_ps"] = evals / spec.h_ps
+        rec.force_evals_per_step = evals
+        rec.force_evals_per_ps = evals / spec.h_ps
         ctx = make_context(scene, ig, platform, spec.threads)
         set_initial_state(ctx, scene, scene.positions, scene.velocities, spec.h_ps, leapfrog)
     except Unsupported as exc:
@@ -179,13 +174,13 @@ def execute(spec: RunSpec, scene: BenchScene) -> tuple[dict, dict]:
     except Exception as exc:  # a broken run is a record, never a crashed sweep
         rec.update(status="error", failure=f"{type(exc).__name__}: {exc}", traceback=traceback.format_exc())
         return rec, arrays
-    rec["setup_s"] = time.perf_counter() - t_setup
+    rec.setup_s = time.perf_counter() - t_setup
     try:
         _measure(spec, scene, ctx, ig, rec, arrays)
     except Exception as exc:
         if is_blowup(exc):  # e.g. in the timing segment
-            rec["blew_up"] = True
-            _failure(rec, _blowup_reason(exc), rec["steps_done"] * spec.h_ps)
+            rec.blew_up = True
+            _failure(rec, _blowup_reason(exc), rec.steps_done * spec.h_ps)
         else:
             rec.update(status="error", failure=f"{type(exc).__name__}: {exc}", traceback=traceback.format_exc())
     finally:
@@ -218,7 +213,7 @@ def _measure(spec, scene, ctx, ig, rec, arrays):
     inv = set(scene.invariants)
     x, v, e0 = measure.read_state(ctx)
     p0, l0 = linear_momentum(v, m), angular_momentum(x, v, m, about="origin")
-    rec["E0"] = e0
+    rec.E0 = e0
     threshold = ENERGY_THRESHOLD_KT * KT300 * n_dof
     stop_early = spec.role == "probe"
     ts, des = [0.0], [0.0]
@@ -232,15 +227,15 @@ def _measure(spec, scene, ctx, ig, rec, arrays):
         except Exception as exc:
             if not is_blowup(exc):
                 raise
-            rec["blew_up"] = True
+            rec.blew_up = True
             _failure(rec, _blowup_reason(exc), (done + 1) * spec.h_ps)
             break
         done = mark
-        rec["steps_done"] = done
+        rec.steps_done = done
         t = done * spec.h_ps
         x, v, e = measure.read_state(ctx)
         if not measure.finite(x, v, e) or np.max(np.abs(v)) > SPEED_LIMIT:
-            rec["blew_up"] = True
+            rec.blew_up = True
             _failure(rec, "blow-up: non-finite or runaway state", t)
             break
         de = e - e0
@@ -257,7 +252,7 @@ def _measure(spec, scene, ctx, ig, rec, arrays):
             _failure(rec, f"energy error above {ENERGY_THRESHOLD_KT:g} kT per DOF", t)
         if worst_c > CONSTRAINT_THRESHOLD:
             _failure(rec, f"constraint error above {CONSTRAINT_THRESHOLD:g}", t)
-        if rec["failed"] and stop_early:
+        if rec.failed and stop_early:
             break
     loop_s = time.perf_counter() - t_loop
     rec.update(energy_error=worst_e, energy_error_per_dof=worst_e / n_dof,
@@ -265,16 +260,16 @@ def _measure(spec, scene, ctx, ig, rec, arrays):
                dP=worst_p if "momentum" in inv else None,
                dL_rel=worst_l if "angular_momentum" in inv else None,
                constraint_error=worst_c, trace_t=ts, trace_de_per_dof=des)
-    if rec.get("blew_up"):
+    if rec.blew_up:
         # the measured maxima only cover the samples before the blow-up: do not report them as errors
         rec.update(energy_error=None, energy_error_per_dof=None, drift_per_ns_per_dof=None, dP=None, dL_rel=None)
-    completed = done == spec.n_steps and not rec.get("blew_up")
+    completed = done == spec.n_steps and not rec.blew_up
     if completed:
         if scene.exact is not None:
             from .toys import exact_state
 
             xe, _ = exact_state(scene.exact, spec.length_ps)
-            rec["traj_error"] = measure.rms_deviation(x, xe)
+            rec.traj_error = measure.rms_deviation(x, xe)
         elif scene.purpose == "accuracy" and spec.role in ("run", "reference"):
             arrays["positions"] = x
     if spec.timing_s > 0 and completed and done:

@@ -31,7 +31,8 @@ import warnings
 import numpy as np
 
 from ...methods.stability import spectral_radius
-from .runs import RunSpec, Unsupported, base_record, execute, is_blowup, make_context, make_integrator
+from .records import StabilityRecord
+from .runs import RunSpec, Unsupported, base_record, execute, is_blowup, label, make_context, make_integrator
 
 #: Oscillators in the linear probe, over [omega_max/2, omega_max]: spacing x/8192 < 4e-4 at x < 3.3 and
 #: < 7.4e-4 at x = 6, below the narrowest band known (7.6e-4 wide, sofroniou-spaletta-10 at 3.1411).
@@ -52,7 +53,7 @@ def _dense_harmonic(omega_max: float):
     return _probe_systems[key]
 
 
-def linear_probe(spec: RunSpec, scene) -> dict:
+def linear_probe(spec: RunSpec, scene):
     """One step of ``spec.method`` on the dense harmonic spectrum; fails if the one-step map grows."""
     from .registry import BenchScene
 
@@ -62,7 +63,7 @@ def linear_probe(spec: RunSpec, scene) -> dict:
                              invariants=())
     platform = spec.platform or scene.platform
     rec = base_record(spec, probe_scene, platform)
-    rec["n_oscillators"] = len(omega)
+    rec.n_oscillators = len(omega)
     try:
         ig, evals, _ = make_integrator(spec.method, spec.h_ps, probe_scene, spec.seed, temperature=0.0)
     except Unsupported as exc:
@@ -93,16 +94,16 @@ def linear_probe(spec: RunSpec, scene) -> dict:
         return rec
     finally:
         del ctx
-    rec["steps_done"] = 1
+    rec.steps_done = 1
     # one-step matrix in the scaled coordinates (x/q, v/w)
     m11, m21 = x[:, 0] / q, v[:, 0] / w
     m12, m22 = x[:, 1] / q, v[:, 1] / w
     radius = spectral_radius(m11, m12, m21, m22)
     bad = ~(radius <= 1 + LINEAR_TOLERANCE)
-    rec["spectral_radius"] = float(np.nanmax(np.where(np.isfinite(radius), radius, np.inf)))
+    rec.spectral_radius = float(np.nanmax(np.where(np.isfinite(radius), radius, np.inf)))
     if np.any(bad):
         i = int(np.flatnonzero(bad)[0])
-        rec["x_first_unstable"] = float(spec.h_ps * omega[i])  # lowest unstable h*omega in this probe
+        rec.x_first_unstable = float(spec.h_ps * omega[i])  # lowest unstable h*omega in this probe
         rec.update(failed=True, status="failed",
                    failure=f"blow-up: one-step map grows by {radius[i]:.6g} at h*omega = {spec.h_ps * omega[i]:.5f}")
     return rec
@@ -150,13 +151,13 @@ def driver(scene_name: str, method: str, settings: dict, platform=None, threads:
                        1 if linear else settings.get("samples", 20),
                        role="linear-probe" if linear else "probe", platform=platform, threads=threads)
         rec = yield spec
-        evals = rec.get("force_evals_per_step") or evals
-        if rec["status"] in ("unsupported", "error"):
-            return _summary(scene_name, method, settings, None, None, rec["failure"], probes, evals, rec["status"])
-        ok = rec["status"] == "ok" and not rec["failed"]
-        probes.append([h, ok, rec["failure"]])
+        evals = rec.force_evals_per_step or evals
+        if rec.status in ("unsupported", "error"):
+            return _summary(scene_name, method, settings, None, None, rec.failure, probes, evals, rec.status)
+        ok = rec.status == "ok" and not rec.failed
+        probes.append([h, ok, rec.failure])
         if not ok:
-            fail_reason = rec["failure"]
+            fail_reason = rec.failure
         try:
             h = s.send(ok)
         except StopIteration as stop:
@@ -165,19 +166,15 @@ def driver(scene_name: str, method: str, settings: dict, platform=None, threads:
             return _summary(scene_name, method, settings, lo, hi, reason, probes, evals, "ok")
 
 
-def _summary(scene, method, settings, lo, hi, reason, probes, evals, status) -> dict:
-    from .runs import label
-
-    out = {"scene": scene, "method": method, "label": label(method), "status": status, "h_stable_fs": lo,
-           "h_fail_fs": hi, "failure": reason if hi is not None or status != "ok" else
-           f"no failure up to {settings['cap_fs']:g} fs", "force_evals_per_step": evals,
-           "stable_fs_per_eval": (lo / evals) if (lo and evals) else None, "probes": probes,
-           "criterion": "linear one-step map" if settings.get("linear") else
-           f"{settings.get('probe_steps')}-step runs", "rel_tol": settings.get("rel_tol", 0.01)}
+def _summary(scene, method, settings, lo, hi, reason, probes, evals, status) -> StabilityRecord:
+    out = StabilityRecord(
+        scene=scene, method=method, label=label(method), status=status, h_stable_fs=lo, h_fail_fs=hi,
+        failure=reason if hi is not None or status != "ok" else f"no failure up to {settings['cap_fs']:g} fs",
+        force_evals_per_step=evals, stable_fs_per_eval=(lo / evals) if (lo and evals) else None, probes=probes,
+        criterion="linear one-step map" if settings.get("linear") else f"{settings.get('probe_steps')}-step runs",
+        rel_tol=settings.get("rel_tol", 0.01))
     if settings.get("linear"):
-        w = settings["omega_max"]
-        out["x_stable"] = lo * 1e-3 * w if lo else None
-        out["catalogue"] = catalogue_stability(method)
+        out.update(x_stable=lo * 1e-3 * settings["omega_max"] if lo else None, catalogue=catalogue_stability(method))
     return out
 
 

@@ -13,6 +13,8 @@ import os
 
 import numpy as np
 
+from .records import RunRecord
+
 
 def run_key(spec_dict: dict, fingerprint: str) -> str:
     text = json.dumps({"spec": spec_dict, "scene": fingerprint}, sort_keys=True)
@@ -51,20 +53,22 @@ class Store:
     def _path(self, key, ext):
         return os.path.join(self.folder, f"{key}.{ext}")
 
-    def get(self, key: str) -> dict | None:
+    def get(self, key: str) -> RunRecord | None:
+        """The stored record, or None; SchemaError for a record of another schema version."""
         try:
             with open(self._path(key, "json")) as fh:
-                return json.load(fh)
+                data = json.load(fh)
         except (FileNotFoundError, json.JSONDecodeError):
             return None
+        return RunRecord.from_json(data)
 
-    def put(self, key: str, record: dict, arrays: dict | None = None):
+    def put(self, key: str, record: RunRecord, arrays: dict | None = None):
         if arrays:
             tmp = self._path(key, f"tmp{os.getpid()}.npz")
             np.savez(tmp, **arrays)
             os.replace(tmp, self._path(key, "npz"))
-        record = dict(record, key=key, has_arrays=bool(arrays))
-        write_json(self._path(key, "json"), record)
+        record.update(key=key, has_arrays=bool(arrays))
+        write_json(self._path(key, "json"), record.to_json())
 
     def arrays(self, key: str) -> dict | None:
         try:

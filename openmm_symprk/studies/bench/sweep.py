@@ -30,7 +30,8 @@ import warnings
 
 from . import presets
 from .executors import make_executor
-from .runs import OPENMM_ROWS, RunSpec
+from .records import RunRecord
+from .runs import OPENMM_ROWS, RunSpec, label
 from .store import Store, run_key, write_json
 
 
@@ -178,7 +179,7 @@ def _run_jobs(jobs, store, executor, fingerprints, progress=True, on_result=None
                 return
             key = run_key(spec.to_dict(), fingerprints[spec.scene])
             stored = store.get(key)
-            if stored is None or stored.get("status") == "error":
+            if stored is None or stored.status == "error":
                 heapq.heappush(ready, (-job.cost, next(counter), job, spec, key))
                 return
             stats["reused"] += 1
@@ -226,8 +227,8 @@ def _result(fut, spec):
     except Exception as exc:  # a worker that died or a bug: record it, keep the sweep going
         import traceback
 
-        rec = dict(spec.to_dict(), status="error", failed=False, failure=f"{type(exc).__name__}: {exc}",
-                   traceback=traceback.format_exc())
+        rec = RunRecord(**spec.to_dict(), label=label(spec.method), status="error",
+                        failure=f"{type(exc).__name__}: {exc}", traceback=traceback.format_exc())
         return rec, {}
 
 

@@ -6,7 +6,7 @@ on them is an error of the integrator alone (no reference run, no chaos):
 
 * harmonic: V = k_i |r_i|^2 / 2 with frequencies spread evenly over (0, omega_max].  Exact solution
   q(t) = q0 cos(wt) + v0/w sin(wt).  A spread of frequencies reaching down to zero is what makes the
-  largest stable step of a simulation equal to the linear stability interval of METHODS.md (stable for
+  largest stable step of a simulation equal to the linear stability interval of the catalogue (stable for
   every h*omega in (0, x]), resonance bands included.
 * anharmonic (hardening Duffing): V = a_i |r_i|^2 / 2 + b_i (x^4 + y^4 + z^4) / 4.  Exact solution
   x(t) = A cn(Omega t + u0 | m) with Omega^2 = a + b A^2 and m = b A^2 / (2 (a + b A^2))

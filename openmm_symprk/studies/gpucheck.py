@@ -1,0 +1,181 @@
+"""The GPU check: the native backend on OpenMM's CUDA platform, in one command.
+
+    python -m openmm_symprk.studies.gpucheck          # = symprk gpucheck
+    python -m openmm_symprk.studies.gpucheck --quick  # fewer steps, the PME box only
+
+Needs OpenMM's CUDA platform (``pip install "openmm_symprk[cuda12]"`` and an NVIDIA GPU with its driver).
+For mixed and double precision it prints, as markdown tables:
+
+1. the same program on both backends: max |x_native - x_custom| and |v_native - v_custom| after 200 steps
+   of ``verlet`` and ``yoshida-4`` (rigid-water cluster, SETTLE; villin in vacuum, HBonds: CCMA/SHAKE);
+2. conservation: |dL|/|L| and |dP| after 2,000 steps of ``verlet`` on the cluster, with and without
+   ``exact_momentum``;
+3. speed: time per step of the native ``verlet`` and ``yoshida-4`` against OpenMM's VerletIntegrator (ratio per
+   force evaluation, integrators taking turns) on a periodic rigid TIP3P box with PME and on villin solvated
+   to about 23,000 atoms (PME, HBonds, rigid water).
+
+Without a CUDA platform it says why and exits with status 1.  Not a test: nothing is asserted.
+"""
+from __future__ import annotations
+
+import argparse
+import sys
+import warnings
+
+import numpy as np
+import openmm as mm
+import openmm.app as app
+import openmm.unit as unit
+
+from .timing import interleaved
+
+
+def cuda_unavailable_reason() -> str:
+    """'' when OpenMM's CUDA platform and the native CUDA kernel are both usable here, else why not."""
+    from .. import plugin
+
+    try:
+        mm.Platform.getPlatformByName("CUDA")
+    except Exception:
+        failures = [f for f in mm.Platform.getPluginLoadFailures() if "CUDA" in f]
+        why = failures[0].strip() if failures else "the openmm-cuda-12 package is not installed"
+        return f"OpenMM has no CUDA platform here ({why}); install openmm_symprk[cuda12] on a machine with a GPU"
+    how = plugin.details().get("CUDA", "")
+    return "" if how == "native" else f"the native plugin has no CUDA kernel: {how}"
+
+
+def _solvated_villin(n_target: int, seed: int = 7):
+    from ..systems.prepare import maxwell_boltzmann, minimise
+
+    pdb = app.PDBFile(_openmm_data("test.pdb"))
+    ff = app.ForceField("amber14-all.xml", "amber14/tip3p.xml")
+    mod = app.Modeller(pdb.topology, pdb.positions)
+    mod.deleteWater()
+    side = (n_target * 0.03) ** (1 / 3)  # ~33 water atoms per nm^3 at ~1 g/cm^3
+    mod.addSolvent(ff, boxSize=mm.Vec3(side, side, side) * unit.nanometer, neutralize=True)
+    system = ff.createSystem(mod.topology, nonbondedMethod=app.PME, nonbondedCutoff=0.9 * unit.nanometer,
+                             constraints=app.HBonds, rigidWater=True, removeCMMotion=False)
+    pos = minimise(system, mod.positions, "CUDA", tolerance=10.0, max_iterations=200)
+    return system, pos, maxwell_boltzmann(system, pos, 300.0, seed)
+
+
+def _openmm_data(name):
+    import os
+
+    return os.path.join(os.path.dirname(app.__file__), "data", name)
+
+
+def _context(system, integrator, precision, pos, vel):
+    ctx = mm.Context(system, integrator, mm.Platform.getPlatformByName("CUDA"), {"Precision": precision})
+    ctx.setPositions(pos)
+    ctx.setVelocities(vel)
+    return ctx
+
+
+def _state(ctx):
+    st = ctx.getState(getPositions=True, getVelocities=True)
+    return (st.getPositions(asNumpy=True).value_in_unit(unit.nanometer),
+            st.getVelocities(asNumpy=True).value_in_unit(unit.nanometer / unit.picosecond))
+
+
+def same_program(scenes, precisions, steps):
+    from ..integrators import SymplecticIntegrator
+
+    rows = ["| scene | precision | method | max abs(dx) nm | max abs(dv) nm/ps |", "|---|---|---|---|---|"]
+    for scene in scenes:
+        for prec in precisions:
+            for method in ("verlet", "yoshida-4"):
+                out = []
+                for backend in ("native", "custom"):
+                    ig = SymplecticIntegrator(1 * unit.femtoseconds, method, system=scene.system, backend=backend)
+                    ctx = _context(scene.system, ig, prec, scene.positions, scene.velocities)
+                    ig.step(steps)
+                    out.append(_state(ctx))
+                    del ctx
+                dx = float(np.abs(out[0][0] - out[1][0]).max())
+                dv = float(np.abs(out[0][1] - out[1][1]).max())
+                rows.append(f"| {scene.name} | {prec} | {method} | {dx:.1e} | {dv:.1e} |")
+    return "\n".join(rows)
+
+
+def conservation(scene, precisions, steps):
+    from ..conservation.diagnostics import angular_momentum, linear_momentum
+    from ..integrators import SymplecticIntegrator
+
+    rows = ["| precision | exact_momentum | abs(dL)/abs(L) | abs(dP) |", "|---|---|---|---|"]
+    for prec in precisions:
+        for exact in (False, True):
+            ig = SymplecticIntegrator(2 * unit.femtoseconds, "verlet", system=scene.system, backend="native",
+                                      exact_momentum=exact)
+            ctx = _context(scene.system, ig, prec, scene.positions, scene.velocities)
+            L0, P0 = angular_momentum(ctx), linear_momentum(ctx)
+            ig.step(steps)
+            L1, P1 = angular_momentum(ctx), linear_momentum(ctx)
+            rows.append(f"| {prec} | {exact} | {np.linalg.norm(L1 - L0) / np.linalg.norm(L0):.1e} | "
+                        f"{np.linalg.norm(P1 - P0):.1e} |")
+            del ctx
+    return "\n".join(rows)
+
+
+def speed(boxes, precisions, steps, rounds):
+    from ..integrators import SymplecticIntegrator
+
+    rows = ["| system | precision | VerletIntegrator ms/step | native verlet / Verlet | native yoshida-4 / (3 x Verlet) |",
+            "|---|---|---|---|---|"]
+    for name, (system, pos, vel) in boxes.items():
+        for prec in precisions:
+            igs = {"verlet-openmm": mm.VerletIntegrator(2 * unit.femtoseconds),
+                   "verlet": SymplecticIntegrator(2 * unit.femtoseconds, "verlet", system=system, backend="native"),
+                   "yoshida-4": SymplecticIntegrator(2 * unit.femtoseconds, "yoshida-4", system=system,
+                                                     backend="native")}
+            ctxs = {k: _context(system, ig, prec, pos, vel) for k, ig in igs.items()}
+
+            def stepper(k):
+                def advance(n):
+                    igs[k].step(n)
+                    ctxs[k].getState(getPositions=True)  # wait for the GPU
+                return advance
+
+            for k in igs:
+                igs[k].step(5)
+            t = interleaved({k: stepper(k) for k in igs}, steps, rounds)
+            base = t["verlet-openmm"].best
+            rows.append(f"| {name} ({system.getNumParticles()} atoms) | {prec} | {base * 1e3:.3f} | "
+                        f"{t['verlet'].best / base:.3f} | {t['yoshida-4'].best / (3 * base):.3f} |")
+            for c in ctxs.values():
+                del c
+    return "\n".join(rows)
+
+
+def main(argv=None) -> int:
+    p = argparse.ArgumentParser(prog="symprk gpucheck", description=__doc__.split("\n\n")[0])
+    p.add_argument("--quick", action="store_true", help="fewer steps; the PME box only for speed")
+    p.add_argument("--precisions", default="mixed,double")
+    args = p.parse_args(argv)
+    reason = cuda_unavailable_reason()
+    if reason:
+        print(f"symprk gpucheck: {reason}", file=sys.stderr)
+        return 1
+    warnings.simplefilter("ignore")
+    from ..studies.native_speed import water_box_system
+    from ..systems.scenes import protein_vacuum, water_cluster
+
+    precisions = [s for s in args.precisions.split(",") if s]
+    cluster = water_cluster(27)
+    print(f"OpenMM {mm.version.full_version}, CUDA device: "
+          f"{mm.Platform.getPlatformByName('CUDA').getPropertyDefaultValue('DeviceName') or 'default'}\n")
+    print("Same program on both backends (200 steps of 1 fs):\n")
+    print(same_program([cluster] + ([] if args.quick else [protein_vacuum()]), precisions, 50 if args.quick else 200))
+    print("\nConservation, native verlet, 27-water cluster, 2 fs:\n")
+    print(conservation(cluster, precisions, 500 if args.quick else 2000))
+    _, system, pos, vel = water_box_system(3.9)
+    boxes = {"TIP3P box, PME": (system, pos, vel)}
+    if not args.quick:
+        boxes["villin in water, PME"] = _solvated_villin(23000)
+    print("\nSpeed (fastest of the blocks, integrators taking turns):\n")
+    print(speed(boxes, precisions, 50 if args.quick else 300, 2 if args.quick else 4))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
