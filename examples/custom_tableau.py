@@ -1,17 +1,23 @@
 """Your own method: a PRK tableau pair or a kick/drift sequence, checked before use.
 
-    python examples/custom_tableau.py
+    python examples/custom_tableau.py          (--quick: the same, it takes a second anyway)
 
 1. A user splitting (here McLachlan's 2-stage 'optimal' second-order method, written as a sequence).
 2. The same method as a PRK tableau pair: Reich's residuals are reported and the integrator accepts it.
 3. A non-symplectic pair (Lobatto IIIA with itself) is refused with its residual, unless opted in.
 """
+import argparse
+
 import openmm.unit as unit
 
 from openmm_symprk import PRKIntegrator, PRKTableau, Splitting, TableauError
 from openmm_symprk.methods.reference import measure_order
 from openmm_symprk.methods.stability import stability_interval
 from openmm_symprk.systems.scenes import morse_molecule
+
+parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+parser.add_argument("--quick", action="store_true", help="accepted for uniformity: this example takes a second")
+parser.parse_args()
 
 # 1. a splitting, coefficients as exact strings
 b = "0.1931833275037835739600"

@@ -4,8 +4,9 @@ Copy the pattern: build (or load) a System, pass it to SymplecticIntegrator so t
 compiled for its constraints and anything that breaks conservation is reported, then use the
 integrator like any OpenMM integrator.
 
-    python examples/demo.py [method] [platform]
+    python examples/demo.py [--method yoshida-4] [--platform Reference] [--quick]
 """
+import argparse
 import sys
 
 import numpy as np
@@ -13,32 +14,26 @@ import openmm as mm
 import openmm.app as app
 import openmm.unit as unit
 
-from openmm_symprk import SymplecticIntegrator
+from openmm_symprk import SymplecticIntegrator, angular_momentum
 from openmm_symprk.systems.scenes import water_cluster
 
-method = sys.argv[1] if len(sys.argv) > 1 else "yoshida-4"
-platform = sys.argv[2] if len(sys.argv) > 2 else "Reference"
+parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+parser.add_argument("--method", default="yoshida-4", help="a catalogue name (symprk methods)")
+parser.add_argument("--platform", default="Reference")
+parser.add_argument("--quick", action="store_true", help="8 waters, 200 steps")
+args = parser.parse_args()
+n_waters, steps = (8, 200) if args.quick else (64, 2000)
 
-scene = water_cluster(64)  # rigid TIP3P (SETTLE), no cutoff, no box, no CMMotionRemover
-integrator = SymplecticIntegrator(2 * unit.femtoseconds, method, system=scene.system)
+scene = water_cluster(n_waters)  # rigid TIP3P (SETTLE), no cutoff, no box, no CMMotionRemover
+integrator = SymplecticIntegrator(2 * unit.femtoseconds, args.method, system=scene.system)
 print(integrator.describe())
 
-simulation = app.Simulation(scene.topology, scene.system, integrator, mm.Platform.getPlatformByName(platform))
+simulation = app.Simulation(scene.topology, scene.system, integrator, mm.Platform.getPlatformByName(args.platform))
 simulation.context.setPositions(scene.positions)
 simulation.context.setVelocities(scene.velocities)
-simulation.reporters.append(app.StateDataReporter(sys.stdout, 500, step=True, time=True, potentialEnergy=True,
+simulation.reporters.append(app.StateDataReporter(sys.stdout, steps // 4, step=True, time=True, potentialEnergy=True,
                                                   totalEnergy=True, temperature=True))
-masses = scene.masses()[:, None]
-
-
-def angular_momentum():
-    state = simulation.context.getState(getPositions=True, getVelocities=True)
-    x = state.getPositions(asNumpy=True).value_in_unit(unit.nanometer)
-    v = state.getVelocities(asNumpy=True).value_in_unit(unit.nanometer / unit.picosecond)
-    return (masses * np.cross(x, v)).sum(axis=0)
-
-
-L0 = angular_momentum()
-simulation.step(2000)
-L1 = angular_momentum()
-print(f"|dL|/|L| after 2000 steps: {np.linalg.norm(L1 - L0) / np.linalg.norm(L0):.2e}")
+L0 = angular_momentum(simulation, about="origin")
+simulation.step(steps)
+L1 = angular_momentum(simulation, about="origin")
+print(f"|dL|/|L| after {steps} steps: {np.linalg.norm(L1 - L0) / np.linalg.norm(L0):.2e}")

@@ -62,15 +62,15 @@ def _momenta(ctx):
     return angular_momentum(ctx), linear_momentum(ctx)
 
 
-def compare(scene, spec, method, steps, step_size=0.002, chunk=None):
+def compare(scene, spec, method, steps, step_size=0.002, chunk=None, backend="auto"):
     """Run off and on side by side (``steps`` rounded down to whole chunks); return a dict of figures."""
     from ..integrators import SymplecticIntegrator
 
     name, props = _platform(spec)
     if name == "OpenCL" and scene.n_atoms < 2:
         raise ValueError("PoCL crashes on 1-particle systems")
-    igs = {"off": SymplecticIntegrator(step_size, method, system=scene.system),
-           "on": SymplecticIntegrator(step_size, method, system=scene.system, exact_momentum=True)}
+    igs = {"off": SymplecticIntegrator(step_size, method, system=scene.system, backend=backend),
+           "on": SymplecticIntegrator(step_size, method, system=scene.system, exact_momentum=True, backend=backend)}
     ctxs = {k: scene.context(ig, name, props) for k, ig in igs.items()}
     start = {}
     for k, ig in igs.items():
@@ -78,7 +78,8 @@ def compare(scene, spec, method, steps, step_size=0.002, chunk=None):
         start[k] = _momenta(ctxs[k])
     chunk = chunk or max(1, min(100, steps // 10))
     timings = interleaved({k: ig.step for k, ig in igs.items()}, chunk, rounds=max(1, steps // chunk))
-    out = {"scene": scene.name, "atoms": scene.n_atoms, "platform": spec, "method": method, "steps": steps}
+    out = {"scene": scene.name, "atoms": scene.n_atoms, "platform": spec, "method": method, "steps": steps,
+           "backend": igs["off"].backend}
     for k in ("off", "on"):
         L1, P1 = _momenta(ctxs[k])
         L0, P0 = start[k]
@@ -133,11 +134,12 @@ def _fmt(x):
 
 
 def table(rows) -> str:
-    head = ("| scene | platform | method | abs(dL)/abs(L) off | abs(dL)/abs(L) on | abs(dP) off | abs(dP) on "
+    head = ("| scene | platform | method | backend | abs(dL)/abs(L) off | abs(dL)/abs(L) on | abs(dP) off | abs(dP) on "
             "| ms/step off | ms/step on | cost on/off |")
-    lines = [head, "|" + "---|" * 10]
+    lines = [head, "|" + "---|" * 11]
     for r in rows:
-        lines.append(f"| {r['scene']} ({r['atoms']} atoms) | {r['platform']} | {r['method']} | {_fmt(r['dL_off'])} | "
+        lines.append(f"| {r['scene']} ({r['atoms']} atoms) | {r['platform']} | {r['method']} | {r['backend']} | "
+                     f"{_fmt(r['dL_off'])} | "
                      f"{_fmt(r['dL_on'])} | {_fmt(r['dP_off'])} | {_fmt(r['dP_on'])} | {r['ms_off']:.3f} | "
                      f"{r['ms_on']:.3f} | {r['ratio']:.2f} |")
     return "\n".join(lines)
@@ -160,6 +162,8 @@ def build_parser():
     p.add_argument("--scenes", default=",".join(DEFAULT_SCENES), help="water, protein, flexible-water")
     p.add_argument("--waters", type=int, default=27, help="waters in the cluster scenes (default 27)")
     p.add_argument("--step-size", type=float, default=0.002, help="ps (default 0.002)")
+    p.add_argument("--backend", default="auto", choices=("auto", "native", "custom"),
+                   help="integrator backend (default auto: the native plugin where it serves every platform)")
     p.add_argument("--no-failures", action="store_true", help="skip the failure-case table")
     p.add_argument("--quick", action="store_true",
                    help="8 waters, 500 steps, verlet, no protein: a smoke run of under a minute")
@@ -180,7 +184,7 @@ def main(argv=None) -> int:
         scene = _scene(scene_name, args.waters)
         for spec in specs:
             for method in args.methods.split(","):
-                r = compare(scene, spec, method, args.steps, args.step_size)
+                r = compare(scene, spec, method, args.steps, args.step_size, backend=args.backend)
                 rows.append(r)
                 print(f"  {scene.name} {spec} {method}: dL/L off {_fmt(r['dL_off'])} on {_fmt(r['dL_on'])}, "
                       f"cost x{r['ratio']:.2f}", file=sys.stderr, flush=True)
