@@ -17,7 +17,7 @@ __all__ = ["BACKENDS", "NATIVE_OPTIONS", "choose_backend", "BackendWarning", "Na
 
 BACKENDS = ("auto", "native", "custom")
 #: Options of SymplecticIntegrator that the native backend takes.
-NATIVE_OPTIONS = frozenset({"exact_momentum", "check_finite", "max_speed"})
+NATIVE_OPTIONS = frozenset({"exact_momentum", "check_finite", "max_speed", "groups", "inner_method"})
 NativeUnavailableError = plugin.NativeUnavailableError
 
 

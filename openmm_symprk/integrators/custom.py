@@ -28,6 +28,7 @@ from ..systems.properties import masses, signature
 from . import program
 from .base import (CheckpointMismatchError, ConvergenceWarning, IntegratorBase, SystemMismatchError,
                    check_max_speed, step_size_in_ps)
+from .mts import describe_levels, mts_splitting
 from .projection import set_masses
 from .symplectic import SymplecticIntegrator
 
@@ -86,6 +87,11 @@ class PRKIntegrator(IntegratorBase, mm.CustomIntegrator):
         Record the first step whose velocities are not finite; ``step`` raises SimulationBlowUpError.
     max_speed : float or speed Quantity, optional
         Also count velocities faster than this (nm/ps) as a blow-up (default: only NaN and infinity).
+    groups : list of (force group, substeps), optional
+        Multiple time stepping (r-RESPA), in the form of OpenMM's ``MTSIntegrator``: e.g. ``[(1, 1), (0, 2)]``
+        kicks with group 1 once per step and runs two inner steps with group 0 in every drift
+        (:mod:`openmm_symprk.methods.respa`; :func:`openmm_symprk.systems.forcegroups.split_forces` sets the groups).
+    inner_method : the kick/drift method of the inner levels (default: the same as the outer one).
     tolerance, max_iterations : implicit methods only: fixed-point tolerance (nm) and iteration cap.
     """
 
@@ -93,9 +99,12 @@ class PRKIntegrator(IntegratorBase, mm.CustomIntegrator):
 
     def __init__(self, stepSize, tableau, system: mm.System | None = None, constraints: bool | None = None,
                  allow_nonsymplectic: bool = False, exact_momentum: bool = False, check_finite: bool = True,
-                 max_speed=None, tolerance: float = 1e-12, max_iterations: int = 60, name: str | None = None):
+                 max_speed=None, groups=None, inner_method=None, tolerance: float = 1e-12, max_iterations: int = 60,
+                 name: str | None = None):
         dt = step_size_in_ps(stepSize)
         method = self._resolve(tableau)
+        if inner_method is not None and groups is None:
+            raise ValueError("inner_method= needs groups= (the force groups of the levels of multiple time stepping)")
         tab = method.tableau() if isinstance(method, Method) else (
             PRKTableau.from_splitting(method, name=name) if isinstance(method, Splitting) else method)
         self.method_name = name or getattr(method, "name", None) or "user tableau"
@@ -120,6 +129,12 @@ class PRKIntegrator(IntegratorBase, mm.CustomIntegrator):
             has_constraints = splitting  # RATTLE steps are harmless (and cheap) on a System without constraints
         if constraints is not None:
             has_constraints = bool(constraints)
+        self.mts_levels = None
+        if groups is not None:
+            if isinstance(method, PRKTableau):
+                method = method.to_splitting()
+            method, self.mts_levels = mts_splitting(method, groups, inner_method, has_constraints, system)
+            tab = None
         mm.CustomIntegrator.__init__(self, dt)
         self.tableau = tab
         try:
@@ -138,7 +153,8 @@ class PRKIntegrator(IntegratorBase, mm.CustomIntegrator):
         meta = {"class": type(self).__name__, "method": self.method_name,
                 "catalogue": self.method.name if self.method is not None else None,
                 "options": {"exact_momentum": self.exact_momentum, "check_finite": self.check_finite,
-                            "max_speed": self.max_speed},
+                            "max_speed": self.max_speed, "groups": None if groups is None else [list(g) for g in groups],
+                            "inner_method": getattr(inner_method, "name", inner_method)},
                 "system": None if sig is None else {"n_particles": sig.n_particles, "constraints": sig.constraints,
                                                     "virtual_sites": sig.virtual_sites,
                                                     "total_mass": sig.total_mass, "masses_digest": sig.masses_digest}}
@@ -231,8 +247,11 @@ class PRKIntegrator(IntegratorBase, mm.CustomIntegrator):
                  f"  program: {info.kind}, {info.stages} {'kicks and drifts' if info.kind == 'splitting' else 'stages'}, "
                  f"constraints={'RATTLE' if info.constraints else 'none'}, force evaluations per step: "
                  f"{info.force_evals}, exact momentum: {info.exact_momentum}",
-                 f"  {self.tableau.summary()}" if self.tableau is not None else "  (tableau not restored)"]
+                 f"  {self.tableau.summary()}" if self.tableau is not None else
+                 ("  multiple time stepping" if self.mts_levels else "  (tableau not restored)")]
         lines += [f"  {n}" for n in info.notes]
+        if self.mts_levels:
+            lines.append("  " + describe_levels(self.mts_levels, info.evals_per_group))
         return "\n".join(lines)
 
 

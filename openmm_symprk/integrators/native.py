@@ -18,10 +18,13 @@ import openmm as mm
 
 from .. import plugin
 from ..methods.catalogue import get_method
+from ..methods.respa import evaluations_per_step, kick_label
+from ..methods.splitting import DRIFT
 from ..systems.checks import validate_system
 from ..systems.properties import has_constraints, signature
 from .backend import NativeMethodError
 from .base import IntegratorBase, check_max_speed, step_size_in_ps
+from .mts import describe_levels, kick_masks, mts_splitting
 from .program import ProgramInfo
 from .symplectic import SymplecticIntegrator
 
@@ -49,7 +52,7 @@ class NativeSymplecticIntegrator(SymplecticIntegrator, _PluginIntegrator, backen
     and NativeMethodError for implicit and general tableaux, which only the CustomIntegrator backend runs."""
 
     def __init__(self, stepSize, method="verlet", system=None, backend="native", exact_momentum=False,
-                 check_finite=True, max_speed=None):
+                 check_finite=True, max_speed=None, groups=None, inner_method=None):
         self._check_backend(backend)
         if _swig is None:
             raise plugin.NativeUnavailableError(f"the native backend is unavailable: {plugin.unavailable_reason()}. "
@@ -68,10 +71,19 @@ class NativeSymplecticIntegrator(SymplecticIntegrator, _PluginIntegrator, backen
             # the native kernels place virtual sites after every drift: no CustomIntegrator caveat
             validate_system(system, f"NativeSymplecticIntegrator({m.name})", exact_momentum, skip=("virtualsites",))
         constraints = True if system is None else has_constraints(system)
-        splitting = m.constrained_splitting if constraints else m.splitting
+        self.mts_levels = None
+        if inner_method is not None and groups is None:
+            raise ValueError("inner_method= needs groups= (the force groups of the levels of multiple time stepping)")
+        if groups is not None:
+            splitting, self.mts_levels = mts_splitting(m, groups, inner_method, constraints, system)
+        else:
+            splitting = m.constrained_splitting if constraints else m.splitting
         coeffs = splitting.coefficients()
-        _PluginIntegrator.__init__(self, dt, [0 if label == "kick" else 1 for label, _ in coeffs],
+        _PluginIntegrator.__init__(self, dt, [1 if label == DRIFT else 0 for label, _ in coeffs],
                                    [float(c) for _, c in coeffs])
+        if groups is not None:
+            self.setSubsteps([1 if label == DRIFT else 0 for label, _ in coeffs], [float(c) for _, c in coeffs],
+                             kick_masks(splitting))
         self.setMethodName(m.name)
         self.setExactMomentum(bool(exact_momentum))
         self.setMaxSpeed(max_speed)
@@ -84,9 +96,11 @@ class NativeSymplecticIntegrator(SymplecticIntegrator, _PluginIntegrator, backen
         self.max_speed = max_speed
         self.exact_momentum = bool(exact_momentum)
         self.compiled_for = None if system is None else signature(system)
-        self.program_info = ProgramInfo("splitting", constraints, splitting.force_evaluations(), len(splitting),
+        per_group = evaluations_per_step(splitting)
+        self.program_info = ProgramInfo("splitting", constraints, sum(per_group.values()), len(splitting),
                                         bool(exact_momentum), ["native SymPRKIntegrator plugin"],
-                                        signature=int(self.getProgramSignature()))
+                                        signature=int(self.getProgramSignature()),
+                                        evals_per_group=per_group if list(per_group) != [None] else None)
 
     # -- backend hooks -------------------------------------------------------------------------------------
     def _blowup_step(self) -> int:
@@ -112,16 +126,25 @@ class NativeSymplecticIntegrator(SymplecticIntegrator, _PluginIntegrator, backen
         return int(self.getForceEvaluationsPerStep())
 
     def substeps(self) -> list:
-        """[("kick"|"drift", coefficient)] as the plugin runs them."""
-        return [("kick" if self.getSubstepKind(i) == 0 else "drift", self.getSubstepCoefficient(i))
-                for i in range(self.getNumSubsteps())]
+        """[(label, coefficient)] as the plugin runs them: "drift", "kick", or "kick:<groups>" for a kick of some
+        force groups only (multiple time stepping)."""
+        out = []
+        for i in range(self.getNumSubsteps()):
+            mask = self.getSubstepForceGroups(i)
+            if self.getSubstepKind(i) == 1:
+                label = DRIFT
+            else:
+                label = "kick" if mask == -1 else kick_label([g for g in range(32) if mask >> g & 1])
+            out.append((label, self.getSubstepCoefficient(i)))
+        return out
 
     def describe(self) -> str:
         return (f"NativeSymplecticIntegrator: {self.method_name}, step {self.getStepSize()}, native backend "
                 f"(platforms: {', '.join(plugin.platforms())})\n"
                 f"  program: splitting, {self.getNumSubsteps()} kicks and drifts, constraints="
                 f"{'RATTLE' if self.program_info.constraints else 'none'}, force evaluations per step: "
-                f"{self.force_evals}, exact momentum: {self.getExactMomentum()}")
+                f"{self.force_evals}, exact momentum: {self.getExactMomentum()}"
+                + (f"\n  {describe_levels(self.mts_levels, self.program_info.evals_per_group)}" if self.mts_levels else ""))
 
 
 # IntegratorBase.step must come before the plugin's own step in the method resolution order.

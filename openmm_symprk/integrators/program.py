@@ -33,7 +33,8 @@ from dataclasses import dataclass, field
 import numpy as np
 import openmm as mm
 
-from ..methods.splitting import DRIFT, KICK, Splitting
+from ..methods.respa import evaluations_per_step, label_groups
+from ..methods.splitting import DRIFT, Splitting
 from ..methods.tableau import PRKTableau, TableauError
 
 #: Global variables every compiled program has, in this order (read by the integrator classes).
@@ -66,6 +67,7 @@ class ProgramInfo:
     exact_momentum: bool
     notes: list = field(default_factory=list)
     signature: int = 0  # the value of global 0 (see the module docstring)
+    evals_per_group: dict | None = None  # multiple time stepping: {force groups: evaluations per step}
 
 
 def program_signature(integrator: mm.CustomIntegrator) -> int:
@@ -132,23 +134,26 @@ class _Emitter:
             self.ig.addGlobalVariable(name, value)
             self._vars.add(name)
 
-    def acceleration(self, target: str) -> str:
-        """Store the (optionally momentum-projected) acceleration F/m in per-DOF ``target``."""
+    def acceleration(self, target: str, force: str = "f") -> str:
+        """Store the (optionally momentum-projected) acceleration ``force``/m in per-DOF ``target``."""
         self.per_dof(target)
         if self.exact_momentum:
             from .projection import emit_projected_acceleration
 
-            emit_projected_acceleration(self.ig, target)
+            emit_projected_acceleration(self.ig, target, force=force)
         else:
-            self.ig.addComputePerDof(target, "f/m")
+            self.ig.addComputePerDof(target, f"{force}/m")
         return target
 
-    def kick(self, c):
-        if self.exact_momentum:
-            a = self.acceleration("symprk_a")
-            self.ig.addComputePerDof("v", f"v + {_num(c)}*dt*{a}")
-        else:
-            self.ig.addComputePerDof("v", f"v + {_num(c)}*dt*f/m")
+    def kick(self, c, groups=None):
+        """v += c*dt*F/m with the forces of ``groups`` (None: all), one computation per group (a CustomIntegrator
+        computation may reference one force group only)."""
+        for force in (["f"] if groups is None else [f"f{g}" for g in groups]):
+            if self.exact_momentum:
+                a = self.acceleration("symprk_a", force)
+                self.ig.addComputePerDof("v", f"v + {_num(c)}*dt*{a}")
+            else:
+                self.ig.addComputePerDof("v", f"v + {_num(c)}*dt*{force}/m")
 
     def project_velocities(self):
         """A velocity projection inside a step (see Splitting.projected_drifts)."""
@@ -202,17 +207,20 @@ def compile_splitting(integrator, splitting: Splitting, constraints: bool, exact
     em = _Emitter(integrator, constraints, exact_momentum, update_context_state)
     projected = set(splitting.projected_drifts())
     for i, (label, c) in enumerate(splitting.coefficients(np.float64)):
-        if label == KICK:
-            em.kick(c)
-        elif label == DRIFT:
+        if label == DRIFT:
             if i in projected:
                 em.project_velocities()
             em.drift(c)
         else:
-            raise TableauError(f"a kick/drift splitting cannot contain a {label!r} sub-flow")
+            try:
+                groups = label_groups(label)
+            except ValueError:
+                raise TableauError(f"a kick/drift splitting cannot contain a {label!r} sub-flow") from None
+            em.kick(c, groups)
     sig = em.finish(check_finite, max_speed)
-    return ProgramInfo("splitting", constraints, splitting.force_evaluations(), len(splitting), exact_momentum,
-                       signature=sig)
+    per_group = evaluations_per_step(splitting)
+    return ProgramInfo("splitting", constraints, sum(per_group.values()), len(splitting), exact_momentum,
+                       signature=sig, evals_per_group=per_group if list(per_group) != [None] else None)
 
 
 def _lincomb(base: str, coeffs, names) -> str:

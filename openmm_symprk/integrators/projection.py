@@ -277,12 +277,14 @@ def _emit_net(ig, vector_var: str, torque_expr: str | None = None):
 
 
 # -- public emitters -------------------------------------------------------------------------------
-def emit_projected_acceleration(integrator: mm.CustomIntegrator, target: str, reuse: bool | None = None) -> None:
+def emit_projected_acceleration(integrator: mm.CustomIntegrator, target: str, reuse: bool | None = None,
+                                force: str = "f") -> None:
     """Append the computations that set per-DOF ``target`` to the projected acceleration.
 
-    References only ``f`` (all force groups), ``m`` and ``x``: one force evaluation if the forces are
-    not cached, as for a plain ``f/m`` kick.  ``target`` must already be a per-DOF variable.
-    ``reuse`` (default: the first call of a program outside any block) emits the cache check."""
+    References only ``force`` (``f``: all force groups; ``f1``: force group 1), ``m`` and ``x``: one force
+    evaluation if those forces are not cached, as for a plain ``f/m`` kick.  ``target`` must already be a
+    per-DOF variable.  ``reuse`` (default: the first call of a program outside any block) emits the cache
+    check."""
     ig = integrator
     g = _g
     steps = _steps(ig)
@@ -292,7 +294,7 @@ def emit_projected_acceleration(integrator: mm.CustomIntegrator, target: str, re
     if not _mass_current(steps):
         _emit_mass(ig)
     mass, fm = g("mass"), g("fm")
-    ig.addComputePerDof(fm, f"select({mass}, f, 0)")
+    ig.addComputePerDof(fm, f"select({mass}, {force}, 0)")
     raw = f"select({mass}, {fm}/{mass}, 0)"
     if reuse:
         ig.addComputeSum(g("chg"), f"(x - {g('xref')})^2 + ({raw} - {g('raw')})^2")

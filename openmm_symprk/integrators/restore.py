@@ -17,6 +17,7 @@ from ..methods.catalogue import get_method
 from ..systems.properties import SystemSignature
 from . import program
 from .custom import CustomSymplecticIntegrator, PRKIntegrator, read_metadata
+from .mts import mts_splitting
 from .native import NativeSymplecticIntegrator, native_available
 from .program import ProgramInfo
 
@@ -62,9 +63,13 @@ def _restore_custom(integrator: mm.CustomIntegrator):
     method = get_method(catalogue) if catalogue else None
     options = meta.get("options", {})
     system = meta.get("system")
+    mts_levels = None
+    if options.get("groups") and method is not None:
+        mts_levels = mts_splitting(method, [tuple(g) for g in options["groups"]], options.get("inner_method"),
+                                   constraints)[1]
     obj.__dict__.update(
-        method=method, method_name=meta.get("method", "user tableau"),
-        tableau=method.tableau() if method is not None else None,
+        method=method, method_name=meta.get("method", "user tableau"), mts_levels=mts_levels,
+        tableau=method.tableau() if method is not None and mts_levels is None else None,
         check_finite=bool(options.get("check_finite", True)), max_speed=float(options.get("max_speed") or 0.0),
         exact_momentum=bool(options.get("exact_momentum", False)),
         compiled_for=SystemSignature(**system) if system else None, _masses=None,
@@ -83,10 +88,11 @@ def _restore_native(integrator):
     m = get_method(obj.getMethodName()) if obj.getMethodName() else None
     from ..methods.splitting import Splitting
 
-    splitting = Splitting(obj.substeps())
+    splitting = Splitting(obj.substeps())  # force groups of a multiple-time-step method live in the plugin
     expected = obj.getExpectedNumParticles()
     obj.__dict__.update(
         method=m, method_name=obj.getMethodName() or "user splitting", splitting=splitting, check_finite=True,
+        mts_levels=None,
         max_speed=float(obj.getMaxSpeed()), exact_momentum=bool(obj.getExactMomentum()), compiled_for=None,
         program_info=ProgramInfo("splitting", bool(obj.getExpectedConstraints()) if expected >= 0 else True,
                                  int(obj.getForceEvaluationsPerStep()), obj.getNumSubsteps(),

@@ -95,12 +95,20 @@ class Splitting:
     def force_evaluations(self, label: str = KICK) -> int:
         """Evaluations of the ``label`` part per step in a long run.
 
-        A sub-flow of ``label`` costs one evaluation; when a step both starts and ends with it, the
-        closing evaluation is reused by the next step's opening one (first same as last)."""
-        n = self.count(label)
-        if n and len(self.steps) > 1 and self.steps[0][0] == label and self.steps[-1][0] == label:
-            n -= 1
-        return n
+        A sub-flow of ``label`` needs an evaluation when the positions changed (a drift) since the previous
+        sub-flow of the same label, counted cyclically: the closing evaluation of a step is reused by the next
+        step's opening one when no drift separates them (first same as last).  Kicks of other labels (force
+        groups of a multiple-time-step sequence) do not move the positions."""
+        kicks = [i for i, (lab, _) in enumerate(self.steps) if lab == label]
+        if not kicks:
+            return 0
+        n, count = len(self.steps), 0
+        for k, i in enumerate(kicks):
+            previous = kicks[k - 1]  # cyclically: the last one of the previous step for the first
+            between = range(previous + 1, i) if previous < i else list(range(previous + 1, n)) + list(range(i))
+            if len(kicks) == 1 or any(self.steps[j][0] == DRIFT for j in between):
+                count += 1
+        return count
 
     def projected_drifts(self) -> list:
         """Indices (into ``steps``) of the drifts before which a constrained step projects the velocities.

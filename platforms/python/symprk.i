@@ -76,6 +76,8 @@ public:
     explicit SymPRKIntegrator(double stepSize);
     SymPRKIntegrator(double stepSize, const std::vector<int>& kinds, const std::vector<double>& coefficients);
     void setSubsteps(const std::vector<int>& kinds, const std::vector<double>& coefficients);
+    void setSubsteps(const std::vector<int>& kinds, const std::vector<double>& coefficients, const std::vector<int>& groups);
+    int getSubstepForceGroups(int index) const;
     int getNumSubsteps() const;
     int getSubstepKind(int index) const;
     double getSubstepCoefficient(int index) const;

@@ -9,6 +9,8 @@
 #include <climits>
 #include <cmath>
 #include <map>
+#include <memory>
+#include <set>
 #include <vector>
 
 using namespace OpenMM;
@@ -47,6 +49,19 @@ void CommonIntegrateSymPRKStepKernel::initialize(const System& system, const Sym
     rigid.initialize(cc, 9, useDouble ? sizeof(double) : sizeof(float), "symprkRigid");
     vBefore.initialize(cc, cc.getPaddedNumAtoms(), useDouble ? 4*sizeof(double) : 4*sizeof(float), "symprkVelocitiesBefore");
     badStep.initialize<int>(cc, 1, "symprkBadStep");
+    set<int> kickGroups;
+    for (int s = 0; s < integrator.getNumSubsteps(); s++)
+        if (integrator.getSubstepKind(s) == SymPRKIntegrator::Kick)
+            kickGroups.insert(integrator.getSubstepForceGroups(s) == -1 ? integrator.getIntegrationForceGroups()
+                                                                        : integrator.getSubstepForceGroups(s));
+    multipleGroups = (kickGroups.size() > 1);
+    if (multipleGroups)
+        for (int mask : kickGroups) {
+            groupForces[mask].reset(new ComputeArray());
+            groupForces[mask]->initialize(cc, cc.getLongForceBuffer().getSize(), cc.getLongForceBuffer().getElementSize(),
+                                          "symprkGroupForces");
+            groupForcesValid[mask] = false;
+        }
     int zero = 0;
     badStep.upload(&zero);
     if (blowUpStep != 0)
@@ -160,15 +175,35 @@ void CommonIntegrateSymPRKStepKernel::execute(ContextImpl& context, const SymPRK
 
     if (context.updateContextState())
         forcesAreValid = false;
+    if (!forcesAreValid)
+        for (auto& entry : groupForcesValid)
+            entry.second = false;  // cached forces of a multiple-time-step method belong to old positions
     for (int s = 0; s < numSubsteps; s++) {
         const double cdt = integrator.getSubstepCoefficient(s)*dt;
         const int checkStep = (s == lastVelocityStep && blowUpStep == 0 ? check : 0);
         if (integrator.getSubstepKind(s) == SymPRKIntegrator::Kick) {
-            if (!forcesAreValid || context.getLastForceGroups() != groups) {
-                ContextDeselector deselector(cc);
-                context.calcForcesAndEnergy(true, false, groups);
-                forcesAreValid = true;
+            // The forces of this kick's groups: computed unless cached since the last drift (a multiple-time-step
+            // method keeps a copy per group, so that a group is evaluated only where a drift came between two of
+            // its kicks).
+            const int mask = (integrator.getSubstepForceGroups(s) == -1 ? groups : integrator.getSubstepForceGroups(s));
+            ArrayInterface* kickForces = &cc.getLongForceBuffer();
+            if (multipleGroups && groupForcesValid[mask])
+                kickForces = groupForces[mask].get();
+            else {
+                if (!forcesAreValid || context.getLastForceGroups() != mask) {
+                    ContextDeselector deselector(cc);
+                    context.calcForcesAndEnergy(true, false, mask);
+                    forcesAreValid = true;
+                }
+                if (multipleGroups) {
+                    cc.getLongForceBuffer().copyTo(*groupForces[mask]);
+                    groupForcesValid[mask] = true;
+                    kickForces = groupForces[mask].get();
+                }
             }
+            kickKernel->setArg(2, *kickForces);
+            kickProjectedKernel->setArg(2, *kickForces);
+            projectionKernel->setArg(3, *kickForces);
             if (exact) {
                 projectionKernel->execute(projectionBlockSize, projectionBlockSize);
                 setMixedArg(kickProjectedKernel, 0, cdt);
@@ -206,6 +241,8 @@ void CommonIntegrateSymPRKStepKernel::execute(ContextImpl& context, const SymPRK
             }
             integration.computeVirtualSites();
             forcesAreValid = false;
+            for (auto& entry : groupForcesValid)
+                entry.second = false;
         }
     }
     if (hasConstraints)

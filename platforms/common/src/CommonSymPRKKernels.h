@@ -5,6 +5,8 @@
 #include "openmm/common/ComputeArray.h"
 #include "openmm/common/ComputeContext.h"
 #include "openmm/common/ComputeKernel.h"
+#include <map>
+#include <memory>
 #include <string>
 
 namespace OpenMM {
@@ -24,7 +26,7 @@ public:
 class CommonIntegrateSymPRKStepKernel : public IntegrateSymPRKStepKernel {
 public:
     CommonIntegrateSymPRKStepKernel(std::string name, const Platform& platform, ComputeContext& cc) :
-            IntegrateSymPRKStepKernel(name, platform), cc(cc), hasInitializedKernels(false), blowUpStep(0) {
+            IntegrateSymPRKStepKernel(name, platform), cc(cc), hasInitializedKernels(false), multipleGroups(false), blowUpStep(0) {
     }
     void initialize(const System& system, const SymPRKIntegrator& integrator);
     void execute(ContextImpl& context, const SymPRKIntegrator& integrator, bool& forcesAreValid, long long stepIndex);
@@ -35,7 +37,9 @@ private:
     void setMixedArg(ComputeKernel& kernel, int index, double value);
     void projectVelocities(double tol, bool exact);
     ComputeContext& cc;
-    bool hasInitializedKernels, hasConstraints;
+    bool hasInitializedKernels, hasConstraints, multipleGroups;
+    std::map<int, std::unique_ptr<ComputeArray> > groupForces;  // multiple time stepping: forces per group mask
+    std::map<int, bool> groupForcesValid;
     int projectionBlockSize;
     long long blowUpStep;
     ComputeArray projection, badStep, rigid, vBefore;

@@ -37,11 +37,15 @@ SymPRKIntegrator::SymPRKIntegrator(double stepSize, const vector<int>& kinds, co
 }
 
 void SymPRKIntegrator::setSubsteps(const vector<int>& newKinds, const vector<double>& newCoefficients) {
+    setSubsteps(newKinds, newCoefficients, vector<int>(newKinds.size(), -1));
+}
+
+void SymPRKIntegrator::setSubsteps(const vector<int>& newKinds, const vector<double>& newCoefficients, const vector<int>& newGroups) {
     if (owner != NULL)
         throw OpenMMException("SymPRKIntegrator: the sub-steps cannot be changed once the integrator is bound to a Context");
-    if (newKinds.size() != newCoefficients.size())
-        throw OpenMMException("SymPRKIntegrator: kinds and coefficients must have the same length");
-    vector<int> k;
+    if (newKinds.size() != newCoefficients.size() || newKinds.size() != newGroups.size())
+        throw OpenMMException("SymPRKIntegrator: kinds, coefficients and force groups must have the same length");
+    vector<int> k, g;
     vector<double> c;
     for (size_t i = 0; i < newKinds.size(); i++) {
         if (newKinds[i] != Kick && newKinds[i] != Drift) {
@@ -54,23 +58,38 @@ void SymPRKIntegrator::setSubsteps(const vector<int>& newKinds, const vector<dou
             msg << "SymPRKIntegrator: sub-step " << i << " has a non-finite coefficient";
             throw OpenMMException(msg.str());
         }
+        int group = (newKinds[i] == Kick ? newGroups[i] : -1);
+        if (group == 0 || group < -1) {
+            stringstream msg;
+            msg << "SymPRKIntegrator: sub-step " << i << " has force-group mask " << group << "; expected a non-zero bit mask or -1";
+            throw OpenMMException(msg.str());
+        }
         if (newCoefficients[i] == 0.0)
             continue;
-        if (!k.empty() && k.back() == newKinds[i])
+        if (!k.empty() && k.back() == newKinds[i] && g.back() == group)
             c.back() += newCoefficients[i];
         else {
             k.push_back(newKinds[i]);
             c.push_back(newCoefficients[i]);
+            g.push_back(group);
         }
         if (c.back() == 0.0) {
             k.pop_back();
             c.pop_back();
+            g.pop_back();
         }
     }
     if (k.empty())
         throw OpenMMException("SymPRKIntegrator: a step needs at least one sub-step with a non-zero coefficient");
     kinds = k;
     coefficients = c;
+    groups = g;
+}
+
+int SymPRKIntegrator::getSubstepForceGroups(int index) const {
+    if (index < 0 || index >= (int) kinds.size())
+        throw OpenMMException("SymPRKIntegrator: sub-step index out of range");
+    return groups[index];
 }
 
 int SymPRKIntegrator::getSubstepKind(int index) const {
@@ -86,13 +105,24 @@ double SymPRKIntegrator::getSubstepCoefficient(int index) const {
 }
 
 int SymPRKIntegrator::getForceEvaluationsPerStep() const {
-    int n = 0;
-    for (int k : kinds)
-        if (k == Kick)
-            n++;
-    if (n > 0 && kinds.size() > 1 && kinds.front() == Kick && kinds.back() == Kick)
-        n--;
-    return n;
+    // A kick needs an evaluation when a drift came since the previous kick of the same force groups, counted
+    // cyclically (the same rule as openmm_symprk.methods.splitting.Splitting.force_evaluations).
+    const int n = kinds.size();
+    int count = 0;
+    for (int i = 0; i < n; i++) {
+        if (kinds[i] != Kick)
+            continue;
+        bool drift = false;
+        for (int j = (i-1+n)%n; ; j = (j-1+n)%n) {
+            if (kinds[j] == Drift)
+                drift = true;
+            if ((kinds[j] == Kick && groups[j] == groups[i]) || j == i)
+                break;
+        }
+        if (drift)
+            count++;
+    }
+    return count;
 }
 
 void SymPRKIntegrator::setExactMomentum(bool exact) {
@@ -139,9 +169,11 @@ long long SymPRKIntegrator::getProgramSignature() const {
         }
     };
     for (size_t i = 0; i < kinds.size(); i++) {
-        int32_t kind = kinds[i];
+        int32_t kind = kinds[i], group = groups[i];
         mix(&kind, sizeof(kind));
         mix(&coefficients[i], sizeof(double));
+        if (group != -1)
+            mix(&group, sizeof(group));  // absent for plain splittings: their signatures are unchanged
     }
     int32_t exact = exactMomentum ? 1 : 0;
     mix(&exact, sizeof(exact));

@@ -18,6 +18,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <limits>
+#include <set>
 
 using namespace OpenMM;
 using namespace std;
@@ -44,6 +45,12 @@ void ReferenceIntegrateSymPRKStepKernel::initialize(const System& sys, const Sym
             hasVirtualSites = true;
     }
     hasConstraints = (sys.getNumConstraints() > 0);
+    set<int> kickGroups;
+    for (int s = 0; s < integrator.getNumSubsteps(); s++)
+        if (integrator.getSubstepKind(s) == SymPRKIntegrator::Kick)
+            kickGroups.insert(integrator.getSubstepForceGroups(s));
+    multipleGroups = (kickGroups.size() > 1);
+    groupForces.clear();
     xRef.resize(numParticles);
     xUnconstrained.resize(numParticles);
     int numThreads = data.threads.getNumThreads();
@@ -226,6 +233,8 @@ void ReferenceIntegrateSymPRKStepKernel::execute(ContextImpl& context, const Sym
 
     if (context.updateContextState())
         forcesAreValid = false;
+    if (!forcesAreValid)
+        groupForces.clear();  // the cached forces of a multiple-time-step method belong to old positions
 
     // One pass over the atoms per kick and per drift; a kick directly followed by a drift (every kick but a
     // step's last) shares its pass with it.  The per-atom arithmetic is the same either way.
@@ -272,6 +281,7 @@ void ReferenceIntegrateSymPRKStepKernel::execute(ContextImpl& context, const Sym
         if (hasVirtualSites)
             vsites.computePositions(*system, pos, data.periodicBoxVectors);
         forcesAreValid = false;
+        groupForces.clear();
     };
     // Velocity projections inside the step, before every drift whose |coefficient| exceeds the previous drift's
     // (the rule of openmm_symprk.methods.splitting.Splitting.projected_drifts): a no-op in exact arithmetic that
@@ -288,19 +298,34 @@ void ReferenceIntegrateSymPRKStepKernel::execute(ContextImpl& context, const Sym
     for (int s = 0; s < numSubsteps; ) {
         const double cdt = integrator.getSubstepCoefficient(s)*dt;
         if (integrator.getSubstepKind(s) == SymPRKIntegrator::Kick) {
-            if (!forcesAreValid || context.getLastForceGroups() != groups) {
-                context.calcForcesAndEnergy(true, false, groups);
-                forcesAreValid = true;
+            // The forces of this kick's groups: computed unless cached since the last drift.  A
+            // multiple-time-step method keeps a copy per group, so that a group is evaluated only where a
+            // drift came between two of its kicks.
+            const int mask = (integrator.getSubstepForceGroups(s) == -1 ? groups : integrator.getSubstepForceGroups(s));
+            const vector<Vec3>* kickForces = &force;
+            auto cached = groupForces.find(mask);
+            if (cached != groupForces.end())
+                kickForces = &cached->second;
+            else {
+                if (!forcesAreValid || context.getLastForceGroups() != mask) {
+                    context.calcForcesAndEnergy(true, false, mask);
+                    forcesAreValid = true;
+                }
+                if (multipleGroups)
+                    kickForces = &groupForces.emplace(mask, force).first->second;
             }
-            // kinds alternate: the next sub-step is a drift, which shares this pass unless it projects first
-            const bool fuse = (s+1 < numSubsteps && !projectBefore[s+1]);
+            const vector<Vec3>& f = *kickForces;
+            // a drift right after this kick shares its pass, unless it projects the velocities first (a kick of
+            // another force group may follow too: multiple time stepping)
+            const bool fuse = (s+1 < numSubsteps && integrator.getSubstepKind(s+1) == SymPRKIntegrator::Drift &&
+                               !projectBefore[s+1]);
             const double cdtDrift = (fuse ? integrator.getSubstepCoefficient(s+1)*dt : 0.0);
             if (exact) {
-                computeProjection(pos, force);
+                computeProjection(pos, f);
                 parallelFor([&] (int t, int start, int end) {
                     for (int i = start; i < end; i++) {
                         if (masses[i] != 0.0) {
-                            Vec3 a = force[i]/masses[i] - acm - alpha.cross(pos[i]-com);
+                            Vec3 a = f[i]/masses[i] - acm - alpha.cross(pos[i]-com);
                             vel[i] = vel[i] + a*cdt;
                         }
                         if (fuse)
@@ -313,7 +338,7 @@ void ReferenceIntegrateSymPRKStepKernel::execute(ContextImpl& context, const Sym
                     for (int i = start; i < end; i++) {
                         if (masses[i] != 0.0)
                             for (int j = 0; j < 3; j++)
-                                vel[i][j] = vel[i][j] + cdt*force[i][j]/masses[i];
+                                vel[i][j] = vel[i][j] + cdt*f[i][j]/masses[i];
                         if (fuse)
                             driftAtom(i, cdtDrift);
                     }

@@ -4,6 +4,7 @@
 #include "openmm/SymPRKKernels.h"
 #include "ReferencePlatform.h"
 #include <functional>
+#include <map>
 #include <vector>
 
 namespace OpenMM {
@@ -42,7 +43,8 @@ private:
     std::vector<double> masses, inverseMasses;
     std::vector<Vec3> xRef, xUnconstrained, vBefore;
     std::vector<int> threadStart;
-    bool hasConstraints, hasVirtualSites, useThreads;
+    bool hasConstraints, hasVirtualSites, useThreads, multipleGroups;
+    std::map<int, std::vector<Vec3> > groupForces;  // multiple time stepping: forces per group mask
     int numParticles;
     long long blowUpStep;
     // exact-momentum projection: centre of mass, acceleration of the centre of mass, angular acceleration

@@ -29,13 +29,15 @@ void SymPRKIntegratorProxy::serialize(const void* object, SerializationNode& nod
         SerializationNode& s = substeps.createChildNode("Substep");
         s.setStringProperty("kind", integrator.getSubstepKind(i) == SymPRKIntegrator::Kick ? "kick" : "drift");
         s.setDoubleProperty("c", integrator.getSubstepCoefficient(i));
+        if (integrator.getSubstepForceGroups(i) != -1)
+            s.setIntProperty("groups", integrator.getSubstepForceGroups(i));
     }
 }
 
 void* SymPRKIntegratorProxy::deserialize(const SerializationNode& node) const {
     if (node.getIntProperty("version") != 1)
         throw OpenMMException("SymPRKIntegrator: unsupported serialization version");
-    vector<int> kinds;
+    vector<int> kinds, groups;
     vector<double> coefficients;
     for (const SerializationNode& s : node.getChildNode("Substeps").getChildren()) {
         string kind = s.getStringProperty("kind");
@@ -46,8 +48,10 @@ void* SymPRKIntegratorProxy::deserialize(const SerializationNode& node) const {
         else
             throw OpenMMException("SymPRKIntegrator: unknown sub-step kind '"+kind+"' in XML");
         coefficients.push_back(s.getDoubleProperty("c"));
+        groups.push_back(s.getIntProperty("groups", -1));
     }
     SymPRKIntegrator* integrator = new SymPRKIntegrator(node.getDoubleProperty("stepSize"), kinds, coefficients);
+    integrator->setSubsteps(kinds, coefficients, groups);
     integrator->setConstraintTolerance(node.getDoubleProperty("constraintTolerance"));
     integrator->setIntegrationForceGroups(node.getIntProperty("integrationForceGroups", 0xFFFFFFFF));
     integrator->setExactMomentum(node.getBoolProperty("exactMomentum", false));

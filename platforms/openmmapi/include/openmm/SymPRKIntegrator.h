@@ -43,16 +43,28 @@ public:
     SymPRKIntegrator(double stepSize, const std::vector<int>& kinds, const std::vector<double>& coefficients);
     /**
      * Set the sub-step sequence: kinds[i] is Kick (0) or Drift (1), coefficients[i] the fraction of the
-     * step size.  Adjacent sub-steps of the same kind are merged and zero coefficients dropped.  Cannot
-     * be called once the integrator is bound to a Context.
+     * step size.  Adjacent sub-steps of the same kind (and, for kicks, the same force groups) are merged and
+     * zero coefficients dropped.  Cannot be called once the integrator is bound to a Context.
      */
     void setSubsteps(const std::vector<int>& kinds, const std::vector<double>& coefficients);
+    /**
+     * The same, with the force groups of every kick: groups[i] is a bit mask of force groups (as in
+     * Context::getState), or -1 for the integrator's integration force groups (drifts ignore it).  Kicks of
+     * different groups make a multiple-time-step method; the forces of every group are cached until the
+     * positions change, so each group is evaluated only where a drift came between two of its kicks.
+     */
+    void setSubsteps(const std::vector<int>& kinds, const std::vector<double>& coefficients, const std::vector<int>& groups);
+    /** The force-group mask of sub-step index (-1: the integration force groups; drifts: -1). */
+    int getSubstepForceGroups(int index) const;
     int getNumSubsteps() const {
         return kinds.size();
     }
     int getSubstepKind(int index) const;
     double getSubstepCoefficient(int index) const;
-    /** Force evaluations per step in a long run (a closing kick's forces serve the next opening kick). */
+    /**
+     * Force evaluations per step in a long run, all groups counted: a kick needs one when a drift came since
+     * the previous kick of its force groups (cyclically, so a closing kick's forces serve the next opening kick).
+     */
     int getForceEvaluationsPerStep() const;
     /**
      * Project the forces of every kick onto zero net force and zero net torque about the centre of mass
@@ -126,7 +138,7 @@ protected:
     void loadCheckpoint(std::istream& stream);
 
 private:
-    std::vector<int> kinds;
+    std::vector<int> kinds, groups;
     std::vector<double> coefficients;
     bool exactMomentum, forcesAreValid;
     std::string methodName;
