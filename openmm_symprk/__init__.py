@@ -37,6 +37,7 @@ _LAZY = {
     "diagnostics": ".conservation.diagnostics",
     "ConservationReporter": ".conservation.reporters",
     "VelocityTRRReporter": ".conservation.reporters",
+    "split_forces": ".systems.forcegroups",
 }
 
 
