@@ -12,7 +12,7 @@ from .properties import has_constraints, masses
 #: Gas constant in kJ/mol/K (OpenMM's value).
 R_KJ = unit.MOLAR_GAS_CONSTANT_R.value_in_unit(unit.kilojoule_per_mole / unit.kelvin)
 
-__all__ = ["minimise", "constrain_velocities", "maxwell_boltzmann", "R_KJ"]
+__all__ = ["minimise", "constrain_velocities", "maxwell_boltzmann", "equilibrate", "R_KJ"]
 
 
 def _context(system, platform="Reference", properties=None):
@@ -73,3 +73,26 @@ def maxwell_boltzmann(system: mm.System, positions, temperature: float, seed: in
         spin = np.cross(np.asarray(angular_velocity, dtype=float), x - centre_of_mass(x, m))
         v += np.where(m[:, None] > 0, spin, 0.0)
     return constrain_velocities(system, x, v)
+
+
+def equilibrate(system: mm.System, positions, temperature: float, picoseconds: float, seed: int,
+                step_fs: float = 2.0, platform="CPU", properties=None):
+    """(positions, velocities) after ``picoseconds`` of Langevin dynamics at ``temperature`` (friction 1/ps) from
+    Maxwell-Boltzmann velocities: an equilibrated state to start NVE runs from.  The velocities are constrained
+    and taken at the same time as the positions (LangevinMiddleIntegrator's are on-step)."""
+    integrator = mm.LangevinMiddleIntegrator(temperature * unit.kelvin, 1.0 / unit.picosecond,
+                                             step_fs * unit.femtoseconds)
+    integrator.setRandomNumberSeed(seed)
+    plat = mm.Platform.getPlatformByName(platform) if isinstance(platform, str) else platform
+    ctx = mm.Context(system, integrator, plat, properties or {})
+    try:
+        x = _nm(positions)
+        ctx.setPositions(x)
+        ctx.setVelocities(maxwell_boltzmann(system, x, temperature, seed))
+        integrator.step(max(0, int(round(picoseconds * 1000.0 / step_fs))))
+        st = ctx.getState(getPositions=True, getVelocities=True)
+        x = np.array(st.getPositions(asNumpy=True).value_in_unit(unit.nanometer))
+        v = np.array(st.getVelocities(asNumpy=True).value_in_unit(unit.nanometer / unit.picosecond))
+    finally:
+        del ctx
+    return x, constrain_velocities(system, x, v)

@@ -167,3 +167,26 @@ def test_records_are_typed_and_versioned(tmp_path):
         RunRecord.from_json(dict(data, schema=1))
     with pytest.raises(SchemaError, match="unknown field.*bogus"):
         RunRecord.from_json(dict(data, bogus=1))
+
+
+def test_production_scene_measures_drift_fluctuation_and_speed_against_a_baseline(tmp_path):
+    """A small expensive-PME box through the production pipeline: MTS rows, OpenMM's MTSIntegrator, the summary
+    table and the chart."""
+    from openmm_symprk.studies.bench.aggregate import format_summary
+
+    cfg = {"mode": "test", "methods": ["openmm-verlet"], "timing_s": 0.05, "threads": 1,
+           "scenes": {"water-pme-accurate": {
+               "params": {"box_nm": 1.8, "ewald_tolerance": 1e-4, "equilibrate_ps": 0.1}, "length_ps": 0.12,
+               "samples": 12, "stability": None, "eval_s": 1e-3, "steps_fs": [2.0], "baseline": ["openmm-verlet", 2.0],
+               "rows": [["openmm-verlet", 2.0], ["verlet", 2.0], ["verlet@mts2", 4.0], ["openmm-mts2", 4.0]]}}}
+    res = run_sweep(cfg, str(tmp_path / "prod"), workers=1, progress=False, log=lambda *a: None)
+    summary = res["production"]["water-pme-accurate"]
+    assert summary["baseline"] == {"method": "openmm-verlet", "step_fs": 2.0}
+    rows = {(r["method"], r["step_fs"]): r for r in summary["rows"]}
+    assert set(rows) == {("openmm-verlet", 2.0), ("verlet", 2.0), ("verlet@mts2", 4.0), ("openmm-mts2", 4.0)}
+    for r in rows.values():
+        assert r["status"] == "ok" and r["ns_per_day"] > 0 and r["fluctuation"] > 0 and r["drift_err"] > 0, r
+    assert rows[("openmm-verlet", 2.0)]["speedup"] == pytest.approx(1.0) and rows[("openmm-verlet", 2.0)]["matches"]
+    text = format_summary(res)
+    assert "NVE production runs" in text and "fastest row at the baseline's drift and fluctuation" in text
+    assert any(p.endswith("bench_production_water-pme-accurate.png") for p in res["charts"])

@@ -69,7 +69,9 @@ def aggregate(config, scenes, jobs, store) -> dict:
                                           "cores": _cores()},
             "scenes": scene_info, "runs": runs, "references": list(refs.values()), "stability": stab,
             "best": best_at_accuracy(accurate),
-            "best_energy": best_at_accuracy(accurate, ENERGY_TARGETS, "energy_error_per_dof")}
+            "best_energy": best_at_accuracy(accurate, ENERGY_TARGETS, "energy_error_per_dof"),
+            "production": {name: production_summary(config["scenes"][name], [r for r in runs if r["scene"] == name])
+                           for name, sc in scenes.items() if sc.purpose == "production"}}
 
 
 def _cores():
@@ -158,18 +160,88 @@ def format_best(results, key="best", what="an RMS trajectory error at the final 
     return "\n".join(lines)
 
 
+#: Production scenes: a configuration "matches" the baseline when its energy fluctuation is at most this factor
+#: of the baseline's and its drift is no larger within two combined standard errors (drifts over tens of ps are
+#: measured with errors of their own size).
+FLUCTUATION_SLACK = 1.10
+
+
+def _speed(r):
+    """Wall time per simulated fs in units of the paired VerletIntegrator's time per step (machine-load free)."""
+    if r.get("wall_vs_verlet_paired") and r.get("step_fs"):
+        return r["wall_vs_verlet_paired"] / r["step_fs"]
+    return None
+
+
+def production_summary(scene_config: dict, runs: list) -> dict:
+    """Per production scene: every row's ns/day, its speed against the baseline (OpenMM's VerletIntegrator at 2 fs,
+    or at its largest good step) measured in the same run, its energy drift and fluctuation, whether it matches
+    the baseline's accuracy, and the fastest row that does."""
+    good = [r for r in runs if usable(r) and r.get("energy_std_per_dof") is not None]
+    spec = scene_config.get("baseline", ["openmm-verlet", 2.0])
+    if spec == "largest-good openmm-verlet":
+        verlets = [r for r in good if r["method"] == "openmm-verlet"]
+        base = max(verlets, key=lambda r: r["step_fs"]) if verlets else None
+    else:
+        base = next((r for r in good if r["method"] == spec[0] and r["step_fs"] == float(spec[1])), None)
+    rows = []
+    for r in runs:
+        row = {"method": r["method"], "step_fs": r["step_fs"], "status": r["status"] if not r.get("failed") else
+               f"failed: {r.get('failure')}", "ns_per_day": 86.4 / r["wall_per_ps"] if r.get("wall_per_ps") else None,
+               "drift": r.get("drift_kT_per_ns_per_dof"), "drift_err": r.get("drift_kT_stderr"),
+               "fluctuation": r.get("energy_std_per_dof"), "speedup": None, "matches": None}
+        if base is not None and _speed(base) and _speed(r):
+            row["speedup"] = _speed(base) / _speed(r)
+        if base is not None and r in good:
+            tol = 2 * float(np.hypot(base["drift_kT_stderr"] or 0.0, r["drift_kT_stderr"] or 0.0))
+            row["matches"] = bool(abs(r["drift_kT_per_ns_per_dof"]) <= abs(base["drift_kT_per_ns_per_dof"]) + tol
+                                  and r["energy_std_per_dof"] <= FLUCTUATION_SLACK * base["energy_std_per_dof"])
+        rows.append(row)
+    winners = sorted((row for row in rows if row["matches"] and row["speedup"]), key=lambda row: -row["speedup"])
+    return {"baseline": None if base is None else {"method": base["method"], "step_fs": base["step_fs"]},
+            "rows": rows, "best": winners[0] if winners else None}
+
+
+def format_production(results, scene) -> str:
+    summary = results.get("production", {}).get(scene)
+    if not summary:
+        return ""
+    base = summary["baseline"]
+    head = (f"{'row':28s} {'h/fs':>5s} {'ns/day':>8s} {'x base':>7s} {'drift kT/ns/DOF':>20s} {'std(E)/DOF':>11s} "
+            f"{'matches':>8s}  status")
+    lines = [f"baseline: {label(base['method'])} at {base['step_fs']:g} fs" if base else "baseline: none usable",
+             head, "-" * len(head)]
+    for row in sorted(summary["rows"], key=lambda row: -(row["speedup"] or 0)):
+        drift = (f"{row['drift']:+.2e} +- {row['drift_err']:.1e}" if row["drift"] is not None else "-")
+        matches = "-" if row["matches"] is None else ("yes" if row["matches"] else "no")
+        lines.append(f"{label(row['method']):28s} {row['step_fs']:5g} {_fmt(row['ns_per_day'], '8.2f'):>8s} "
+                     f"{_fmt(row['speedup'], '7.2f'):>7s} {drift:>20s} {_fmt(row['fluctuation'], '11.2e'):>11s} "
+                     f"{matches:>8s}  {row['status']}")
+    best = summary["best"]
+    lines.append(f"fastest row at the baseline's drift and fluctuation: "
+                 + (f"{label(best['method'])} at {best['step_fs']:g} fs, {best['speedup']:.2f}x the baseline"
+                    if best else "none"))
+    return "\n".join(lines)
+
+
 def format_summary(results) -> str:
     out = [f"symprk bench ({results['config']['mode']}): OpenMM {results['machine']['openmm']}, "
            f"{results['machine']['cores']} cores"]
     for name, info in results["scenes"].items():
+        if info["purpose"] == "production":
+            out += ["", f"== {name}: {info['description']} [{info['platform']}; NVE production runs]",
+                    format_production(results, name)]
+            continue
         ref = next((r for r in results["references"] if r["scene"] == name), None)
         src = "exact solution" if info["exact"] else (
             f"reference {ref['method']} at {ref['step_fs']:.4g} fs (floor {_fmt(ref.get('reference_floor'))} nm)"
             if ref else "no trajectory reference")
         out += ["", f"== {name}: {info['description']} [{info['platform']}; errors vs {src}]",
                 format_runs(results, name)]
-    out += ["", "== largest stable step", format_stability(results), "", format_best(results), "",
-            format_best(results, "best_energy", "a max |E - E0| per DOF", "kJ/mol")]
+    if results.get("stability"):
+        out += ["", "== largest stable step", format_stability(results)]
+    if results.get("best"):
+        out += ["", format_best(results), "", format_best(results, "best_energy", "a max |E - E0| per DOF", "kJ/mol")]
     return "\n".join(out)
 
 

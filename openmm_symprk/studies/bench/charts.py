@@ -260,11 +260,50 @@ def speed_chart(results, path) -> str | None:
     return path
 
 
+def production_chart(results, scene, path) -> str | None:
+    """Speed against accuracy of a production scene: speed-up over the baseline (same run, machine-load free)
+    against the energy drift (kT/ns/DOF, with its standard error) and against the energy fluctuation per DOF."""
+    summary = results.get("production", {}).get(scene)
+    rows = [r for r in (summary or {}).get("rows", []) if r["speedup"] and r["fluctuation"] is not None]
+    if not rows:
+        return None
+    base = summary["baseline"]
+    fig, axes = plt.subplots(1, 2, figsize=(13, 5.2))
+    for ax, key, ylabel in ((axes[0], "drift", "|energy drift| (kT / ns / DOF)"),
+                            (axes[1], "fluctuation", "std(E) per DOF (kJ/mol)")):
+        for r in rows:
+            is_base = base and r["method"] == base["method"] and r["step_fs"] == base["step_fs"]
+            colour = "black" if r["method"].startswith("openmm") else ("C2" if r["matches"] else "C3")
+            y = abs(r[key])
+            err = r["drift_err"] if key == "drift" else None
+            ax.errorbar(r["speedup"], max(y, 1e-12), yerr=err, fmt="s" if is_base else "o", color=colour, ms=7 if is_base
+                        else 5, capsize=3)
+            ax.annotate(f"{label(r['method'])} {r['step_fs']:g} fs", (r["speedup"], max(y, 1e-12)), fontsize=7,
+                        xytext=(4, 3), textcoords="offset points")
+        if base:
+            b = next(r for r in rows if r["method"] == base["method"] and r["step_fs"] == base["step_fs"])
+            ax.axhline(abs(b[key]), color="0.6", ls=":", lw=1)
+        ax.axvline(1.0, color="0.6", ls=":", lw=1)
+        ax.set_yscale("log")
+        ax.set_xlabel("speed-up over the baseline (wall time per simulated ps, same run)")
+        ax.set_ylabel(ylabel)
+    info = results["scenes"][scene]
+    fig.suptitle(f"{scene}: {info['description']}\nbaseline (square): {label(base['method'])} at {base['step_fs']:g} fs; "
+                 "green: drift and fluctuation no larger than the baseline's; red: larger; black: OpenMM's integrators",
+                 fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return path
+
+
 def make_charts(results, folder) -> list:
     """Write every chart of ``results`` into ``folder``; returns the paths written."""
     os.makedirs(folder, exist_ok=True)
     paths = []
     for scene, info in results["scenes"].items():
+        if info["purpose"] == "production":
+            paths.append(production_chart(results, scene, os.path.join(folder, f"bench_production_{scene}.png")))
         if info["purpose"] == "accuracy":
             paths.append(work_precision(results, scene, os.path.join(folder, f"bench_work_precision_{scene}.png")))
             paths.append(energy_chart(results, scene, os.path.join(folder, f"bench_energy_{scene}.png")))

@@ -1,6 +1,7 @@
 """``symprk bench``: work-precision sweeps and stability searches (``main(argv)``).
 
     symprk bench --quick                       # CI: seconds
+    symprk bench --production                  # solvated villin, HMR, multiple time stepping: about an hour
     symprk bench --workers 2                   # the full sweep of docs/benchmarks.md
     symprk bench --resume                      # continue an interrupted sweep in the same --out
     symprk bench --summary                     # print the tables of a finished sweep
@@ -64,6 +65,9 @@ def build_parser() -> argparse.ArgumentParser:
                     "scene; energy, momentum, constraint and trajectory errors; force evaluations and wall time "
                     "per ps; largest stable step by bisection.  Writes results.json, summary.txt and charts.")
     p.add_argument("--quick", action="store_true", help="CI mode: tiny scenes, seconds")
+    p.add_argument("--production", action="store_true",
+                   help="production-shaped runs: solvated villin (with and without HMR) and an expensive-PME box, "
+                        "NVE drift, fluctuation and ns/day (about an hour on 2 cores)")
     p.add_argument("--out", help="output folder (default bench-results/quick or bench-results/full)")
     p.add_argument("--scenes", nargs="+", metavar="NAME", help=f"scenes to run (of {', '.join(SCENES)})")
     p.add_argument("--methods", nargs="+", metavar="NAME",
@@ -93,7 +97,7 @@ def build_parser() -> argparse.ArgumentParser:
 def make_config(args) -> dict:
     from . import presets
 
-    base = presets.quick() if args.quick else presets.full()
+    base = presets.quick() if args.quick else presets.production() if args.production else presets.full()
     scenes = _list(args.scenes)
     user = bool(args.system_xml or args.pdb)
     if user:
@@ -132,7 +136,8 @@ def make_config(args) -> dict:
 
 def main(argv=None) -> int:
     args = build_parser().parse_args(argv)
-    out = args.out or os.path.join("bench-results", "quick" if args.quick else "full")
+    out = args.out or os.path.join("bench-results", "quick" if args.quick else
+                                   "production" if args.production else "full")
     if args.summary:
         from .aggregate import format_summary
 

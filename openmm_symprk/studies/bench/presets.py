@@ -5,9 +5,12 @@ A configuration is plain JSON-ready data (it is saved in results.json)::
     {"mode": ..., "methods": [...], "reference": {"method": "kahan-li-8", "factor": 4},
      "timing_s": 0.5, "threads": 1,
      "scenes": {name: {"params": {...}, "steps_fs": [...], "length_ps": T, "samples": n,
-                       "stability": {...} | None, "eval_s": cost hint, "platform": optional}}}
+                       "stability": {...} | None, "eval_s": cost hint, "platform": optional,
+                       "rows": [[row, step_fs], ...] (optional: instead of methods x steps_fs),
+                       "baseline": [row, step_fs] (production scenes: what the others are compared to)}}}
 
 Every step size must divide the run length (trajectory errors are compared at the same final time).
+:func:`production` is the sweep of the production-shaped scenes (``symprk bench --production``).
 ``stability`` holds the search settings of :func:`~.stability.driver` (``linear`` for the harmonic toy).
 """
 from __future__ import annotations
@@ -82,10 +85,57 @@ def quick() -> dict:
     }
 
 
+def production() -> dict:
+    """Production-shaped runs (``symprk bench --production``): the solvated villin box as OpenMM users run it,
+    with and without hydrogen mass repartitioning, and a box whose slow force is the expensive part; NVE, energy
+    drift and fluctuation, ns/day.  About an hour on 2 cores (a benchmark, not a test)."""
+    return {
+        "mode": "production",
+        "methods": ["openmm-verlet", "verlet"],
+        "timing_s": 4.0,
+        "threads": 2,
+        "scenes": {
+            "villin-pme": {
+                "params": {}, "length_ps": 24.0, "samples": 240, "stability": None, "eval_s": 1.2e-2,
+                "steps_fs": [2.0], "baseline": ["openmm-verlet", 2.0],
+                "rows": [["openmm-verlet", 2.0], ["verlet", 2.0], ["omelyan-2", 4.0], ["omelyan-2", 4.8],
+                         ["pefrl", 6.0], ["verlet@mts2", 4.0], ["openmm-mts2", 4.0], ["omelyan-2/verlet@mts2", 6.0],
+                         ["omelyan-2/verlet@mts1", 4.8]]},
+            "villin-pme-hmr": {
+                "params": {}, "length_ps": 24.0, "samples": 240, "stability": None, "eval_s": 1.2e-2,
+                "steps_fs": [4.0], "baseline": "largest-good openmm-verlet",
+                "rows": [["openmm-verlet", 2.0], ["openmm-verlet", 3.0], ["openmm-verlet", 4.0],
+                         ["openmm-verlet", 4.8], ["verlet", 4.0], ["omelyan-2", 6.0], ["omelyan-2", 8.0],
+                         ["pefrl", 8.0], ["verlet@mts2", 6.0], ["openmm-mts2", 6.0], ["omelyan-2/verlet@mts1", 8.0]]},
+            "water-pme-accurate": {
+                "params": {}, "length_ps": 12.0, "samples": 120, "stability": None, "eval_s": 4e-2,
+                "steps_fs": [2.0], "baseline": ["openmm-verlet", 2.0],
+                "rows": [["openmm-verlet", 2.0], ["verlet", 2.0], ["verlet@mts2", 4.0], ["openmm-mts2", 4.0],
+                         ["verlet@mts4", 6.0], ["openmm-mts4", 6.0], ["omelyan-2/verlet@mts1", 4.0],
+                         ["omelyan-2/verlet@mts2", 6.0]]},
+        },
+    }
+
+
+def rows_of(config: dict, scene: str) -> list:
+    """[(row, step_fs)] of a scene: its explicit rows, or the sweep's methods x the scene's step sizes."""
+    sc = config["scenes"][scene]
+    if sc.get("rows"):
+        return [(m, float(h)) for m, h in sc["rows"]]
+    if sc.get("production") and sc.get("production_rows"):
+        return [(m, float(h)) for m, h in sc["production_rows"]]
+    return [(m, float(h)) for h in sc["steps_fs"] for m in sc.get("methods", config["methods"])]
+
+
 def user_defaults() -> dict:
-    """Settings for a user-supplied system (molecular-dynamics step sizes, short runs)."""
+    """Settings for a user-supplied system: molecular-dynamics step sizes and short runs against a reference run;
+    a periodic one is measured like a production run instead (``production_rows``, ``production_length_ps``):
+    NVE drift, fluctuation and ns/day against OpenMM's VerletIntegrator at 2 fs."""
     return {"params": {}, "steps_fs": [0.5, 1.0, 2.0, 3.0, 4.0], "length_ps": 0.24, "samples": 40,
-            "stability": _md_stability(200), "eval_s": 1e-2}
+            "stability": _md_stability(200), "eval_s": 1e-2, "baseline": ["openmm-verlet", 2.0],
+            "production_rows": [["openmm-verlet", 2.0], ["verlet", 2.0], ["omelyan-2", 4.0], ["pefrl", 6.0],
+                                ["verlet@mts2", 4.0], ["openmm-mts2", 4.0], ["omelyan-2/verlet@mts2", 6.0]],
+            "production_length_ps": 12.0, "production_samples": 120}
 
 
 def select(config: dict, scenes=None, methods=None, steps_fs=None, length_ps=None, stability=True) -> dict:
@@ -96,18 +146,21 @@ def select(config: dict, scenes=None, methods=None, steps_fs=None, length_ps=Non
         if unknown:
             from .registry import SCENES
 
-            extra = {s: full()["scenes"][s] for s in unknown if s in SCENES}
+            known = dict(full()["scenes"], **production()["scenes"])
+            extra = {s: known[s] for s in unknown if s in SCENES}
             bad = [s for s in unknown if s not in extra]
             if bad:
                 raise ValueError(f"unknown scene(s) {', '.join(bad)}; known: {', '.join(SCENES)}")
             cfg["scenes"].update(extra)
         cfg["scenes"] = {k: v for k, v in cfg["scenes"].items() if k in scenes}
     if methods:
-        from ...methods.catalogue import get_method
-        from .runs import OPENMM_ROWS
+        from .runs import canonical_row
 
-        cfg["methods"] = [m if m in OPENMM_ROWS else get_method(m).name for m in methods]
+        cfg["methods"] = [canonical_row(m) for m in methods]
     for sc in cfg["scenes"].values():
+        if methods or steps_fs:
+            sc.pop("rows", None)  # an explicit grid replaces a scene's own rows
+            sc.pop("production_rows", None)
         if steps_fs:
             sc["steps_fs"] = [float(h) for h in steps_fs]
         if length_ps:
@@ -120,7 +173,7 @@ def select(config: dict, scenes=None, methods=None, steps_fs=None, length_ps=Non
 def check(config: dict):
     """Raise ValueError if a step size does not divide its scene's run length."""
     for name, sc in config["scenes"].items():
-        for h in sc["steps_fs"]:
+        for h in sorted({h for _, h in rows_of(config, name)}):
             n = sc["length_ps"] * 1e3 / h
             if abs(n - round(n)) > 1e-6 * n or round(n) < 1:
                 raise ValueError(f"scene {name}: step {h} fs does not divide the run length "

@@ -12,7 +12,7 @@ from __future__ import annotations
 from dataclasses import asdict, dataclass, field, fields
 
 #: Version of the JSON schema of run records, stability records and results.json.
-SCHEMA_VERSION = 2
+SCHEMA_VERSION = 3
 
 __all__ = ["SCHEMA_VERSION", "SchemaError", "RunRecord", "StabilityRecord"]
 
@@ -93,6 +93,9 @@ class RunRecord(_Record):
     dL_rel: float | None = None
     constraint_error: float | None = None
     traj_error: float | None = None
+    energy_std_per_dof: float | None = None  # production scenes: std of E per DOF (kJ/mol)
+    drift_kT_per_ns_per_dof: float | None = None  # production scenes: energy drift, kT per ns per DOF ...
+    drift_kT_stderr: float | None = None  # ... and its standard error (correlated samples)
     trace_t: list = field(default_factory=list)
     trace_de_per_dof: list = field(default_factory=list)
     # -- linear stability probes ---------------------------------------------------------------------------------

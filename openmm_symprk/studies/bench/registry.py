@@ -22,7 +22,8 @@ import openmm as mm
 import openmm.app as app
 import openmm.unit as unit
 
-from ...systems.prepare import maxwell_boltzmann, minimise
+from ...systems.forcegroups import split_forces
+from ...systems.prepare import equilibrate, maxwell_boltzmann, minimise
 from ...systems.properties import constraint_arrays, degrees_of_freedom, masses
 from . import toys
 
@@ -37,7 +38,8 @@ class BenchScene:
     positions: np.ndarray
     velocities: np.ndarray
     description: str
-    purpose: str = "accuracy"  # "accuracy": errors and stability; "speed": wall time only
+    purpose: str = "accuracy"  # "accuracy": errors and stability; "speed": wall time only; "production": NVE drift,
+    #                            fluctuation and ns/day of a periodic system (no trajectory reference)
     platform: str = "Reference"
     invariants: tuple = ALL_INVARIANTS
     temperature: float = 300.0  # K, for the Langevin comparison row
@@ -93,7 +95,7 @@ class BenchScene:
         p = self.payload()
         base = os.path.join(folder, self.name)
         _atomic_write(base + ".xml", p["xml"])
-        tmp = base + ".tmp.npz"
+        tmp = f"{base}.tmp{os.getpid()}.npz"
         np.savez(tmp, positions=p["positions"], velocities=p["velocities"])
         os.replace(tmp, base + ".npz")
         _atomic_write(base + ".json", json.dumps({"info": _plain(p["info"]), "fingerprint": p["fingerprint"]},
@@ -126,7 +128,7 @@ def _plain(obj):
 
 
 def _atomic_write(path: str, text: str):
-    tmp = path + ".tmp"
+    tmp = f"{path}.tmp{os.getpid()}"
     with open(tmp, "w") as fh:
         fh.write(text)
     os.replace(tmp, path)
@@ -225,6 +227,54 @@ def water_box_pme(box_nm: float = 3.9, seed: int = 17) -> BenchScene:
                       purpose="speed", platform="CPU", invariants=("energy", "momentum"), why=_why(water_box_pme))
 
 
+def _openmm_data(name: str) -> str:
+    return os.path.join(os.path.dirname(app.__file__), "data", name)
+
+
+def villin_pme(hmr: bool = False, equilibrate_ps: float = 10.0, seed: int = 29) -> BenchScene:
+    """OpenMM's test.pdb as shipped: the villin headpiece in 2,761 TIP3P waters (8,867 atoms), amber14, PME with a
+    0.9 nm cutoff, HBonds and rigid water, no CMMotionRemover; with ``hmr`` the hydrogen masses are repartitioned
+    to 1.5 Da (ForceField hydrogenMass).  NVE from one Langevin-equilibrated state at 300 K.
+
+    This is the run OpenMM users make, so it is where "what should I run" is answered: energy drift (kT/ns/DOF,
+    the unit of OpenMM's published validation), energy fluctuation per DOF and ns/day, against OpenMM's
+    VerletIntegrator on the same masses.  The reciprocal space of PME is in force group 1 (all else in group 0),
+    for the multiple-time-step rows; the single-level rows integrate both groups."""
+    pdb = app.PDBFile(_openmm_data("test.pdb"))
+    ff = app.ForceField("amber14-all.xml", "amber14/tip3p.xml")
+    system = ff.createSystem(pdb.topology, nonbondedMethod=app.PME, nonbondedCutoff=0.9 * unit.nanometer,
+                             constraints=app.HBonds, rigidWater=True, removeCMMotion=False,
+                             hydrogenMass=1.5 * unit.amu if hmr else None)
+    split_forces(system, slow="reciprocal")
+    pos = minimise(system, pdb.positions, "CPU", tolerance=10.0, max_iterations=200)
+    pos, vel = equilibrate(system, pos, 300.0, equilibrate_ps, seed)
+    return BenchScene("villin-pme-hmr" if hmr else "villin-pme", system, pos, vel,
+                      f"villin in water (test.pdb, {system.getNumParticles()} atoms), PME 0.9 nm, HBonds, rigid water"
+                      + (", HMR 1.5 Da" if hmr else "") + f", equilibrated {equilibrate_ps:g} ps at 300 K",
+                      purpose="production", platform="CPU", invariants=("energy",), why=_why(villin_pme))
+
+
+def water_pme_accurate(box_nm: float = 3.0, ewald_tolerance: float = 1e-6, equilibrate_ps: float = 5.0,
+                       seed: int = 31) -> BenchScene:
+    """A rigid TIP3P box (about 2,700 atoms) with PME tuned for accuracy (ewaldErrorTolerance 1e-6: a 128^3 grid
+    on 3 nm): the reciprocal space costs about twice the rest on the CPU platform, so it models the expensive,
+    smooth long-range force a user puts on the outer step of multiple time stepping (accurate electrostatics,
+    or a machine-learned or polarizable term).  It is where multiple time stepping pays."""
+    ff = app.ForceField("amber14/tip3p.xml")
+    mod = app.Modeller(app.Topology(), [])
+    mod.addSolvent(ff, model="tip3p", boxSize=mm.Vec3(box_nm, box_nm, box_nm) * unit.nanometer)
+    system = ff.createSystem(mod.topology, nonbondedMethod=app.PME, nonbondedCutoff=0.9 * unit.nanometer,
+                             constraints=app.HBonds, rigidWater=True, removeCMMotion=False,
+                             ewaldErrorTolerance=ewald_tolerance)
+    split_forces(system, slow="reciprocal")
+    pos = minimise(system, mod.positions, "CPU", tolerance=10.0, max_iterations=200)
+    pos, vel = equilibrate(system, pos, 300.0, equilibrate_ps, seed)
+    return BenchScene("water-pme-accurate", system, pos, vel,
+                      f"rigid TIP3P box, {system.getNumParticles()} atoms, PME with ewaldErrorTolerance "
+                      f"{ewald_tolerance:g} (reciprocal space in group 1)", purpose="production", platform="CPU",
+                      invariants=("energy",), why=_why(water_pme_accurate))
+
+
 #: Registry: name -> builder.  Default sweeps use all of them.
 SCENES = {
     "harmonic": harmonic,
@@ -233,6 +283,9 @@ SCENES = {
     "water-flexible": water_flexible,
     "villin": villin,
     "water-box-pme": water_box_pme,
+    "villin-pme": villin_pme,
+    "villin-pme-hmr": lambda **kw: villin_pme(hmr=True, **kw),
+    "water-pme-accurate": water_pme_accurate,
 }
 
 
@@ -264,7 +317,7 @@ def _invariants_of(system) -> tuple:
 
 def user_scene(name: str = "user", system_xml: str | None = None, state: str | None = None,
                pdb: str | None = None, forcefields=(), temperature: float = 300.0, seed: int = 23,
-               platform: str | None = None, minimize: bool = True) -> BenchScene:
+               platform: str | None = None, minimize: bool = True, equilibrate_ps: float = 2.0) -> BenchScene:
     """Your own system: a serialized System XML with positions (PDB or serialized State XML), or a PDB
     plus force-field file names (e.g. ``amber14-all.xml amber14/tip3pfb.xml``).
 
@@ -310,9 +363,18 @@ def user_scene(name: str = "user", system_xml: str | None = None, state: str | N
     platform = platform or ("CPU" if periodic else "Reference")
     if minimize:
         positions = minimise(system, positions, platform)
-    if velocities is None:
+    if velocities is None and periodic:
+        # a periodic system is measured like a production run: NVE from an equilibrated state
+        positions, velocities = equilibrate(system, positions, temperature, equilibrate_ps, seed, platform=platform)
+    elif velocities is None:
         velocities = maxwell_boltzmann(system, positions, temperature, seed)
+    if periodic:
+        try:
+            split_forces(system, slow="reciprocal")  # for the multiple-time-step rows
+        except ValueError:
+            pass  # no reciprocal space: the MTS rows report an error, the others run
     return BenchScene(name, system, positions, velocities,
                       f"user system ({system.getNumParticles()} atoms, {system.getNumConstraints()} constraints"
                       f"{', periodic' if periodic else ''})", platform=platform, invariants=_invariants_of(system),
-                      temperature=temperature, why="Supplied by the user.")
+                      temperature=temperature, purpose="production" if periodic else "accuracy",
+                      why="Supplied by the user.")

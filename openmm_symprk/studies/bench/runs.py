@@ -28,6 +28,7 @@ gives them the same position trajectory as velocity Verlet from (x0, v0).
 from __future__ import annotations
 
 import math
+import re
 import time
 import traceback
 import warnings
@@ -38,6 +39,7 @@ import openmm as mm
 import openmm.unit as unit
 
 from ...physics import angular_momentum, linear_momentum
+from ...systems.prepare import R_KJ
 from ..timing import interleaved
 from ...systems.properties import constraint_violation
 from . import measure
@@ -46,8 +48,10 @@ from .registry import BenchScene
 
 #: The comparison rows: OpenMM's own integrators.
 OPENMM_ROWS = ("openmm-verlet", "openmm-langevin")
-#: Constraint tolerance for every run (SETTLE ignores it; CCMA iterates to it).
+#: Constraint tolerance for every run (SETTLE ignores it; CCMA iterates to it) ...
 CONSTRAINT_TOLERANCE = 1e-10
+#: ... but production scenes run with OpenMM's default, as users do.
+PRODUCTION_CONSTRAINT_TOLERANCE = 1e-5
 #: Failure thresholds (see stability.py for their rationale).
 KT300 = 0.0083144626 * 300.0
 ENERGY_THRESHOLD_KT = 0.1  # kT(300 K) per degree of freedom
@@ -96,8 +100,39 @@ class Unsupported(Exception):
     """The method cannot run on this system."""
 
 
+#: Rows of multiple time stepping: "<method>[/<inner method>]@mts<n>" runs SymplecticIntegrator with the scene's slow
+#: force group 1 once per step and the fast group 0 n times; "openmm-mts<n>" is OpenMM's MTSIntegrator with the same.
+MTS_ROW = re.compile(r"^(?P<method>[^/@]+)(?:/(?P<inner>[^@]+))?@mts(?P<n>[0-9]+)$")
+OPENMM_MTS_ROW = re.compile(r"^openmm-mts(?P<n>[0-9]+)$")
+
+
+def mts_groups(n: int) -> list:
+    """The ``groups=`` of an MTS row: the scenes put the slow forces (PME reciprocal space) in group 1."""
+    return [(1, 1), (0, int(n))]
+
+
+def canonical_row(name: str) -> str:
+    """The canonical name of a bench row (catalogue aliases resolved); ValueError naming what is accepted."""
+    from ...methods.catalogue import get_method
+
+    if name in OPENMM_ROWS or OPENMM_MTS_ROW.match(name):
+        return name
+    m = MTS_ROW.match(name)
+    if m:
+        if int(m["n"]) < 1:
+            raise ValueError(f"row {name!r}: the number of inner steps must be >= 1")
+        inner = f"/{get_method(m['inner']).name}" if m["inner"] else ""
+        return f"{get_method(m['method']).name}{inner}@mts{int(m['n'])}"
+    try:
+        return get_method(name).name
+    except Exception as exc:
+        raise ValueError(f"{exc} Bench rows are catalogue names, {', '.join(OPENMM_ROWS)}, openmm-mts<n> (OpenMM's "
+                         f"MTSIntegrator) or <method>[/<inner>]@mts<n> (multiple time stepping)") from None
+
+
 def make_integrator(method: str, h_ps: float, scene: BenchScene, seed: int = 1, temperature=None):
     """(integrator, force evaluations per step, leapfrog?) for a row name."""
+    tolerance = PRODUCTION_CONSTRAINT_TOLERANCE if scene.purpose == "production" else CONSTRAINT_TOLERANCE
     if method == "openmm-verlet":
         ig, evals, leapfrog = mm.VerletIntegrator(h_ps), 1, True
     elif method == "openmm-langevin":
@@ -105,20 +140,28 @@ def make_integrator(method: str, h_ps: float, scene: BenchScene, seed: int = 1, 
         ig = mm.LangevinMiddleIntegrator(t * unit.kelvin, 1.0 / unit.picosecond, h_ps)
         ig.setRandomNumberSeed(seed)
         evals, leapfrog = 1, True
-    else:
-        from ...methods.catalogue import get_method
-        from ...integrators import SymplecticIntegrator
-        from ...integrators import ConstraintSupportError
+    elif OPENMM_MTS_ROW.match(method):
+        from openmm.mtsintegrator import MTSIntegrator
 
-        m = get_method(method)
+        n = int(OPENMM_MTS_ROW.match(method)["n"])
+        ig, evals, leapfrog = MTSIntegrator(h_ps, mts_groups(n)), 1 + n, False
+    else:
+        from ...integrators import ConstraintSupportError, SymplecticIntegrator
+        from ...methods.catalogue import get_method
+
+        mts = MTS_ROW.match(method)
+        m = get_method(mts["method"] if mts else method)
+        options = {} if m.symplectic else {"allow_nonsymplectic": True}
+        if mts:
+            options.update(groups=mts_groups(int(mts["n"])), inner_method=mts["inner"])
         try:
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
-                ig = SymplecticIntegrator(h_ps, m.name, system=scene.system, allow_nonsymplectic=True)
+                ig = SymplecticIntegrator(h_ps, m.name, system=scene.system, **options)
         except ConstraintSupportError as exc:
             raise Unsupported(str(exc)) from None
         evals, leapfrog = ig.program_info.force_evals, False
-    ig.setConstraintTolerance(CONSTRAINT_TOLERANCE)
+    ig.setConstraintTolerance(tolerance)
     return ig, evals, leapfrog
 
 
@@ -260,9 +303,16 @@ def _measure(spec, scene, ctx, ig, rec, arrays):
                dP=worst_p if "momentum" in inv else None,
                dL_rel=worst_l if "angular_momentum" in inv else None,
                constraint_error=worst_c, trace_t=ts, trace_de_per_dof=des)
+    if scene.purpose == "production" and len(ts) > 3:
+        # production figures: energy fluctuation and drift per DOF, the drift in kT/ns with its standard error
+        kT = R_KJ * scene.temperature
+        slope, stderr = measure.drift_with_error(ts, des)  # kJ/mol per ps per DOF
+        rec.update(energy_std_per_dof=float(np.std(des)), drift_kT_per_ns_per_dof=slope * 1e3 / kT,
+                   drift_kT_stderr=stderr * 1e3 / kT)
     if rec.blew_up:
         # the measured maxima only cover the samples before the blow-up: do not report them as errors
-        rec.update(energy_error=None, energy_error_per_dof=None, drift_per_ns_per_dof=None, dP=None, dL_rel=None)
+        rec.update(energy_error=None, energy_error_per_dof=None, drift_per_ns_per_dof=None, dP=None, dL_rel=None,
+                   energy_std_per_dof=None, drift_kT_per_ns_per_dof=None, drift_kT_stderr=None)
     completed = done == spec.n_steps and not rec.blew_up
     if completed:
         if scene.exact is not None:

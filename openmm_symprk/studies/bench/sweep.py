@@ -81,10 +81,15 @@ def _single(spec):
 
 
 def _evals(method):
+    """Force evaluations per step of a row (a cost estimate for scheduling)."""
+    from ...methods.catalogue import get_method
+    from .runs import MTS_ROW, OPENMM_MTS_ROW
+
     if method in OPENMM_ROWS:
         return 1
-    from ...methods.catalogue import get_method
-
+    mts = MTS_ROW.match(method) or OPENMM_MTS_ROW.match(method)
+    if mts:
+        return 1 + int(mts["n"])
     return get_method(method).force_evals
 
 
@@ -122,6 +127,10 @@ def prepare_scenes(config: dict, out: str, reuse: bool = True, log=print) -> dic
 # -- plan ----------------------------------------------------------------------------------------
 def plan(config: dict, scenes: dict) -> list:
     """The jobs of a sweep: runs, one reference run per molecular accuracy scene, stability searches."""
+    for name, sc in config["scenes"].items():  # a user's periodic System is measured like a production run
+        if scenes[name].purpose == "production" and sc.get("production_rows") and not sc.get("rows"):
+            sc.update(production=True, length_ps=sc.get("production_length_ps", sc["length_ps"]),
+                      samples=sc.get("production_samples", sc.get("samples", 50)), stability=None)
     presets.check(config)
     jobs = []
     timing = config.get("timing_s", 0.5)
@@ -131,12 +140,11 @@ def plan(config: dict, scenes: dict) -> list:
         scene = scenes[name]
         eval_s = sc.get("eval_s", 1e-3)
         length = sc["length_ps"]
-        for h in sc["steps_fs"]:
+        for m, h in presets.rows_of(config, name):
             n = round(length * 1e3 / h)
-            for m in methods:
-                spec = RunSpec(name, m, float(h), n, sc.get("samples", 50), "run", timing_s=timing, threads=threads)
-                jobs.append(_Job("run", _single(spec), name, m, cost=n * _evals(m) * eval_s))
-        if scene.purpose == "accuracy" and scene.exact is None:
+            spec = RunSpec(name, m, float(h), n, sc.get("samples", 50), "run", timing_s=timing, threads=threads)
+            jobs.append(_Job("run", _single(spec), name, m, cost=n * _evals(m) * eval_s))
+        if scene.purpose == "accuracy" and scene.exact is None and not sc.get("rows"):
             ref = config.get("reference", presets.REFERENCE)
             h_min = min(sc["steps_fs"])
             n = round(length * 1e3 / h_min) * int(ref["factor"])
@@ -148,7 +156,7 @@ def plan(config: dict, scenes: dict) -> list:
         if st and scene.purpose == "accuracy":
             from .stability import driver
 
-            for m in methods:
+            for m in sc.get("methods", methods):
                 est = 20 if st.get("linear") else 11
                 steps = 1 if st.get("linear") else st["probe_steps"]
                 jobs.append(_Job("stability", driver(name, m, st, threads=threads), name, m, estimate=est,
