@@ -24,7 +24,7 @@ import openmm as mm
 import openmm.app as app
 import openmm.unit as unit
 
-from ..physics import momenta
+from ..physics import momenta, temperature
 from ..systems.properties import constraint_violation as _violation
 from ..systems.properties import degrees_of_freedom, masses, molecules
 
@@ -33,7 +33,8 @@ _NM_PS = unit.nanometer / unit.picosecond
 _KJ = unit.kilojoule_per_mole
 
 __all__ = ["masses_of", "linear_momentum", "angular_momentum", "molecules", "molecule_angular_momentum",
-           "kinetic_energy", "energies", "constraint_violation", "degrees_of_freedom", "Diagnostics", "diagnostics"]
+           "kinetic_energy", "kinetic_temperatures", "energies", "constraint_violation", "degrees_of_freedom",
+           "Diagnostics", "diagnostics"]
 
 #: The System's masses (Da) -- the same function as openmm_symprk.systems.properties.masses.
 masses_of = masses
@@ -114,6 +115,24 @@ def molecule_angular_momentum(obj, system: mm.System | None = None, groups=None,
         if mg.sum() > 0:
             out[k] = momenta.angular_momentum(x[g], v[g], mg, about="com")
     return out
+
+
+def kinetic_temperatures(obj, system: mm.System | None = None, groups=None, momentum_fixed: bool = True,
+                         masses=None):
+    """Translational and rotational (and internal) kinetic temperature of the molecules, in K
+    (:class:`openmm_symprk.physics.temperature.KineticTemperatures`).
+
+    ``groups``: lists of particle indices (default: the molecules of the Context or System); every distance
+    constraint of the System is inside a molecule and removes an internal degree of freedom.
+    ``momentum_fixed``: the total momentum is conserved or removed (NVE without external forces, or a
+    CMMotionRemover): translation then has 3 N_mol - 3 degrees of freedom.  Positions must keep molecules whole
+    (OpenMM's State does unless asked to wrap them)."""
+    x, v, m, _, system = _resolve(obj, system, masses)
+    if groups is None:
+        src = obj.context if isinstance(obj, app.Simulation) else obj
+        groups = molecules(src if isinstance(src, mm.Context) else system)
+    n_constraints = system.getNumConstraints() if system is not None else 0
+    return temperature.kinetic_temperatures(x, v, m, [list(g) for g in groups], momentum_fixed, n_constraints)
 
 
 # -- energies and constraints --------------------------------------------------------------------

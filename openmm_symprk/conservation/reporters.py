@@ -12,7 +12,8 @@ momentum that is being reported.
 :class:`ConservationReporter` writes, like ``StateDataReporter``, one line per report: step, time,
 total energy, its drift (slope of a least-squares line through all reports so far, in kJ/mol per ns
 per degree of freedom), |P - P0|, |L - L0|/|L0| (L about the centre of mass, or about the origin),
-and the largest relative constraint violation; every figure is computed in float64 from the State
+the largest relative constraint violation, and the translational and rotational kinetic temperatures of the
+molecules (:mod:`openmm_symprk.physics.temperature`); every figure is computed in float64 from the State
 (:mod:`openmm_symprk.physics`).  At its first report it warns once, with the reason, about
 anything that keeps the system from conserving what is reported (:mod:`openmm_symprk.systems.checks`:
 the System's issues and thermostatting integrators, one :class:`ConservationWarning` per kind).
@@ -34,8 +35,9 @@ import openmm.app as app
 import openmm.unit as unit
 
 from ..physics import momenta
+from ..physics.temperature import kinetic_temperatures
 from ..systems.checks import conservation_issues, integrator_issues, warn_conservation, warn_once
-from ..systems.properties import constraint_arrays, constraint_violation, degrees_of_freedom, masses
+from ..systems.properties import constraint_arrays, constraint_violation, degrees_of_freedom, masses, molecules
 
 _NM, _NM_PS, _KJ = unit.nanometer, unit.nanometer / unit.picosecond, unit.kilojoule_per_mole
 
@@ -70,7 +72,7 @@ class ConservationReporter:
     """
 
     COLUMNS = ("Step", "Time (ps)", "Total Energy (kJ/mol)", "Energy drift (kJ/mol/ns/dof)",
-               "|dP| (amu nm/ps)", "|dL|/|L|", "Constraint error")
+               "|dP| (amu nm/ps)", "|dL|/|L|", "Constraint error", "T_trans (K)", "T_rot (K)")
 
     def __init__(self, file, reportInterval: int, about: str = "com", separator: str = ",",
                  append: bool = False, warn: bool = True):
@@ -116,13 +118,16 @@ class ConservationReporter:
         else:
             drift = float("nan")
         nL0 = float(np.linalg.norm(self._L0))
+        temps = kinetic_temperatures(x, v, m, self._molecules, True, self._system.getNumConstraints())
         rec = {"step": step, "time": t, "total_energy": total, "energy_drift": drift,
                "dP": float(np.linalg.norm(P - self._P0)),
                "dL_rel": float(np.linalg.norm(L - self._L0) / nL0) if nL0 > 0 else float("nan"),
-               "constraint_error": constraint_violation(x, self._constraints)}
+               "constraint_error": constraint_violation(x, self._constraints),
+               "T_trans": temps.translational, "T_rot": temps.rotational}
         self.records.append(rec)
         vals = [str(step), f"{t:.6g}", f"{total:.10g}", f"{drift:.4g}", f"{rec['dP']:.4g}",
-                f"{rec['dL_rel']:.4g}", f"{rec['constraint_error']:.4g}"]
+                f"{rec['dL_rel']:.4g}", f"{rec['constraint_error']:.4g}", f"{rec['T_trans']:.5g}",
+                f"{rec['T_rot']:.5g}"]
         print(self._sep.join(vals), file=self._out)
         try:
             self._out.flush()
@@ -134,6 +139,7 @@ class ConservationReporter:
         self._system = simulation.system
         self._masses = masses(self._system)
         self._constraints = constraint_arrays(self._system)
+        self._molecules = [list(g) for g in molecules(simulation.context)]
         self._dof = degrees_of_freedom(self._system)
         self._P0 = self._L0 = None
         self._t, self._e = [], []

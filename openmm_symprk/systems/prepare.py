@@ -7,10 +7,8 @@ import openmm as mm
 import openmm.unit as unit
 
 from ..physics import centre_of_mass
+from ..physics.temperature import R_KJ
 from .properties import has_constraints, masses
-
-#: Gas constant in kJ/mol/K (OpenMM's value).
-R_KJ = unit.MOLAR_GAS_CONSTANT_R.value_in_unit(unit.kilojoule_per_mole / unit.kelvin)
 
 __all__ = ["minimise", "constrain_velocities", "maxwell_boltzmann", "equilibrate", "R_KJ"]
 

@@ -8,8 +8,10 @@ import openmm.app as app
 import pytest
 
 from openmm_symprk import SymplecticIntegrator
-from openmm_symprk.conservation.analysis import FLOAT32_FLOOR, AngularMomentum, LinearMomentum, universe
-from openmm_symprk.conservation import angular_momentum, linear_momentum, molecule_angular_momentum
+from openmm_symprk.conservation.analysis import (FLOAT32_FLOOR, AngularMomentum, KineticTemperatures, LinearMomentum,
+                                                 universe)
+from openmm_symprk.conservation import (angular_momentum, kinetic_temperatures, linear_momentum,
+                                        molecule_angular_momentum)
 from openmm_symprk.conservation.reporters import VelocityTRRReporter, write_topology
 
 pytestmark = [pytest.mark.filterwarnings("ignore:Reload offsets"), pytest.mark.filterwarnings("ignore:Reader has no dt")]
@@ -22,14 +24,16 @@ def _record(scene, path, integrator=None, frames=6, every=20):
     sim.context.setVelocities(scene.velocities)
     rep = VelocityTRRReporter(str(path), every)
     sim.reporters.append(rep)
-    L, P, Lm = [], [], []
+    L, P, Lm, T = [], [], [], []
     for _ in range(frames):
         sim.step(every)
         L.append(angular_momentum(sim.context))
         P.append(linear_momentum(sim.context))
         Lm.append(molecule_angular_momentum(sim.context))
+        t = kinetic_temperatures(sim.context)
+        T.append((t.translational, t.rotational))
     rep.close()
-    return np.array(L), np.array(P), np.array(Lm)
+    return np.array(L), np.array(P), np.array(Lm), np.array(T)
 
 
 @pytest.fixture(scope="module")
@@ -46,7 +50,7 @@ def water8_module():
 
 
 def test_matches_in_process_to_float32_floor(recorded, water8_module):
-    path, (L, P, Lm) = recorded
+    path, (L, P, Lm, _) = recorded
     u = universe(water8_module.topology, str(path), system=water8_module.system)
     a = AngularMomentum(u.atoms, by="residues").run()
     p = LinearMomentum(u.atoms).run()
@@ -67,7 +71,7 @@ def test_guessed_masses_are_not_the_system_masses(recorded, water8_module, tmp_p
     conserved one; masses=System fixes it."""
     import MDAnalysis as mda
 
-    path, (L, _, _) = recorded
+    path, (L, _, _, _) = recorded
     pdb = str(tmp_path / "w.pdb")
     write_topology(pdb, water8_module.topology, water8_module.positions)
     u = mda.Universe(pdb, str(path))
@@ -78,7 +82,7 @@ def test_guessed_masses_are_not_the_system_masses(recorded, water8_module, tmp_p
 
 
 def test_fragments_and_origin(recorded, water8_module):
-    path, (L, _, _) = recorded
+    path, (L, _, _, _) = recorded
     u = universe(water8_module.topology, str(path), system=water8_module.system)
     frag = AngularMomentum(u.atoms, by="fragments").run()
     assert frag.results.groups.shape == (6, 8, 3)
@@ -101,3 +105,13 @@ def test_no_velocities_is_an_error(water8_module, tmp_path):
     write_topology(pdb, water8_module.topology, water8_module.positions)
     with pytest.raises(ValueError, match="no velocities"):
         AngularMomentum(mda.Universe(pdb).atoms).run()
+
+
+def test_kinetic_temperatures_from_a_trajectory_match_the_live_ones(recorded, water8_module):
+    path, (_, _, _, T) = recorded
+    u = universe(water8_module.topology, str(path), system=water8_module.system)
+    k = KineticTemperatures(u.atoms, masses=water8_module.system).run()
+    np.testing.assert_allclose(k.results.translational, T[:, 0], rtol=1e-5)
+    np.testing.assert_allclose(k.results.rotational, T[:, 1], rtol=1e-5)
+    assert k.results.dof == {"translational": 21, "rotational": 24, "internal": 0}
+    assert k.results.mean_difference == pytest.approx(float(np.mean(T[:, 1] - T[:, 0])), rel=1e-4)

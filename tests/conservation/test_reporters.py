@@ -39,15 +39,22 @@ def test_conservation_reporter_output_parses(water8, tmp_path):
     sim.step(200)
     rep.close()
     text = path.read_text().splitlines()
-    assert text[0].startswith('#"Step"') and len(text[0].split(",")) == 7
+    assert text[0].startswith('#"Step"') and len(text[0].split(",")) == 9
     data = np.loadtxt(path, delimiter=",", comments="#")
-    assert data.shape == (4, 7)
+    assert data.shape == (4, 9)
     assert list(data[:, 0]) == [50, 100, 150, 200]
     assert np.allclose(data[:, 1], [0.1, 0.2, 0.3, 0.4])
     assert np.isnan(data[0, 3]) and np.all(np.isfinite(data[1:, 3]))
     assert np.all(data[:, 4] < 1e-10)  # |dP|, Reference
     assert np.all(data[:, 5] < 1e-12)  # |dL|/|L|, Reference
     assert np.all(data[:, 6] < 1e-6)  # constraint error
+    # kinetic temperatures of the 8 spinning waters (150 K Maxwell-Boltzmann plus a spin): finite, positive,
+    # and equal to the package's own function on the final state
+    from openmm_symprk.conservation import kinetic_temperatures
+
+    t = kinetic_temperatures(sim.context)
+    assert np.all(data[:, 7:9] > 0) and data[-1, 7] == pytest.approx(t.translational, rel=1e-4)
+    assert data[-1, 8] == pytest.approx(t.rotational, rel=1e-4)
     assert rep.records[-1]["dL_rel"] == pytest.approx(data[-1, 5], rel=1e-3)
 
 
