@@ -197,3 +197,28 @@ def protein_vacuum(constraints=app.HBonds, temperature: float = 300.0, angular_v
     return Scene("villin-vacuum", system, mod.topology, np.array(pos), vel,
                  f"villin headpiece (test.pdb, {system.getNumParticles()} atoms) in vacuum, amber14, "
                  f"{system.getNumConstraints()} constraints")
+
+
+#: Rigid water models for :func:`water_box`: name -> (force field file, Modeller model name).
+WATER_MODELS = {"spce": ("amber14/spce.xml", "spce"), "tip3p": ("amber14/tip3p.xml", "tip3p")}
+
+
+def water_box(model: str = "spce", n_waters: int = 216, cutoff_nm: float = 0.9):
+    """A periodic box of ``n_waters`` rigid waters (SETTLE), PME with ``cutoff_nm``, no CMMotionRemover (so
+    an NVE run conserves the total momentum and the translational degrees of freedom are 3 N - 3).
+    Returns (system, topology, positions in nm); positions are Modeller's, not minimised."""
+    if model not in WATER_MODELS:
+        raise ValueError(f"unknown water model {model!r}; known: {', '.join(WATER_MODELS)}")
+    if int(n_waters) < 2:
+        raise ValueError(f"n_waters must be >= 2, got {n_waters!r}")
+    ffname, name = WATER_MODELS[model]
+    ff = app.ForceField(ffname)
+    mod = app.Modeller(app.Topology(), [])
+    mod.addSolvent(ff, model=name, numAdded=int(n_waters))
+    box = min(mod.topology.getUnitCellDimensions().value_in_unit(unit.nanometer))
+    if not 2 * cutoff_nm < box:
+        raise ValueError(f"cutoff {cutoff_nm} nm needs a box wider than {2 * cutoff_nm} nm; {n_waters} waters "
+                         f"give {box:.3f} nm: use more waters or a shorter cutoff")
+    system = ff.createSystem(mod.topology, nonbondedMethod=app.PME, nonbondedCutoff=cutoff_nm * unit.nanometer,
+                             constraints=app.HBonds, rigidWater=True, removeCMMotion=False)
+    return system, mod.topology, np.array(mod.positions.value_in_unit(unit.nanometer))

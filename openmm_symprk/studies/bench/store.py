@@ -13,33 +13,13 @@ import os
 
 import numpy as np
 
+from ..folders import write_json
 from .records import RunRecord
 
 
 def run_key(spec_dict: dict, fingerprint: str) -> str:
     text = json.dumps({"spec": spec_dict, "scene": fingerprint}, sort_keys=True)
     return hashlib.sha1(text.encode()).hexdigest()[:20]
-
-
-def _jsonable(obj):
-    if isinstance(obj, dict):
-        return {k: _jsonable(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [_jsonable(v) for v in obj]
-    if isinstance(obj, np.ndarray):
-        return obj.tolist()
-    if isinstance(obj, np.generic):
-        return obj.item()
-    if isinstance(obj, float) and obj != obj:
-        return None
-    return obj
-
-
-def write_json(path: str, data):
-    tmp = f"{path}.tmp{os.getpid()}"
-    with open(tmp, "w") as fh:
-        json.dump(_jsonable(data), fh, indent=1, allow_nan=True)
-    os.replace(tmp, path)
 
 
 class Store:

@@ -28,40 +28,20 @@ import os
 import time
 import warnings
 
+from ..folders import FolderLock, FolderLockedError, write_json
 from . import presets
 from .executors import make_executor
 from .records import RunRecord
 from .runs import OPENMM_ROWS, RunSpec, label
-from .store import Store, run_key, write_json
+from .store import Store, run_key
 
 
 class SweepExistsError(RuntimeError):
     """The output folder already holds finished runs and resume was not asked for."""
 
 
-class SweepLockedError(RuntimeError):
+class SweepLockedError(FolderLockedError):
     """Another sweep is running on the same output folder."""
-
-
-class _FolderLock:
-    """An exclusive lock on ``<out>/.lock`` for the life of a sweep (released when the process ends)."""
-
-    def __init__(self, out: str):
-        import fcntl
-
-        self.fh = open(os.path.join(out, ".lock"), "w")
-        try:
-            fcntl.flock(self.fh, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except OSError:
-            self.fh.close()
-            raise SweepLockedError(f"another symprk bench is running on {out}: wait for it, or use another --out") \
-                from None
-
-    def release(self):
-        import fcntl
-
-        fcntl.flock(self.fh, fcntl.LOCK_UN)
-        self.fh.close()
 
 
 class _Job:
@@ -248,7 +228,7 @@ def run_sweep(config: dict, out: str, workers: int = 2, scheduler: str | None = 
     Returns the results dict (see :func:`.aggregate.aggregate`), with ``stats`` = runs computed now and
     runs taken from disk."""
     os.makedirs(out, exist_ok=True)
-    lock = _FolderLock(out)
+    lock = FolderLock(out, "symprk bench", SweepLockedError)
     try:
         return _sweep(config, out, workers, scheduler, resume, charts, progress, on_result, log)
     finally:

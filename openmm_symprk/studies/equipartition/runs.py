@@ -1,0 +1,137 @@
+"""The OpenMM side of the equipartition study: the water box, its replica states and one NVE run.
+
+A run starts from a replica state (positions and on-step, constrained velocities after Langevin dynamics),
+lets the method settle for ``settle_ps`` (the kinetic energy redistributes itself in the method's own
+dynamics within a picosecond), then records every ``sample_fs``: time, translational and rotational
+temperature (3 N - 3 and 3 N degrees of freedom), potential and total energy.
+"""
+from __future__ import annotations
+
+import time
+
+import numpy as np
+import openmm as mm
+import openmm.unit as unit
+
+from ...methods.catalogue import get_method
+from ...physics.temperature import kinetic_temperatures
+from ...rigid.bodies import RigidBodies
+from ...systems.prepare import equilibrate, minimise
+from ...systems.properties import masses
+from ...systems.scenes import water_box
+from .presets import RIGID_PREFIX
+
+__all__ = ["WaterBox", "build_box", "replica_states", "run_nve", "steps_per_sample", "force_evals_per_step", "make_engine"]
+
+
+class WaterBox:
+    """The study's System for one water model, with its molecules and masses."""
+
+    def __init__(self, model: str, n_waters: int, cutoff_nm: float):
+        self.model = model
+        self.system, self.topology, self.positions = water_box(model, n_waters, cutoff_nm)
+        self.molecules = [[a.index for a in r.atoms()] for r in self.topology.residues()]
+        self.masses = masses(self.system)
+        self.n_constraints = self.system.getNumConstraints()
+
+
+def build_box(cfg: dict, model: str) -> WaterBox:
+    return WaterBox(model, cfg["n_waters"], cfg["cutoff_nm"])
+
+
+def replica_states(box: WaterBox, cfg: dict, log=print):
+    """(x, v) arrays of shape (replicas, N, 3): minimise, Langevin ``equilibrate_ps`` at ``temperature``,
+    then one state every ``spacing_ps`` of further Langevin dynamics."""
+    platform, props = "CPU", {"Threads": str(cfg.get("threads", 1))}
+    t0 = time.perf_counter()
+    x = minimise(box.system, box.positions, platform=platform, properties=props, max_iterations=500)
+    seed = int(cfg["seed"])
+    x, v = equilibrate(box.system, x, cfg["temperature"], cfg["equilibrate_ps"], seed, platform=platform,
+                       properties=props)
+    xs, vs = [x], [v]
+    for r in range(1, int(cfg["replicas"])):
+        x, v = equilibrate(box.system, x, cfg["temperature"], cfg["spacing_ps"], seed + r, platform=platform,
+                           properties=props)
+        xs.append(x)
+        vs.append(v)
+    log(f"{box.model}: {len(box.molecules)} waters, {cfg['replicas']} replica states "
+        f"({cfg['equilibrate_ps']} + {cfg['spacing_ps']} ps apart of Langevin dynamics, {time.perf_counter() - t0:.0f} s)")
+    return np.array(xs), np.array(vs)
+
+
+def force_evals_per_step(method: str) -> int:
+    name = method[len(RIGID_PREFIX):] if method.startswith(RIGID_PREFIX) else method
+    return get_method(name).force_evals
+
+
+def steps_per_sample(step_fs: float, sample_fs: float) -> int:
+    return max(1, int(round(sample_fs / step_fs)))
+
+
+class _Constrained:
+    def __init__(self, box, x, v, method, step_fs, props):
+        from ...integrators import SymplecticIntegrator
+
+        self.integrator = SymplecticIntegrator(step_fs * unit.femtoseconds, method, system=box.system)
+        self.context = mm.Context(box.system, self.integrator, mm.Platform.getPlatformByName("CPU"), props)
+        self.context.setPositions(x)
+        self.context.setVelocities(v)
+
+    def step(self, n):
+        self.integrator.step(n)
+
+    def sample(self):
+        st = self.context.getState(getPositions=True, getVelocities=True, getEnergy=True)
+        x = st.getPositions(asNumpy=True).value_in_unit(unit.nanometer)
+        v = st.getVelocities(asNumpy=True).value_in_unit(unit.nanometer / unit.picosecond)
+        return np.asarray(x), np.asarray(v), st.getPotentialEnergy().value_in_unit(unit.kilojoule_per_mole)
+
+
+class _Rigid:
+    def __init__(self, box, x, v, method, step_fs, props):
+        self.engine = RigidBodies(box.system, x, v, box.molecules, step_fs * 1e-3, method, "CPU", props)
+
+    def step(self, n):
+        self.engine.step(n)
+
+    def sample(self):
+        return self.engine.positions(), self.engine.velocities(), self.engine.potential_energy()
+
+
+def make_engine(box, x, v, method, step_fs, threads):
+    props = {"Threads": str(threads)}
+    if method.startswith(RIGID_PREFIX):
+        return _Rigid(box, x, v, method[len(RIGID_PREFIX):], step_fs, props)
+    return _Constrained(box, x, v, method, step_fs, props)
+
+
+def run_nve(box: WaterBox, x, v, method: str, step_fs: float, cfg: dict):
+    """One NVE run; returns (arrays, info).  arrays: t (ps, from the end of settling), T_trans, T_rot (K),
+    pe and etot (kJ/mol).  info: wall_s, steps, force_evals, status ("ok", or "blew up at step S")."""
+    every = steps_per_sample(step_fs, cfg["sample_fs"])
+    dt_sample = every * step_fs * 1e-3
+    settle = int(round(cfg["settle_ps"] / dt_sample))
+    n_samples = int(round(cfg["length_ps"] / dt_sample)) + 1
+    m = box.masses
+    t0 = time.perf_counter()
+    eng = make_engine(box, x, v, method, step_fs, cfg.get("threads", 1))
+    out = {k: np.full(n_samples, np.nan) for k in ("t", "T_trans", "T_rot", "pe", "etot")}
+    status, steps = "ok", 0
+    for i in range(-settle, n_samples):
+        if i > -settle:
+            eng.step(every)
+            steps += every
+        if i < 0:
+            continue
+        xs, vs, pe = eng.sample()
+        kt = kinetic_temperatures(xs, vs, m, box.molecules, True, box.n_constraints)
+        ke = 0.5 * float((m[:, None] * vs * vs).sum())
+        out["t"][i], out["T_trans"][i], out["T_rot"][i] = i * dt_sample, kt.translational, kt.rotational
+        out["pe"][i], out["etot"][i] = pe, pe + ke
+        if not np.isfinite(pe + ke) or abs(kt.translational) > 1e5:
+            status = f"blew up at step {steps}"
+            break
+    wall = time.perf_counter() - t0
+    info = {"wall_s": wall, "steps": steps, "force_evals": steps * force_evals_per_step(method), "status": status,
+            "sample_ps": dt_sample}
+    return out, info
