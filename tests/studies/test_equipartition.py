@@ -1,0 +1,78 @@
+"""The equipartition study end to end on a tiny box: runs, summary, reuse of finished runs, errors."""
+import copy
+import os
+
+import pytest
+
+from openmm_symprk.studies.equipartition import presets, run_study
+from openmm_symprk.studies.equipartition.cli import main
+from openmm_symprk.studies.equipartition.report import format_summary
+from openmm_symprk.studies.equipartition.runs import steps_per_sample
+
+
+def _tiny():
+    cfg = presets.quick()
+    cfg.update(replicas=2, length_ps=0.06, settle_ps=0.012, equilibrate_ps=0.2, spacing_ps=0.05)
+    cfg["models"] = {"spce": [["verlet", 0.5], ["verlet", 2.0], ["rigid:verlet", 2.0]]}
+    return cfg
+
+
+@pytest.fixture(scope="module")
+def study(tmp_path_factory):
+    out = str(tmp_path_factory.mktemp("eq"))
+    logs = []
+    summary = run_study(_tiny(), out, workers=1, progress=False, log=logs.append)
+    return out, summary, logs
+
+
+def test_summary_has_every_row_with_error_bars(study):
+    out, summary, _ = study
+    res = summary["models"]["spce"]
+    assert [r["label"] for r in res["rows"]] == ["verlet 0.5 fs", "verlet 2 fs", "rigid:verlet 2 fs"]
+    for r in res["rows"]:
+        assert r["replicas"] == 2 and not r["failed"]
+        assert 150 < r["T_trans"]["mean"] < 450 and r["dT"]["se"] > 0 and r["pe"]["se"] > 0
+        assert r["evals_per_ps"] == pytest.approx(1000.0 / r["step_fs"])
+        assert r["s_per_ps"] > 0
+    ref = res["rows"][0]
+    assert res["reference"] == "verlet 0.5 fs" and ref["matches_ref"] and ref["wall_vs_ref"] == 1.0
+    text = format_summary(summary)
+    assert "T_rot-T_trans" in text and "Published trend" in text
+    for name in ("summary.txt", "results.json", "equipartition.png"):
+        assert os.path.getsize(os.path.join(out, name)) > 0
+
+
+def test_a_second_call_reuses_every_finished_run(study):
+    out, summary, _ = study
+    logs = []
+    again = run_study(_tiny(), out, workers=1, timing=False, progress=False, log=logs.append)
+    assert any("reusing 6 finished runs" in line for line in logs)
+    a, b = summary["models"]["spce"]["rows"], again["models"]["spce"]["rows"]
+    assert [r["dT"]["mean"] for r in a] == [r["dT"]["mean"] for r in b]
+
+
+def test_a_changed_setting_does_not_reuse_runs():
+    from openmm_symprk.studies.equipartition.study import run_key
+
+    cfg = _tiny()
+    other = copy.deepcopy(cfg)
+    other["length_ps"] = 0.1
+    assert run_key(cfg, "spce", "verlet", 2.0, 0) != run_key(other, "spce", "verlet", 2.0, 0)
+    assert run_key(cfg, "spce", "verlet", 2.0, 0) != run_key(cfg, "spce", "verlet", 2.0, 1)
+
+
+def test_samples_fall_on_steps():
+    assert [steps_per_sample(h, 24.0) for h in (0.5, 1.0, 2.0, 3.0, 4.0)] == [48, 24, 12, 8, 6]
+
+
+def test_bad_settings_are_refused(tmp_path, capsys):
+    cfg = _tiny()
+    cfg["models"]["spce"] = [["verlet", 2.0]]
+    with pytest.raises(ValueError, match="reference row"):
+        run_study(cfg, str(tmp_path), workers=1, progress=False)
+    assert main(["--quick", "--rows", "verlt:2", "--out", str(tmp_path)]) == 2
+    assert "Did you mean 'verlet'" in capsys.readouterr().err
+    assert main(["--quick", "--models", "tip4p", "--out", str(tmp_path)]) == 2
+    assert "unknown water model" in capsys.readouterr().err
+    with pytest.raises(SystemExit):
+        main(["--rows", "verlet"])
