@@ -190,3 +190,18 @@ def test_production_scene_measures_drift_fluctuation_and_speed_against_a_baselin
     text = format_summary(res)
     assert "NVE production runs" in text and "fastest row at the baseline's drift and fluctuation" in text
     assert any(p.endswith("bench_production_water-pme-accurate.png") for p in res["charts"])
+
+    # --retime: every timed run is timed again; what the runs measured is kept, nothing is recomputed
+    from openmm_symprk.studies.bench.sweep import retime_sweep
+
+    again = retime_sweep(cfg, str(tmp_path / "prod"), rounds=1, charts=False, progress=False, log=lambda *a: None)
+    assert again["stats"]["computed"] == 0
+    before = {(r["method"], r["step_fs"]): r for r in res["runs"]}
+    for r in again["runs"]:
+        old = before[(r["method"], r["step_fs"])]
+        assert r["retimed"] and not old["retimed"]
+        assert r["wall_per_step"] > 0 and r["wall_per_step"] != old["wall_per_step"]
+        for k in ("drift_kT_per_ns_per_dof", "energy_std_per_dof", "trace_de_per_dof", "E0"):
+            assert r[k] == old[k], k
+    with pytest.raises(ValueError, match="no finished runs"):
+        retime_sweep(cfg, str(tmp_path / "empty"), progress=False, log=lambda *a: None)

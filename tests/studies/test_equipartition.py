@@ -51,6 +51,31 @@ def test_a_second_call_reuses_every_finished_run(study):
     assert [r["dT"]["mean"] for r in a] == [r["dT"]["mean"] for r in b]
 
 
+def test_more_replicas_extend_the_study_and_reuse_every_finished_run(study):
+    import glob
+
+    import numpy as np
+
+    out, summary, _ = study
+    (path,) = glob.glob(os.path.join(out, "states", "spce-*.npz"))
+    with np.load(path) as d:
+        x2 = d["x"]
+    cfg = _tiny()
+    cfg["replicas"] = 3
+    cfg["models"]["spce"] = cfg["models"]["spce"][:2]
+    logs = []
+    more = run_study(cfg, out, workers=1, timing=False, progress=False, log=logs.append)
+    assert any("reusing 4 finished runs" in line for line in logs)
+    assert any("3 replica states" in line and "1 new" in line for line in logs)
+    with np.load(path) as d:
+        assert len(d["x"]) == 3 and np.array_equal(d["x"][:2], x2)  # the first two states are kept as they were
+    assert [r["replicas"] for r in more["models"]["spce"]["rows"]] == [3, 3]
+    # a later call asking for fewer replicas still uses every finished one
+    again = run_study(_tiny(), out, workers=1, timing=False, progress=False, log=lambda *a: None)
+    assert [r["replicas"] for r in again["models"]["spce"]["rows"]] == [3, 3, 2]
+    assert "  3 " in format_summary(again)
+
+
 def test_a_changed_setting_does_not_reuse_runs():
     from openmm_symprk.studies.equipartition.study import run_key
 

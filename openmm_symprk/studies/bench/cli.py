@@ -1,9 +1,10 @@
 """``symprk bench``: work-precision sweeps and stability searches (``main(argv)``).
 
     symprk bench --quick                       # CI: seconds
-    symprk bench --production                  # solvated villin, HMR, multiple time stepping: about an hour
+    symprk bench --production                  # solvated villin, HMR, multiple time stepping: about two hours
     symprk bench --workers 2                   # the full sweep of docs/benchmarks.md
     symprk bench --resume                      # continue an interrupted sweep in the same --out
+    symprk bench --retime --production         # time every finished run again on a quiet machine
     symprk bench --summary                     # print the tables of a finished sweep
     symprk bench --scenes water-rigid villin --methods verlet yoshida-4 --steps-fs 1 2
     symprk bench --system-xml system.xml --state state.xml     # your own system
@@ -67,7 +68,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--quick", action="store_true", help="CI mode: tiny scenes, seconds")
     p.add_argument("--production", action="store_true",
                    help="production-shaped runs: solvated villin (with and without HMR) and an expensive-PME box, "
-                        "NVE drift, fluctuation and ns/day (about an hour on 2 cores)")
+                        "NVE drift, fluctuation and ns/day (about two hours on 2 cores)")
     p.add_argument("--out", help="output folder (default bench-results/quick or bench-results/full)")
     p.add_argument("--scenes", nargs="+", metavar="NAME", help=f"scenes to run (of {', '.join(SCENES)})")
     p.add_argument("--methods", nargs="+", metavar="NAME",
@@ -79,6 +80,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--scheduler", metavar="ADDRESS",
                    help="Dask distributed scheduler address (e.g. tcp://host:8786); needs the 'cluster' extra")
     p.add_argument("--resume", action="store_true", help="continue the sweep stored in --out")
+    p.add_argument("--retime", action="store_true",
+                   help="measure again the wall time of every finished run in --out (against OpenMM's "
+                        "VerletIntegrator, in turns), keeping its accuracy figures; then continue as --resume")
     p.add_argument("--no-charts", action="store_true", help="skip the PNG charts")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     p.add_argument("--summary", action="store_true", help="print the tables of the results in --out and exit")
@@ -148,13 +152,17 @@ def main(argv=None) -> int:
         with open(path) as fh:
             print(format_summary(json.load(fh)))
         return 0
-    from .sweep import SweepExistsError, SweepLockedError, run_sweep
+    from .sweep import SweepExistsError, SweepLockedError, retime_sweep, run_sweep
 
     try:
         _check_out(out)
         cfg = make_config(args)
-        results = run_sweep(cfg, out, workers=args.workers, scheduler=args.scheduler, resume=args.resume,
-                            charts=not args.no_charts, progress=not args.no_progress)
+        if args.retime:
+            results = retime_sweep(cfg, out, workers=args.workers, charts=not args.no_charts,
+                                   progress=not args.no_progress)
+        else:
+            results = run_sweep(cfg, out, workers=args.workers, scheduler=args.scheduler, resume=args.resume,
+                                charts=not args.no_charts, progress=not args.no_progress)
     except (SweepExistsError, SweepLockedError, ValueError, ImportError, OSError) as exc:
         print(f"symprk bench: error: {exc}", file=sys.stderr)
         return 2

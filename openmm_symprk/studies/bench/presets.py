@@ -88,7 +88,7 @@ def quick() -> dict:
 def production() -> dict:
     """Production-shaped runs (``symprk bench --production``): the solvated villin box as OpenMM users run it,
     with and without hydrogen mass repartitioning, and a box whose slow force is the expensive part; NVE, energy
-    drift and fluctuation, ns/day.  About an hour on 2 cores (a benchmark, not a test)."""
+    drift and fluctuation, ns/day.  About two hours on 2 cores (a benchmark, not a test)."""
     return {
         "mode": "production",
         "methods": ["openmm-verlet", "verlet"],

@@ -84,6 +84,7 @@ class RunRecord(_Record):
     timing_steps: int = 0
     verlet_wall_per_step: float | None = None
     wall_vs_verlet_paired: float | None = None
+    retimed: bool = False  # the timing was measured again (``symprk bench --retime``), apart from the run
     # -- accuracy ----------------------------------------------------------------------------------------------
     E0: float | None = None
     energy_error: float | None = None

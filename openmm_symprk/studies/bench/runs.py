@@ -336,12 +336,12 @@ def _steps_for(seconds, per_step):
     return int(min(100_000, max(10, math.ceil(seconds / max(per_step, 1e-9)))))
 
 
-def _time(spec, scene, ig, rec, per_step_estimate):
+def _time(spec, scene, ig, rec, per_step_estimate, rounds=TIMING_ROUNDS):
     """Wall time per step of ``ig`` (continuing from where the measured run ended) and of a fresh OpenMM
     VerletIntegrator on the same scene and platform, taking turns (:func:`..timing.interleaved`): the
     fastest block of each is kept, so that load from other processes cancels out of the ratio as far as
     it can."""
-    n_time = _steps_for(spec.timing_s / (2 * TIMING_ROUNDS), per_step_estimate)
+    n_time = _steps_for(spec.timing_s / (2 * rounds), per_step_estimate)
     platform = spec.platform or scene.platform
     v_ig, _, _ = make_integrator("openmm-verlet", VERLET_TIMING_STEP_FS * 1e-3, scene)
     v_ctx = make_context(scene, v_ig, platform, spec.threads)
@@ -349,9 +349,9 @@ def _time(spec, scene, ig, rec, per_step_estimate):
     v_ig.step(2)  # warm up (kernels, force cache)
     t0 = time.perf_counter()
     v_ig.step(10)
-    n_verlet = _steps_for(spec.timing_s / (2 * TIMING_ROUNDS), (time.perf_counter() - t0) / 10)
+    n_verlet = _steps_for(spec.timing_s / (2 * rounds), (time.perf_counter() - t0) / 10)
     try:
-        t = interleaved({"own": ig.step, "verlet": v_ig.step}, {"own": n_time, "verlet": n_verlet}, TIMING_ROUNDS)
+        t = interleaved({"own": ig.step, "verlet": v_ig.step}, {"own": n_time, "verlet": n_verlet}, rounds)
     except Exception as exc:
         if not is_blowup(exc):
             raise
@@ -359,5 +359,26 @@ def _time(spec, scene, ig, rec, per_step_estimate):
     finally:
         del v_ctx
     best, verlet = t["own"].best, t["verlet"].best
-    rec.update(wall_per_step=best, wall_per_ps=best / spec.h_ps, timing_steps=n_time * TIMING_ROUNDS,
+    rec.update(wall_per_step=best, wall_per_ps=best / spec.h_ps, timing_steps=n_time * rounds,
                verlet_wall_per_step=verlet, wall_vs_verlet_paired=best / verlet)
+
+
+def retime(spec: RunSpec, scene: BenchScene, rec: RunRecord, rounds: int = TIMING_ROUNDS) -> RunRecord:
+    """Measure the timing of a finished run again, from the scene's initial state, leaving what the run
+    measured untouched: for a sweep whose machine was busy while it ran (``symprk bench --retime``).  The
+    paired VerletIntegrator is timed in turns with it, as in the run itself."""
+    if not rec.wall_per_step:
+        raise ValueError(f"run {rec.method} at {rec.step_fs:g} fs on {rec.scene} has no timing to measure again "
+                         f"(status {rec.status!r})")
+    platform = spec.platform or scene.platform
+    ig, _, leapfrog = make_integrator(spec.method, spec.h_ps, scene, spec.seed)
+    ctx = make_context(scene, ig, platform, spec.threads)
+    try:
+        set_initial_state(ctx, scene, scene.positions, scene.velocities, spec.h_ps, leapfrog)
+        ig.step(2)  # warm up (kernels, force cache)
+        t0 = time.perf_counter()
+        ig.step(5)
+        _time(spec, scene, ig, rec, (time.perf_counter() - t0) / 5, rounds)
+    finally:
+        del ctx
+    return rec.update(retimed=True)

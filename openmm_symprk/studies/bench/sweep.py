@@ -235,6 +235,41 @@ def run_sweep(config: dict, out: str, workers: int = 2, scheduler: str | None = 
         lock.release()
 
 
+def retime_sweep(config: dict, out: str, rounds: int = 3, workers: int = 1, charts: bool = True,
+                 progress: bool = True, log=print) -> dict:
+    """Measure again the timing of every finished run of the sweep in ``out`` (each against a fresh
+    VerletIntegrator, in turns, ``rounds`` rounds), one at a time in this process, keeping everything else
+    each run measured; then continue the sweep as ``resume=True`` does and rewrite its results.  For a sweep
+    that shared its machine with other work: the ratios are taken in turns, but heavy load still blurs them."""
+    from tqdm import tqdm
+
+    from .runs import retime
+
+    if not os.path.isdir(os.path.join(out, "runs")) or not len(Store(out)):
+        raise ValueError(f"{out} holds no finished runs to time again: run the sweep first")
+    lock = FolderLock(out, "symprk bench", SweepLockedError)
+    try:
+        store = Store(out)
+        scenes = prepare_scenes(config, out, reuse=True, log=log)
+        fingerprints = {name: sc.payload()["fingerprint"] for name, sc in scenes.items()}
+        todo = []
+        for job in plan(config, scenes):
+            if job.kind != "run":
+                continue
+            spec = next(job.gen)
+            key = run_key(spec.to_dict(), fingerprints[spec.scene])
+            rec = store.get(key)
+            if rec is not None and rec.wall_per_step and spec.timing_s > 0:
+                todo.append((spec, key, rec))
+        for spec, key, rec in tqdm(todo, desc="retime", unit="run", disable=not progress, dynamic_ncols=True):
+            retime(spec, scenes[spec.scene], rec, rounds)
+            store.put(key, rec, store.arrays(key) if rec.has_arrays else None)
+        log(f"timed {len(todo)} runs again")
+    finally:
+        lock.release()
+    return run_sweep(config, out, workers=workers, resume=True, charts=charts, progress=progress, log=log)
+
+
 def _sweep(config, out, workers, scheduler, resume, charts, progress, on_result, log) -> dict:
     from .aggregate import aggregate, format_summary
 

@@ -129,13 +129,14 @@ def _pm(d, spec=".2f"):
 def format_summary(summary: dict) -> str:
     cfg = summary["config"]
     lines = [f"Equipartition of rigid water: {cfg['n_waters']} waters, PME {cfg['cutoff_nm']} nm, "
-             f"{cfg['temperature']:g} K, {cfg['replicas']} replicas x {cfg['length_ps']:g} ps NVE "
-             f"(after {cfg['settle_ps']:g} ps settling); mean ± standard error over replicas"]
+             f"{cfg['temperature']:g} K, NVE runs of {cfg['length_ps']:g} ps (after {cfg['settle_ps']:g} ps settling) "
+             f"from n replica states; mean ± standard error over replicas"]
     for model, res in summary["models"].items():
         lines.append("")
         lines.append(f"{model}:")
         lines.append(f"{'method':24s} {'T_rot-T_trans K':>16s} {'T_trans K':>15s} {'PE/mol kJ/mol':>17s} "
-                     f"{'drift kT/ns/dof':>17s} {'tau ps':>7s} {'evals/ps':>9s} {'wall/ref':>8s} {'wall/v2':>8s} match")
+                     f"{'drift kT/ns/dof':>17s} {'tau ps':>7s} {'n':>3s} {'evals/ps':>9s} {'wall/ref':>8s} "
+                     f"{'wall/v2':>8s} match")
         for r in res["rows"]:
             if "dT" not in r:
                 lines.append(f"{r['label']:24s} {'no finished runs' if not r['failed'] else r['failed'][0]}")
@@ -146,7 +147,7 @@ def format_summary(summary: dict) -> str:
             fail = f"  ({len(r['failed'])} failed: {r['failed'][0]})" if r["failed"] else ""
             lines.append(f"{r['label']:24s} {_pm(r['dT']):>16s} {_pm(r['T_trans'], '.1f'):>15s} "
                          f"{_pm(r['pe'], '.3f'):>17s} {_pm(r['drift'], '.3f'):>17s} {r['tau_ps']:7.3f} "
-                         f"{r['evals_per_ps']:9.0f} {wr:>8s} {w2:>8s} {mark}{fail}")
+                         f"{r['replicas']:3d} {r['evals_per_ps']:9.0f} {wr:>8s} {w2:>8s} {mark}{fail}")
         lines.append(res["verlet_trend"]["text"])
         c = res["cheapest_match"]
         if c:

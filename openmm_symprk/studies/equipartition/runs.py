@@ -39,23 +39,30 @@ def build_box(cfg: dict, model: str) -> WaterBox:
     return WaterBox(model, cfg["n_waters"], cfg["cutoff_nm"])
 
 
-def replica_states(box: WaterBox, cfg: dict, log=print):
+def replica_states(box: WaterBox, cfg: dict, log=print, start=None):
     """(x, v) arrays of shape (replicas, N, 3): minimise, Langevin ``equilibrate_ps`` at ``temperature``,
-    then one state every ``spacing_ps`` of further Langevin dynamics."""
+    then one state every ``spacing_ps`` of further Langevin dynamics (replica r with seed ``seed + r``).
+    ``start``: the (x, v) arrays of replicas already built, which the chain continues from."""
     platform, props = "CPU", {"Threads": str(cfg.get("threads", 1))}
     t0 = time.perf_counter()
-    x = minimise(box.system, box.positions, platform=platform, properties=props, max_iterations=500)
     seed = int(cfg["seed"])
-    x, v = equilibrate(box.system, x, cfg["temperature"], cfg["equilibrate_ps"], seed, platform=platform,
-                       properties=props)
-    xs, vs = [x], [v]
-    for r in range(1, int(cfg["replicas"])):
+    n_old = 0 if start is None else len(start[0])
+    if not n_old:
+        x = minimise(box.system, box.positions, platform=platform, properties=props, max_iterations=500)
+        x, v = equilibrate(box.system, x, cfg["temperature"], cfg["equilibrate_ps"], seed, platform=platform,
+                           properties=props)
+        xs, vs = [x], [v]
+    else:
+        xs, vs = list(start[0]), list(start[1])
+        x, v = xs[-1], vs[-1]
+    for r in range(len(xs), int(cfg["replicas"])):
         x, v = equilibrate(box.system, x, cfg["temperature"], cfg["spacing_ps"], seed + r, platform=platform,
                            properties=props)
         xs.append(x)
         vs.append(v)
-    log(f"{box.model}: {len(box.molecules)} waters, {cfg['replicas']} replica states "
-        f"({cfg['equilibrate_ps']} + {cfg['spacing_ps']} ps apart of Langevin dynamics, {time.perf_counter() - t0:.0f} s)")
+    log(f"{box.model}: {len(box.molecules)} waters, {len(xs)} replica states ({cfg['equilibrate_ps']} + "
+        f"{cfg['spacing_ps']} ps apart of Langevin dynamics; {len(xs) - n_old} new, "
+        f"{time.perf_counter() - t0:.0f} s)")
     return np.array(xs), np.array(vs)
 
 

@@ -24,7 +24,9 @@ from .report import summarise
 
 __all__ = ["run_study", "run_key", "load_runs"]
 
-_STATE_KEYS = ("n_waters", "cutoff_nm", "temperature", "seed", "equilibrate_ps", "spacing_ps", "replicas", "threads")
+#: What a replica state depends on.  Not the number of replicas: replica r is the same state whatever that number,
+#: so a study asked for more replicas later extends the chain and reuses every finished run.
+_STATE_KEYS = ("n_waters", "cutoff_nm", "temperature", "seed", "equilibrate_ps", "spacing_ps", "threads")
 _RUN_KEYS = _STATE_KEYS + ("settle_ps", "length_ps", "sample_fs")
 
 
@@ -38,14 +40,18 @@ def run_key(cfg: dict, model: str, method: str, step_fs: float, replica: int) ->
 
 
 def _states(cfg, model, out, log):
+    """The model's replica states (at least ``cfg["replicas"]``), built or extended and kept in ``<out>/states``."""
     from .runs import build_box, replica_states
 
     path = os.path.join(out, "states", f"{model}-{_hash({k: cfg[k] for k in _STATE_KEYS})}.npz")
+    start = None
     if os.path.exists(path):
         with np.load(path) as d:
-            return d["x"], d["v"]
+            start = d["x"], d["v"]
+        if len(start[0]) >= int(cfg["replicas"]):
+            return start
     os.makedirs(os.path.dirname(path), exist_ok=True)
-    x, v = replica_states(build_box(cfg, model), cfg, log)
+    x, v = replica_states(build_box(cfg, model), cfg, log, start=start)
     tmp = f"{path}.tmp{os.getpid()}.npz"
     np.savez(tmp, x=x, v=v)
     os.replace(tmp, path)
@@ -74,19 +80,27 @@ def _paths(out, key):
 
 
 def load_runs(cfg: dict, out: str) -> dict:
-    """{(model, method, step_fs): [(arrays, info) per finished replica]}."""
-    found = {}
-    for model, rows in cfg["models"].items():
-        for method, h in rows:
-            reps = []
-            for r in range(int(cfg["replicas"])):
-                jpath, npath = _paths(out, run_key(cfg, model, method, h, r))
-                if os.path.exists(jpath) and os.path.exists(npath):
-                    with open(jpath) as fh:
-                        info = json.load(fh)
-                    with np.load(npath) as d:
-                        reps.append(({k: d[k] for k in d.files}, info))
-            found[(model, method, float(h))] = reps
+    """{(model, method, step_fs): [(arrays, info) per finished replica]}: every finished replica in ``out`` made
+    with these settings, also those beyond ``cfg["replicas"]`` (from an earlier call that asked for more)."""
+    wanted = {(model, method, float(h)) for model, rows in cfg["models"].items() for method, h in rows}
+    found = {row: [] for row in wanted}
+    folder = os.path.join(out, "runs")
+    for name in sorted(os.listdir(folder)) if os.path.isdir(folder) else []:
+        if not name.endswith(".json"):
+            continue
+        jpath, npath = _paths(out, name[:-5])
+        try:
+            with open(jpath) as fh:
+                info = json.load(fh)
+            row = (info["model"], info["method"], float(info["step_fs"]))
+        except (OSError, ValueError, KeyError):
+            continue
+        if row not in wanted or name[:-5] != run_key(cfg, *row, info["replica"]) or not os.path.exists(npath):
+            continue
+        with np.load(npath) as d:
+            found[row].append(({k: d[k] for k in d.files}, info))
+    for reps in found.values():
+        reps.sort(key=lambda rep: rep[1]["replica"])
     return found
 
 
