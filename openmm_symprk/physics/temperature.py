@@ -10,8 +10,11 @@ there.  Equipartition gives each degree of freedom kT/2 on average, so
 
     T_trans = 2 K_trans / (k (3 N_mol - c)),    T_rot = 2 K_rot / (k f_rot)
 
-where c = 3 when the total momentum is fixed (an isolated or NVE system without external forces conserves
-it, removing three translational degrees of freedom; 0 otherwise) and f_rot counts 3 per non-linear molecule,
+where c = 3 when the total momentum P is fixed (an isolated or NVE system without external forces conserves
+it, removing three translational degrees of freedom; 0 otherwise); then the kinetic energy of the motion of
+the whole set, |P|^2 / 2 M_total, is not thermal and is taken out of K_trans first (it is zero when P is, and
+a state drawn from a thermostat without a CMMotionRemover carries ~3/2 kT of it, which would otherwise warm
+T_trans by ~kT/(N_mol k): 1.4 K for 216 waters) and f_rot counts 3 per non-linear molecule,
 2 per linear one and 0 per atom.  Units: nm, ps, Da, kJ/mol, K.
 """
 from __future__ import annotations
@@ -96,10 +99,16 @@ def kinetic_temperatures(x, v, m, molecules, momentum_fixed: bool = True, constr
     """Translational, rotational and internal kinetic temperature of ``molecules``.
 
     ``momentum_fixed``: the total momentum is conserved (or removed), so translation has 3 N_mol - 3 degrees
-    of freedom; ``constraints``: the number of distance constraints inside the molecules (for the internal
+    of freedom and the kinetic energy of the centre of mass of all the molecules is not counted in it (the
+    temperatures are then the same in any frame moving uniformly); ``constraints``: the number of distance constraints inside the molecules (for the internal
     degrees of freedom: 3 n - 6 per rigid non-linear molecule is all of them)."""
     mk = molecule_kinetics(x, v, m, molecules, linear_tol)
     m = np.asarray(m, dtype=np.float64)
+    k_trans = float(mk.translational.sum())
+    if momentum_fixed:  # the motion of the whole set is not thermal: out of K_trans (zero when P = 0)
+        idx = np.concatenate([np.asarray(g, dtype=int) for g in molecules]) if len(molecules) else np.zeros(0, int)
+        p = (m[idx, None] * np.asarray(v, dtype=np.float64)[idx]).sum(axis=0)
+        k_trans -= float(p @ p) / (2.0 * m[idx].sum()) if m[idx].sum() > 0 else 0.0
     n_massive = sum(int(np.count_nonzero(m[np.asarray(g)] > 0)) for g in molecules)
     n_mol = sum(1 for g in molecules if m[np.asarray(g)].sum() > 0)
     f_trans = 3 * n_mol - (3 if momentum_fixed else 0)
@@ -107,7 +116,7 @@ def kinetic_temperatures(x, v, m, molecules, momentum_fixed: bool = True, constr
     f_int = 3 * n_massive - 3 * n_mol - f_rot - int(constraints or 0)
     k_int = float(mk.total.sum() - mk.translational.sum() - mk.rotational.sum())
     return KineticTemperatures(
-        translational=2 * float(mk.translational.sum()) / (R_KJ * f_trans) if f_trans > 0 else float("nan"),
+        translational=2 * k_trans / (R_KJ * f_trans) if f_trans > 0 else float("nan"),
         rotational=2 * float(mk.rotational.sum()) / (R_KJ * f_rot) if f_rot > 0 else float("nan"),
         internal=2 * k_int / (R_KJ * f_int) if f_int > 0 else float("nan"),
         translational_dof=f_trans, rotational_dof=f_rot, internal_dof=max(f_int, 0))

@@ -55,6 +55,20 @@ def test_prescribed_translational_and_rotational_temperatures_are_recovered_exac
     assert (t.translational_dof, t.rotational_dof, t.internal_dof) == (147, 150, 0) and np.isnan(t.internal)
 
 
+def test_a_uniform_drift_of_the_whole_set_is_not_temperature():
+    """With the total momentum fixed, the motion of the centre of mass of all molecules is not thermal: the
+    prescribed temperatures come back in any uniformly moving frame; counted as translation without
+    ``momentum_fixed`` (3 N DOF), the drift's kinetic energy shows up exactly."""
+    x, v, m, mols = _waters(50, 280.0, 320.0)
+    boost = np.array([0.3, -0.2, 0.5])  # nm/ps, ~ a thermal centre-of-mass speed of a small box
+    t = kinetic_temperatures(x, v + boost, m, mols, constraints=3 * 50)
+    assert t.translational == pytest.approx(280.0, rel=1e-12) and t.rotational == pytest.approx(320.0, rel=1e-12)
+    free = kinetic_temperatures(x, v + boost, m, mols, momentum_fixed=False, constraints=3 * 50)
+    k_drift = 0.5 * m.sum() * float(boost @ boost)
+    assert free.translational_dof == 150
+    assert free.translational == pytest.approx((280.0 * 147 * R_KJ / 2 + k_drift) * 2 / (R_KJ * 150), rel=1e-12)
+
+
 def test_random_draws_equipartition_statistically():
     x, v, m, mols = _waters(3000, 300.0, 300.0, seed=5, exact=False)
     t = kinetic_temperatures(x, v, m, mols, constraints=3 * 3000)

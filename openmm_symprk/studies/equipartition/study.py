@@ -34,9 +34,14 @@ def _hash(obj) -> str:
     return hashlib.sha1(json.dumps(obj, sort_keys=True).encode()).hexdigest()[:16]
 
 
+#: Version of what a run stores (2: T_trans without the kinetic energy of the box's centre of mass); a run
+#: stored by another version is never reused.
+RUN_VERSION = 2
+
+
 def run_key(cfg: dict, model: str, method: str, step_fs: float, replica: int) -> str:
     return _hash({"cfg": {k: cfg[k] for k in _RUN_KEYS}, "model": model, "row": [method, float(step_fs)],
-                  "replica": int(replica)})
+                  "replica": int(replica), "version": RUN_VERSION})
 
 
 def _states(cfg, model, out, log):
