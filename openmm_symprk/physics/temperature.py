@@ -108,7 +108,7 @@ def kinetic_temperatures(x, v, m, molecules, momentum_fixed: bool = True, constr
     if momentum_fixed:  # the motion of the whole set is not thermal: out of K_trans (zero when P = 0)
         idx = np.concatenate([np.asarray(g, dtype=int) for g in molecules]) if len(molecules) else np.zeros(0, int)
         p = (m[idx, None] * np.asarray(v, dtype=np.float64)[idx]).sum(axis=0)
-        k_trans -= float(p @ p) / (2.0 * m[idx].sum()) if m[idx].sum() > 0 else 0.0
+        k_trans -= float(p @ p) / (2.0 * float(m[idx].sum())) if m[idx].sum() > 0 else 0.0
     n_massive = sum(int(np.count_nonzero(m[np.asarray(g)] > 0)) for g in molecules)
     n_mol = sum(1 for g in molecules if m[np.asarray(g)].sum() > 0)
     f_trans = 3 * n_mol - (3 if momentum_fixed else 0)

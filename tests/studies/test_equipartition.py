@@ -101,3 +101,6 @@ def test_bad_settings_are_refused(tmp_path, capsys):
     assert "unknown water model" in capsys.readouterr().err
     with pytest.raises(SystemExit):
         main(["--rows", "verlet"])
+    out = tmp_path / "rk4"
+    assert main(["--quick", "--rows", "rk4:2", "--out", str(out)]) == 2  # refused before anything is built
+    assert "rk4 is a reference method" in capsys.readouterr().err and not out.exists()

@@ -30,7 +30,7 @@ def build_parser():
     ap.add_argument("--quick", action="store_true", help="64 waters, short runs: seconds, large error bars")
     ap.add_argument("--out", default="equipartition-results", help="output folder (finished runs are reused)")
     ap.add_argument("--workers", type=int, default=2, help="worker processes (each runs one NVE run at a time)")
-    ap.add_argument("--models", default=None, help="comma-separated water models (spce, tip3p); default: all")
+    ap.add_argument("--models", default=None, help="comma-separated water models (spce, tip3p); default: all (--quick: spce)")
     ap.add_argument("--rows", type=_rows, default=None,
                     help="METHOD:STEP_FS,... for every model (rigid:METHOD for the rigid-body engine); "
                          "the reference verlet:0.5 is added")

@@ -129,7 +129,11 @@ def _check(cfg):
 
     for model, rows in cfg["models"].items():
         for method, h in rows:
-            get_method(method[len(RIGID_PREFIX):] if method.startswith(RIGID_PREFIX) else method)
+            m = get_method(method[len(RIGID_PREFIX):] if method.startswith(RIGID_PREFIX) else method)
+            if not m.is_splitting:
+                raise ValueError(f"{model}: row {method} is a {m.family} method; rigid water (constraints, or the "
+                                 f"rigid-body engine) runs kick/drift splittings and compositions only, e.g. "
+                                 f"verlet, omelyan-2, pefrl, yoshida-4 (symprk methods lists their families)")
             if not float(h) > 0:
                 raise ValueError(f"{model}: step size of {method} must be positive, got {h!r}")
         if list(cfg["reference"]) not in [[m, float(h)] for m, h in rows]:
