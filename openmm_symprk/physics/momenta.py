@@ -8,10 +8,12 @@ CMMotionRemover keeps the first and changes the second, so the two must never be
 """
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 
 __all__ = ["centre_of_mass", "linear_momentum", "angular_momentum", "inertia_tensor", "kinetic_energy",
-           "reference_point"]
+           "reference_point", "MoleculeFrames", "molecule_frames"]
 
 
 def _arrays(*arrays):
@@ -65,3 +67,32 @@ def kinetic_energy(v, m) -> float:
     """1/2 sum m |v|^2 (kJ/mol for Da nm^2/ps^2)."""
     v, m = _arrays(v, m)
     return float(0.5 * (m[:, None] * v * v).sum())
+
+
+class MoleculeFrames(NamedTuple):
+    """Per molecule (batched): mass M (n,), centre of mass (n, 3) and its velocity V (n, 3), atom positions
+    relative to it r (n, k, 3), angular momentum about it L (n, 3) and inertia tensor about it (n, 3, 3)."""
+
+    M: np.ndarray
+    com: np.ndarray
+    V: np.ndarray
+    r: np.ndarray
+    L: np.ndarray
+    inertia: np.ndarray
+
+
+def molecule_frames(x, v, m, idx) -> MoleculeFrames:
+    """Centre-of-mass frames of n molecules of k atoms each (``idx``: an (n, k) index array), each moment
+    about the molecule's own centre of mass.  A massless molecule gets M = 0, its centre of mass and V at
+    the origin (so it carries nothing)."""
+    x, v, m = _arrays(x, v, m)
+    idx = np.asarray(idx, dtype=int)
+    mg, xg, vg = m[idx], x[idx], v[idx]
+    M = mg.sum(axis=1)
+    Mw = np.where(M > 0, M, 1.0)[:, None]
+    com = (mg[..., None] * xg).sum(axis=1) / Mw
+    V = (mg[..., None] * vg).sum(axis=1) / Mw
+    r = xg - com[:, None, :]
+    L = (mg[..., None] * np.cross(r, vg - V[:, None, :])).sum(axis=1)
+    inertia = np.eye(3) * (mg * (r * r).sum(axis=2)).sum(axis=1)[:, None, None] - np.einsum("ni,nij,nik->njk", mg, r, r)
+    return MoleculeFrames(M, com, V, r, L, inertia)

@@ -23,6 +23,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .momenta import linear_momentum, molecule_frames
+
 #: Gas constant in kJ/mol/K.
 R_KJ = 0.00831446261815324
 
@@ -55,24 +57,17 @@ def molecule_kinetics(x, v, m, molecules, linear_tol: float = 1e-8) -> MoleculeK
     n = len(molecules)
     trans, rot, total, dof = np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n, dtype=int)
     for size, (ks, idx) in _groups_by_size(molecules).items():
-        mg, xg, vg = m[idx], x[idx], v[idx]  # (n_s, size), (n_s, size, 3)
-        M = mg.sum(axis=1)
-        ok = M > 0
-        Mw = np.where(ok, M, 1.0)
-        com = (mg[..., None] * xg).sum(axis=1) / Mw[:, None]
-        V = (mg[..., None] * vg).sum(axis=1) / Mw[:, None]
+        fr = molecule_frames(x, v, m, idx)
+        mg, vg = m[idx], v[idx]
+        ok = fr.M > 0
         total[ks] = 0.5 * (mg[..., None] * vg * vg).sum(axis=(1, 2))
-        trans[ks] = np.where(ok, 0.5 * M * (V * V).sum(axis=1), 0.0)
+        trans[ks] = np.where(ok, 0.5 * fr.M * (fr.V * fr.V).sum(axis=1), 0.0)
         if size == 1:
             continue
-        r = xg - com[:, None, :]
-        L = (mg[..., None] * np.cross(r, vg - V[:, None, :])).sum(axis=1)
-        r2 = (r * r).sum(axis=2)
-        inertia = np.eye(3) * (mg * r2).sum(axis=1)[:, None, None] - np.einsum("ni,nij,nik->njk", mg, r, r)
-        moments = np.linalg.eigvalsh(inertia)  # ascending
+        moments = np.linalg.eigvalsh(fr.inertia)  # ascending
         linear = moments[:, 0] <= linear_tol * np.maximum(moments[:, 2], 1e-300)
-        omega = np.einsum("nij,nj->ni", np.linalg.pinv(inertia, rcond=linear_tol, hermitian=True), L)
-        rot[ks] = np.where(ok, 0.5 * (L * omega).sum(axis=1), 0.0)
+        omega = np.einsum("nij,nj->ni", np.linalg.pinv(fr.inertia, rcond=linear_tol, hermitian=True), fr.L)
+        rot[ks] = np.where(ok, 0.5 * (fr.L * omega).sum(axis=1), 0.0)
         dof[ks] = np.where(ok & (moments[:, 2] > 0), np.where(linear, 2, 3), 0)
     return MoleculeKinetics(trans, rot, total, dof)
 
@@ -107,7 +102,7 @@ def kinetic_temperatures(x, v, m, molecules, momentum_fixed: bool = True, constr
     k_trans = float(mk.translational.sum())
     if momentum_fixed:  # the motion of the whole set is not thermal: out of K_trans (zero when P = 0)
         idx = np.concatenate([np.asarray(g, dtype=int) for g in molecules]) if len(molecules) else np.zeros(0, int)
-        p = (m[idx, None] * np.asarray(v, dtype=np.float64)[idx]).sum(axis=0)
+        p = linear_momentum(np.asarray(v)[idx], m[idx])
         k_trans -= float(p @ p) / (2.0 * float(m[idx].sum())) if m[idx].sum() > 0 else 0.0
     n_massive = sum(int(np.count_nonzero(m[np.asarray(g)] > 0)) for g in molecules)
     n_mol = sum(1 for g in molecules if m[np.asarray(g)].sum() > 0)

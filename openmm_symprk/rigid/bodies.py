@@ -27,6 +27,7 @@ import openmm.unit as unit
 
 from ..methods.catalogue import methods as catalogue_methods
 from ..methods.splitting import DRIFT, KICK, Splitting
+from ..physics.momenta import molecule_frames
 from .lie_poisson import splitting_of
 
 __all__ = ["RigidBodies", "rigid_body_state"]
@@ -36,22 +37,15 @@ def rigid_body_state(x, v, m, molecules):
     """(X, V, Q, body, moments, pi) of molecules (an (n, k) index array, all the same size and massive):
     centre of mass and its velocity, principal axes as orientation (det +1), atom coordinates in the body
     frame, principal moments and body angular momentum."""
-    idx = np.asarray(molecules, dtype=int)
-    mg, xg, vg = m[idx], x[idx], v[idx]
-    M = mg.sum(axis=1)
-    X = (mg[..., None] * xg).sum(axis=1) / M[:, None]
-    V = (mg[..., None] * vg).sum(axis=1) / M[:, None]
-    r = xg - X[:, None, :]
-    inertia = np.eye(3) * (mg * (r * r).sum(axis=2)).sum(axis=1)[:, None, None] - np.einsum("ni,nij,nik->njk", mg, r, r)
-    moments, Q = np.linalg.eigh(inertia)
+    fr = molecule_frames(x, v, m, molecules)
+    moments, Q = np.linalg.eigh(fr.inertia)
     if np.any(moments[:, 0] <= 1e-8 * moments[:, 2]):
         raise ValueError("a molecule is linear (a zero principal moment): this engine needs 3 rotational "
                          "degrees of freedom per molecule")
     Q[np.linalg.det(Q) < 0, :, 2] *= -1.0
-    body = np.einsum("nji,nkj->nki", Q, r)  # b = Q^T r
-    L = (mg[..., None] * np.cross(r, vg - V[:, None, :])).sum(axis=1)
-    pi = np.einsum("nji,nj->ni", Q, L)
-    return X, V, Q, body, moments, pi
+    body = np.einsum("nji,nkj->nki", Q, fr.r)  # b = Q^T r
+    pi = np.einsum("nji,nj->ni", Q, fr.L)
+    return fr.com, fr.V, Q, body, moments, pi
 
 
 class RigidBodies:

@@ -14,6 +14,7 @@ import openmm as mm
 import openmm.unit as unit
 
 from ...methods.catalogue import get_method
+from ...physics.momenta import kinetic_energy
 from ...physics.temperature import kinetic_temperatures
 from ...rigid.bodies import RigidBodies
 from ...systems.prepare import equilibrate, minimise
@@ -132,7 +133,7 @@ def run_nve(box: WaterBox, x, v, method: str, step_fs: float, cfg: dict):
             continue
         xs, vs, pe = eng.sample()
         kt = kinetic_temperatures(xs, vs, m, box.molecules, True, box.n_constraints)
-        ke = 0.5 * float((m[:, None] * vs * vs).sum())
+        ke = kinetic_energy(vs, m)
         out["t"][i], out["T_trans"][i], out["T_rot"][i] = i * dt_sample, kt.translational, kt.rotational
         out["pe"][i], out["etot"][i] = pe, pe + ke
         if not np.isfinite(pe + ke) or abs(kt.translational) > 1e5:
