@@ -172,9 +172,10 @@ def _user_errors():
 
     from .integrators import SimulationBlowUpError
     from .methods import TableauError, UnknownMethodError
+    from .support import MissingDependencyError
 
     return (CommandError, UnknownMethodError, TableauError, SimulationBlowUpError, mm.OpenMMException, ValueError,
-            TypeError, OSError)
+            TypeError, OSError, MissingDependencyError)
 
 
 def main(argv=None):
@@ -182,7 +183,13 @@ def main(argv=None):
     if argv and argv[0] in DELEGATED:
         import importlib
 
-        return importlib.import_module(DELEGATED[argv[0]]).main(argv[1:]) or 0
+        from .support import MissingDependencyError
+
+        try:  # a study's module may need an extra (matplotlib, scipy, ...): say which, in one line
+            return importlib.import_module(DELEGATED[argv[0]]).main(argv[1:]) or 0
+        except MissingDependencyError as exc:
+            print(f"symprk {argv[0]}: error: {exc}", file=sys.stderr)
+            return 2
     args = build_parser().parse_args(argv)
     try:
         rc = args.func(args)

@@ -36,6 +36,7 @@ import openmm.unit as unit
 
 from ..physics import momenta
 from ..physics.temperature import kinetic_temperatures
+from ..support import require
 from ..systems.checks import conservation_issues, integrator_issues, warn_conservation, warn_once
 from ..systems.properties import constraint_arrays, constraint_violation, degrees_of_freedom, masses, molecules
 
@@ -178,7 +179,8 @@ class VelocityTRRReporter:
     def __init__(self, file: str, reportInterval: int, append: bool = False, forces: bool = False):
         import tempfile
 
-        from MDAnalysis.lib.formats.libmdaxdr import TRRFile  # noqa: F401 (fail here, not at the first report)
+        # fail here, not at the first report
+        require("MDAnalysis.lib.formats.libmdaxdr", "analysis", "openmm_symprk.conservation.VelocityTRRReporter")
 
         if int(reportInterval) < 1:
             raise ValueError(f"reportInterval must be a positive number of steps, got {reportInterval!r}")
@@ -192,7 +194,8 @@ class VelocityTRRReporter:
         os.close(fd)
 
     def _count_frames(self) -> int:
-        from MDAnalysis.lib.formats.libmdaxdr import TRRFile
+        TRRFile = require("MDAnalysis.lib.formats.libmdaxdr", "analysis",
+                          "openmm_symprk.conservation.VelocityTRRReporter").TRRFile
 
         if not os.path.exists(self.path) or os.path.getsize(self.path) == 0:
             return 0
@@ -205,7 +208,8 @@ class VelocityTRRReporter:
         return {"steps": steps, "periodic": False, "include": include}
 
     def report(self, simulation, state):
-        from MDAnalysis.lib.formats.libmdaxdr import TRRFile
+        TRRFile = require("MDAnalysis.lib.formats.libmdaxdr", "analysis",
+                          "openmm_symprk.conservation.VelocityTRRReporter").TRRFile
 
         x = np.asarray(state.getPositions(asNumpy=True).value_in_unit(_NM), dtype=np.float32)
         v = np.asarray(state.getVelocities(asNumpy=True).value_in_unit(_NM_PS), dtype=np.float32)

@@ -39,10 +39,10 @@ from dataclasses import dataclass
 from functools import lru_cache
 
 import numpy as np
-from scipy.special import ellipj, ellipk, ellipkinc
 
 from ..methods.catalogue import methods as catalogue_methods
 from ..methods.splitting import Splitting, compose
+from ..support import require
 
 __all__ = [
     "METHODS", "RigidBodyMethod", "euler_rhs", "energy", "casimir", "integrate", "step",
@@ -353,6 +353,8 @@ def exact_solution(x0, moments, times) -> np.ndarray:
     (Landau-Lifshitz §37), with σ, s_c fixed by x0 and by the sense of rotation (the ODE).  On the
     separatrix (m = 1) cn = dn = sech and sn = tanh.  Symmetric tops rotate about the distinct axis in
     closed form; a spherical top (or x = 0) stays put."""
+    special = require("scipy.special", "analysis", "openmm_symprk.rigid.lie_poisson.exact_solution")
+    ellipj, ellipk, ellipkinc = special.ellipj, special.ellipk, special.ellipkinc
     x0 = _check_x(x0)
     M = _check_moments(moments)
     t = np.atleast_1d(np.asarray(times, dtype=float))

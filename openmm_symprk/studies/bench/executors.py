@@ -13,6 +13,8 @@ from __future__ import annotations
 import concurrent.futures as cf
 import multiprocessing as mp
 
+from ...support import require
+
 _payloads: dict = {}
 _scenes: dict = {}
 
@@ -124,11 +126,7 @@ class DaskExecutor:
     """A Dask distributed scheduler at ``address`` (e.g. ``tcp://head:8786``); workers need this package."""
 
     def __init__(self, payloads, address):
-        try:
-            from dask.distributed import Client
-        except ImportError:
-            raise ImportError("--scheduler needs Dask distributed: pip install 'openmm_symprk[cluster]' "
-                              "(or pip install 'dask[distributed]')") from None
+        Client = require("dask.distributed", "cluster", "the bench's --scheduler (DaskExecutor)").Client
         self.client = Client(address)
         info = self.client.scheduler_info()
         self.workers = max(1, sum(w.get("nthreads", 1) for w in info.get("workers", {}).values()))
@@ -139,7 +137,7 @@ class DaskExecutor:
         return self.client.submit(work, spec_dict, scene_name, self.payloads[scene_name], pure=False)
 
     def wait(self, futures):
-        from dask.distributed import wait
+        wait = require("dask.distributed", "cluster", "the bench's --scheduler (DaskExecutor)").wait
 
         return set(wait(list(futures), return_when="FIRST_COMPLETED").done)
 

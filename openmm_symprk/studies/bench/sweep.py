@@ -28,6 +28,7 @@ import os
 import time
 import warnings
 
+from ...support import require
 from ..folders import FolderLock, FolderLockedError, write_json
 from . import presets
 from .executors import make_executor
@@ -146,7 +147,7 @@ def plan(config: dict, scenes: dict) -> list:
 
 # -- execution -----------------------------------------------------------------------------------
 def _run_jobs(jobs, store, executor, fingerprints, progress=True, on_result=None):
-    from tqdm import tqdm
+    tqdm = require("tqdm", "studies", "openmm_symprk.studies.bench (progress bar)").tqdm
 
     counter = itertools.count()
     ready, inflight = [], {}
@@ -241,7 +242,7 @@ def retime_sweep(config: dict, out: str, rounds: int = 3, workers: int = 1, char
     VerletIntegrator, in turns, ``rounds`` rounds), one at a time in this process, keeping everything else
     each run measured; then continue the sweep as ``resume=True`` does and rewrite its results.  For a sweep
     that shared its machine with other work: the ratios are taken in turns, but heavy load still blurs them."""
-    from tqdm import tqdm
+    tqdm = require("tqdm", "studies", "openmm_symprk.studies.bench (progress bar)").tqdm
 
     from .runs import retime
 

@@ -14,6 +14,7 @@ from __future__ import annotations
 import numpy as np
 
 from ...physics.temperature import R_KJ
+from ...support import require
 from .presets import RIGID_PREFIX
 from .runs import force_evals_per_step
 from .stats import Estimate, agrees, combine, drift, series_stats
@@ -203,10 +204,8 @@ def chart(summary: dict, path: str):
     """Three panels, error bars ± 2 SE: T_rot - T_trans against step size with the reference row as a band;
     T_rot - T_trans minus the reference's (replica by replica) against force evaluations per ps; the potential
     energy per molecule minus the reference's against step size."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    require("matplotlib", "studies", "openmm_symprk.studies.equipartition.report.chart").use("Agg")
+    plt = require("matplotlib.pyplot", "studies", "openmm_symprk.studies.equipartition.report.chart")
 
     fig, axes = plt.subplots(1, 3, figsize=(15, 4.6))
     markers = {"verlet": "o", "omelyan-2": "s", "pefrl": "D"}

@@ -19,6 +19,7 @@ import os
 
 import numpy as np
 
+from ...support import require
 from ..folders import FolderLock, write_json
 from .report import summarise
 
@@ -190,7 +191,7 @@ def _execute(todo, cfg, states, out, workers, progress, log):
         return
     bar = None
     if progress:
-        from tqdm import tqdm
+        tqdm = require("tqdm", "studies", "openmm_symprk.studies.equipartition (progress bar)").tqdm
 
         bar = tqdm(total=len(todo), desc="equipartition runs", unit="run")
 
