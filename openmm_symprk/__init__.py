@@ -5,6 +5,7 @@
 
 The package by layer (each imports only from the ones above it):
 
+* :mod:`.support` -- optional dependencies imported on first use (an error names the extra installing them);
 * :mod:`.methods` -- tableaux, splittings, the catalogue, pure-numpy reference integrators (no OpenMM);
 * :mod:`.physics` -- momenta and inertia on arrays, about a stated point (no OpenMM);
 * :mod:`.systems` -- facts of an OpenMM System, conservation checks, initial states, minimal scenes;
