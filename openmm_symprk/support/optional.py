@@ -61,9 +61,10 @@ def require(module: str, extra: str, feature: str):
     try:
         return importlib.import_module(module)
     except ImportError as exc:
-        missing = (exc.name or "").split(".")[0]
-        if missing in (top, "distributed") or (exc.name or "").startswith(module):
-            why = "which is not installed"
+        missing = exc.name or ""
+        if missing and (module == missing or module.startswith(missing + ".")
+                        or (top == "dask" and missing == "distributed")):
+            why = "which is not installed"  # the module itself or a parent package of it is absent
         else:  # installed, but it (or one of its own dependencies) does not import
             why = f"which does not import here ({type(exc).__name__}: {exc})"
         raise MissingDependencyError(
