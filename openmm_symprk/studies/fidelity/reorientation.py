@@ -12,8 +12,9 @@ integral of the measured C_l from 0 to the cutoff t_c, the first lag where C_l <
 the last lag if it never gets there), plus the integral of an exponential tail A exp(-t / tau_e) from t_c
 to infinity, A and tau_e fitted (least squares on log C_l) to the measured C_l over the lags where
 ``c_cut`` <= C_l <= ``c_fit`` (default 0.5) up to t_c.  The fast librational drop of water at t < 0.1 ps
-lies above C = 0.5 and is integrated, not fitted.  Its standard error: the same computation on C_l
-averaged over each of ``n_groups`` disjoint groups of molecules, standard deviation / sqrt(n_groups).
+lies above C = 0.5 and is integrated, not fitted.  Its standard error (:func:`reorientation_time`): the
+delete-one-group jackknife over ``n_groups`` disjoint groups of molecules (tau is a non-linear function of
+C_l, which the jackknife handles better than the scatter of small groups' own tau).
 
 Vectors (:func:`dipole_vectors`, :func:`atom_vectors`, :func:`bisector_vectors`): from positions of whole
 molecules (or pass ``box`` to make each whole by the minimum image from its first atom).
@@ -138,17 +139,21 @@ def correlation_time(c, dt_ps: float, c_cut: float = 0.1, c_fit: float = 0.5) ->
     return CorrelationTime(integral + tail, float("nan"), integral, tail, float(tau_exp), float(t[cut]))
 
 
-def reorientation_time(u, order: int, dt_ps: float, *, n_groups: int = 8, max_lag: int | None = None,
+def reorientation_time(u, order: int, dt_ps: float, *, n_groups: int = 20, max_lag: int | None = None,
                        c_cut: float = 0.1, c_fit: float = 0.5) -> tuple:
     """(C_l averaged over molecules (max_lag + 1,), :class:`CorrelationTime` tau_l in ps with its standard
-    error from ``n_groups`` disjoint groups of molecules) for unit vectors ``u`` (F, n, 3) every ``dt_ps``."""
+    error) for unit vectors ``u`` (F, n, 3) every ``dt_ps``.  The error is the delete-one-group jackknife over
+    ``n_groups`` disjoint groups of molecules (at most one group per molecule): tau recomputed from C_l
+    averaged over all groups but one, sqrt((G - 1) / G * sum (tau_(g) - mean)^2)."""
     c = legendre_correlation(u, order, max_lag)
     n = c.shape[1]
-    if not 2 <= n_groups <= n:
-        raise ValueError(f"n_groups must be between 2 and the number of molecules {n}, got {n_groups}")
-    mean = c.mean(axis=1)
-    result = correlation_time(mean, dt_ps, c_cut, c_fit)
-    groups = [correlation_time(c[:, g].mean(axis=1), dt_ps, c_cut, c_fit).tau
-              for g in np.array_split(np.arange(n), n_groups)]
-    result.se = float(np.std(groups, ddof=1) / np.sqrt(n_groups))
-    return mean, result
+    if n_groups < 2 or n < 2:
+        raise ValueError(f"the error needs n_groups >= 2 and at least 2 molecules, got {n_groups} and {n}")
+    groups = np.array_split(np.arange(n), min(n_groups, n))
+    total = c.sum(axis=1)
+    result = correlation_time(total / n, dt_ps, c_cut, c_fit)
+    jack = np.array([correlation_time((total - c[:, g].sum(axis=1)) / (n - len(g)), dt_ps, c_cut, c_fit).tau
+                     for g in groups])
+    g = len(groups)
+    result.se = float(np.sqrt((g - 1) / g * ((jack - jack.mean()) ** 2).sum()))
+    return total / n, result
