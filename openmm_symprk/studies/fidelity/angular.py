@@ -4,7 +4,7 @@ Each molecule's angular velocity is omega = I^-1 L, with L its angular momentum 
 about its own centre of mass, from positions, velocities and masses through the package's one definition of
 a molecule's centre-of-mass frame (:func:`openmm_symprk.physics.momenta.molecule_frames`).  For a rigid
 molecule it is the exact rotation rate (v_i = V + omega x r_i); for a flexible one it is the rate that
-carries the angular momentum.
+carries the angular momentum; a linear molecule's has no component along its axis.
 
 ``frame="space"``: components along the box axes.  ``frame="body"``: along the molecule's principal axes
 e_1, e_2, e_3 (moments ascending), each axis's sign fixed from the molecule's atoms (e_1, e_2 point towards
@@ -34,6 +34,7 @@ from .molecules import trajectory_frames
 __all__ = ["angular_velocities", "angular_velocity_acf", "AcfSummary", "acf_summary"]
 
 _SIGN_TOL_NM = 1e-6
+_LINEAR = 1e-8  # smallest / largest principal moment below which a molecule is linear
 _DEGENERATE = 1e-6  # relative gap between principal moments below which the body frame is not unique
 
 
@@ -62,7 +63,8 @@ def angular_velocities(x, v, m, molecules, frame: str = "space") -> np.ndarray:
     fr = trajectory_frames(x, v, m, molecules)
     if np.any(fr.M <= 0):
         raise ValueError("a molecule has no mass: no angular velocity")
-    omega = np.linalg.solve(fr.inertia, fr.L[..., None])[..., 0]
+    # pseudo-inverse: a linear molecule has no rotation about its axis (as physics.temperature counts it)
+    omega = np.einsum("...ij,...j->...i", np.linalg.pinv(fr.inertia, rcond=_LINEAR, hermitian=True), fr.L)
     if frame == "body":
         omega = np.einsum("...dj,...d->...j", _body_axes(fr.inertia, fr.r), omega)
     return omega
