@@ -10,8 +10,9 @@ pairs); each bin's count divided by the ideal-gas count at the frame's density,
 so that uniform random points give g = 1 (the N - 1 makes it exact at any N).  Its error: the frames cut
 into ``n_blocks`` consecutive blocks, g of each block, standard deviation / sqrt(n_blocks).
 
-First peak (:func:`first_peak`): the highest bin beyond ``r_min``, refined by the parabola through it and
-its two neighbours (vertex position and height); the same on each block's g gives their standard errors.
+First peak (:func:`first_peak`): the first run of bins beyond ``r_min`` where g > 1 (``above``), its
+highest bin refined by the parabola through it and its two neighbours (vertex position and height); the
+same on each block's g gives their standard errors.
 """
 from __future__ import annotations
 
@@ -82,27 +83,34 @@ class Peak:
     height_se: float
 
 
-def _vertex(r, g, r_min):
-    """Parabola through the highest bin beyond r_min and its neighbours: (position, height)."""
-    k = int(np.argmax(np.where(r > r_min, g, -np.inf)))
+def _vertex(r, g, r_min, above):
+    """Parabola through the highest bin of the first run of bins beyond r_min with g > above, and its two
+    neighbours: (position, height)."""
+    over = (r > r_min) & (g > above)
+    if not over.any():
+        raise ValueError(f"g(r) never exceeds {above} beyond r_min = {r_min} nm: no first peak")
+    start = int(np.argmax(over))
+    stop = start + (int(np.argmin(over[start:])) if not over[start:].all() else len(g) - start)
+    k = start + int(np.argmax(g[start:stop]))
     if k == 0 or k == len(g) - 1:
-        raise ValueError(f"the highest bin beyond r_min = {r_min} nm is at the end of the range "
-                         f"(r = {r[k]:.4g} nm): no peak to refine (raise r_max or lower r_min)")
+        raise ValueError(f"the first peak's highest bin is at the end of the range (r = {r[k]:.4g} nm): "
+                         f"no peak to refine (raise r_max or r_min)")
     g0, g1, g2 = g[k - 1], g[k], g[k + 1]
     curv = g0 - 2.0 * g1 + g2
     if curv >= 0:
         return float(r[k]), float(g1)
     h = r[1] - r[0]
-    shift = 0.5 * (g0 - g2) / curv  # in bins, within (-1/2, 1/2] since g1 is the highest
+    shift = 0.5 * (g0 - g2) / curv  # in bins, within [-1/2, 1/2] since g1 is the highest of the three
     return float(r[k] + shift * h), float(g1 - 0.25 * (g0 - g2) * shift)
 
 
-def first_peak(rdf: Rdf, r_min: float = 0.0) -> Peak:
-    """Position and height of the highest peak of ``rdf`` beyond ``r_min`` nm (water's O-O: the first peak,
-    near 0.28 nm), refined by a parabola through three bins, with the blocks' standard errors."""
-    r, h = _vertex(rdf.r, rdf.g, r_min)
+def first_peak(rdf: Rdf, r_min: float = 0.0, above: float = 1.0) -> Peak:
+    """Position (nm) and height of the first peak of ``rdf``: the first run of bins beyond ``r_min`` nm where
+    g > ``above`` (water's O-O: 0.26-0.33 nm), its highest bin refined by the parabola through it and its
+    two neighbours; standard errors from the same on each block's g."""
+    r, h = _vertex(rdf.r, rdf.g, r_min, above)
     if len(rdf.blocks) > 1:
-        per = np.array([_vertex(rdf.r, b, r_min) for b in rdf.blocks])
+        per = np.array([_vertex(rdf.r, b, r_min, above) for b in rdf.blocks])
         se = per.std(axis=0, ddof=1) / np.sqrt(len(per))
     else:
         se = (np.nan, np.nan)
