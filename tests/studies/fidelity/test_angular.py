@@ -123,3 +123,24 @@ def test_a_symmetric_top_has_no_body_frame_and_bad_frames_are_named():
         angular_velocities(x, np.zeros_like(x), [1.0, 1.0, 1.0], [[0, 1, 2]], frame="body")
     with pytest.raises(ValueError, match="'space' or 'body'"):
         angular_velocities(x, np.zeros_like(x), [1.0, 1.0, 1.0], [[0, 1, 2]], frame="lab")
+
+
+def test_rotational_energy_from_omega_is_the_temperature_modules():
+    """1/2 omega . I omega summed over molecules equals physics.temperature's rotational kinetic energy
+    (one definition of the molecule's frame behind both), for random rigid-water velocities."""
+    from openmm_symprk.physics.temperature import molecule_kinetics
+    from openmm_symprk.studies.fidelity.molecules import trajectory_frames
+
+    rng = np.random.default_rng(25)
+    xs, vs = [], []
+    for _ in range(6):
+        x, v = _spinning(rng.normal(size=3) * 8, rng.normal(size=3), np.array([0.0]),
+                         start=_rotation(rng.normal(size=3), rng.uniform(0, 3)), origin=rng.uniform(0, 2, 3))
+        xs.append(x)
+        vs.append(v)
+    x, v, m = np.concatenate(xs, 1), np.concatenate(vs, 1), np.tile(MASS, 6)
+    mols = [[3 * i, 3 * i + 1, 3 * i + 2] for i in range(6)]
+    w = angular_velocities(x, v, m, mols)[0]
+    inertia = trajectory_frames(x, v, m, mols).inertia[0]
+    k_rot = 0.5 * np.einsum("ni,nij,nj->n", w, inertia, w)
+    np.testing.assert_allclose(k_rot, molecule_kinetics(x[0], v[0], m, mols).rotational, rtol=1e-10)
