@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 
 from openmm_symprk.studies.fidelity.diffusion import (NM2_PER_PS_IN_1E5_CM2_PER_S, VISCOSITY_MPAS,
-                                                      mean_squared_displacement, self_diffusion, unwrap,
-                                                      yeh_hummer)
+                                                      mean_squared_displacement, remove_drift, self_diffusion,
+                                                      unwrap, yeh_hummer)
 
 D_WATER = 2.5e-3  # nm^2/ps = 2.5e-5 cm^2/s
 
@@ -19,7 +19,7 @@ def _random_walk(D, dt, n_frames, n_mol, rng):
 def test_random_walk_recovers_its_diffusion_coefficient(error):
     rng = np.random.default_rng(4)
     r = _random_walk(D_WATER, 0.1, 2000, 200, rng)
-    fit = self_diffusion(r, 0.1, (1.0, 10.0), error=error, n_blocks=5)
+    fit = self_diffusion(r, 0.1, (1.0, 10.0), error=error, n_blocks=5, drift=False)
     D = D_WATER * NM2_PER_PS_IN_1E5_CM2_PER_S
     assert abs(fit.D - D) < 3 * fit.se, f"{fit} against {D}"
     assert fit.se < 0.05 * D  # resolved, not a loose bar
@@ -28,7 +28,8 @@ def test_random_walk_recovers_its_diffusion_coefficient(error):
 def test_the_standard_error_is_the_scatter_of_independent_runs():
     """Over 40 independent random walks the spread of D is the standard error the fit states (within 30%)."""
     rng = np.random.default_rng(5)
-    fits = [self_diffusion(_random_walk(D_WATER, 0.1, 400, 60, rng), 0.1, (0.5, 5.0)) for _ in range(40)]
+    fits = [self_diffusion(_random_walk(D_WATER, 0.1, 400, 60, rng), 0.1, (0.5, 5.0), drift=False)
+            for _ in range(40)]
     D = np.array([f.D for f in fits])
     se = np.sqrt(np.mean([f.se ** 2 for f in fits]))
     assert 0.7 < D.std(ddof=1) / se < 1.3
@@ -58,13 +59,30 @@ def test_brownian_particles_diffuse_at_kt_over_m_gamma_once_past_the_ballistic_r
     for k in range(1, n):
         v[k] = c * v[k - 1] + noise[k]
     r = np.concatenate([np.zeros((1, nm, 3)), np.cumsum(0.5 * (v[1:] + v[:-1]) * dt, axis=0)])
-    fit = self_diffusion(r, dt, (1.0, 5.0))
+    fit = self_diffusion(r, dt, (1.0, 5.0), drift=False)
     assert abs(fit.D - D * 1000) < 3 * fit.se and fit.se < 0.05 * D * 1000
     t = fit.lag_ps[:200]
     theory = 6 * D * (t - (1 - np.exp(-gamma * t)) / gamma)
     np.testing.assert_allclose(fit.msd[1:200], theory[1:], rtol=0.05)
-    ballistic = self_diffusion(r, dt, (0.01, 0.05))
+    ballistic = self_diffusion(r, dt, (0.01, 0.05), drift=False)
     assert ballistic.D < 0.5 * D * 1000
+
+
+def test_a_translating_whole_is_taken_out_and_independent_walkers_lose_one_over_n():
+    """Random walkers (D) all carried at V = 0.05 nm/ps: with the drift taken out, D (1 - 1/n) as the
+    common centre's own diffusion goes with it; without, the V^2 t^2 term more than doubles the slope."""
+    rng = np.random.default_rng(9)
+    n = 50
+    walk = _random_walk(D_WATER, 0.1, 2000, n, rng)
+    moving = walk + (np.arange(2000) * 0.1)[:, None, None] * np.array([0.05, 0.0, 0.0])
+    kept = self_diffusion(moving, 0.1, (1.0, 10.0))
+    assert abs(kept.D - D_WATER * 1000 * (1 - 1 / n)) < 3 * kept.se
+    np.testing.assert_allclose(remove_drift(moving), remove_drift(walk), atol=1e-9)
+    assert self_diffusion(moving, 0.1, (1.0, 10.0), drift=False).D > 2 * D_WATER * 1000
+    # weights: a molecule at rest, heavy enough to carry the centre, anchors it: nothing is taken out
+    anchored = moving.copy()
+    anchored[:, 0] = anchored[0, 0]
+    np.testing.assert_allclose(remove_drift(anchored, np.r_[1e12, np.ones(n - 1)]), anchored, atol=1e-9)
 
 
 def test_unwrapping_a_particle_crossing_the_box_several_times():
@@ -83,7 +101,7 @@ def test_unwrapping_restores_wrapped_random_walks_and_their_diffusion():
     wrapped = r - box * np.floor(r / box)
     back = unwrap(wrapped, box)
     np.testing.assert_allclose(back - back[0], r - r[0], atol=1e-10)
-    assert self_diffusion(wrapped, 0.1, (1, 10)).D < 0.5 * self_diffusion(back, 0.1, (1, 10)).D
+    assert self_diffusion(wrapped, 0.1, (1, 10), drift=False).D < 0.5 * self_diffusion(back, 0.1, (1, 10), drift=False).D
 
 
 def test_unwrapping_refuses_steps_too_long_to_tell_the_image():
