@@ -175,7 +175,8 @@ def self_diffusion(r, dt_ps: float, window_ps, *, error: str = "molecules", n_bl
     if len(per) < 2:
         raise ValueError("the error needs at least 2 molecules (or blocks)")
     se = float(np.std(per, ddof=1) / np.sqrt(len(per)))
-    return DiffusionFit(D, se, np.arange(msd.shape[0]) * dt_ps, mean_msd, (t[0], t[-1]), error, len(per))
+    return DiffusionFit(D, se, np.arange(msd.shape[0]) * dt_ps, mean_msd, (float(t[0]), float(t[-1])), error,
+                        len(per))
 
 
 def yeh_hummer(box_nm: float, temperature_k: float, viscosity_mpas: float) -> float:
