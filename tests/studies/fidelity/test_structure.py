@@ -56,3 +56,21 @@ def test_parabola_refines_the_peak_between_bins():
 def test_r_max_beyond_half_the_box_is_refused():
     with pytest.raises(ValueError, match="half the shortest box edge"):
         radial_distribution(np.zeros((1, 4, 3)), [2.0, 2.0, 1.0], r_max=0.8)
+
+
+def test_g_equals_mdanalysis_interrdf():
+    """The same numbers as MDAnalysis' InterRDF of a group with itself (self pairs excluded), Universe in memory."""
+    mda = pytest.importorskip("MDAnalysis")
+    from MDAnalysis.analysis.rdf import InterRDF
+    from MDAnalysis.coordinates.memory import MemoryReader
+
+    rng = np.random.default_rng(33)
+    box, n = np.array([2.0, 2.2, 2.4]), 60
+    x = rng.uniform(size=(10, n, 3)) * box
+    u = mda.Universe.empty(n, trajectory=False)
+    dims = np.tile(np.r_[box * 10, 90, 90, 90], (10, 1))  # Angstrom
+    u.load_new((x * 10).astype(np.float32), format=MemoryReader, dimensions=dims)
+    ref = InterRDF(u.atoms, u.atoms, nbins=50, range=(0.0, 10.0), exclusion_block=(1, 1)).run()
+    ours = radial_distribution(x, box, r_max=1.0, dr=0.02, n_blocks=2)
+    np.testing.assert_allclose(ours.r, ref.results.bins / 10, atol=1e-12)
+    np.testing.assert_allclose(ours.g, ref.results.rdf, atol=1e-6)
