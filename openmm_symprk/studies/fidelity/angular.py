@@ -21,6 +21,8 @@ averaged over molecules and time origins (:func:`angular_velocity_acf`; per comp
 with ``components=True``).  Its summary (:func:`acf_summary`): the first zero crossing, the first local
 minimum (time and value) and the trapezoidal integral of C from 0 to the last computed lag (ps; it
 oscillates with the librations, so the integral is stated together with its upper limit).
+:func:`omega_correlation` gives both, with the summary's standard errors from the delete-one-group
+jackknife over groups of molecules (:func:`~.correlation.jackknife_over_molecules`).
 """
 from __future__ import annotations
 
@@ -28,10 +30,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .correlation import origin_averaged_correlation
+from .correlation import jackknife_over_molecules, origin_averaged_correlation
 from .molecules import trajectory_frames
 
-__all__ = ["angular_velocities", "angular_velocity_acf", "AcfSummary", "acf_summary"]
+__all__ = ["angular_velocities", "angular_velocity_acf", "AcfSummary", "acf_summary", "omega_correlation"]
 
 _SIGN_TOL_NM = 1e-6
 _LINEAR = 1e-8  # smallest / largest principal moment below which a molecule is linear
@@ -92,13 +94,16 @@ def angular_velocity_acf(omega, max_lag: int | None = None, components: bool = F
 @dataclass
 class AcfSummary:
     """First zero crossing (ps, nan if none), first local minimum (ps and value, nan if none) and the
-    integral of C from 0 to ``t_max`` (ps)."""
+    integral of C from 0 to ``t_max`` (ps); standard errors (nan unless computed: :func:`omega_correlation`)."""
 
     t_zero: float
     t_min: float
     c_min: float
     integral: float
     t_max: float
+    t_zero_se: float = float("nan")
+    c_min_se: float = float("nan")
+    integral_se: float = float("nan")
 
 
 def acf_summary(c, dt_ps: float) -> AcfSummary:
@@ -117,3 +122,26 @@ def acf_summary(c, dt_ps: float) -> AcfSummary:
     t_min, c_min = (float((minima[0] + 1) * dt_ps), float(c[minima[0] + 1])) if len(minima) else (np.nan, np.nan)
     integral = float(dt_ps * (c.sum() - 0.5 * (c[0] + c[-1])))
     return AcfSummary(float(t_zero), t_min, c_min, integral, (len(c) - 1) * dt_ps)
+
+
+def omega_correlation(omega, dt_ps: float, max_lag: int | None = None, n_groups: int = 20) -> tuple:
+    """(C(t) (max_lag + 1,), :class:`AcfSummary` with the standard errors of t_zero, c_min and the integral)
+    of the angular velocities ``omega`` (F, n, 3) rad/ps sampled every ``dt_ps``: the normalised
+    autocorrelation of :func:`angular_velocity_acf`, summarised by :func:`acf_summary`; errors by the
+    delete-one-group jackknife over ``n_groups`` groups of molecules."""
+    omega = np.asarray(omega, dtype=np.float64)
+    if omega.ndim != 3 or omega.shape[2] != 3:
+        raise ValueError(f"omega must have shape (n_frames, n_molecules, 3) in rad/ps, got {omega.shape}")
+    per = origin_averaged_correlation(omega, max_lag).sum(axis=2)  # (L, n), not normalised
+    if not per[0].mean() > 0:
+        raise ValueError("omega is zero at every frame: it has no normalised autocorrelation")
+    c = per.mean(axis=1) / per[0].mean()
+
+    def figures(mean):
+        s = acf_summary(mean / mean[0], dt_ps)
+        return np.array([s.t_zero, s.c_min, s.integral])
+
+    summary = acf_summary(c, dt_ps)
+    _, se = jackknife_over_molecules(per, figures, n_groups)
+    summary.t_zero_se, summary.c_min_se, summary.integral_se = (float(e) for e in se)
+    return c, summary

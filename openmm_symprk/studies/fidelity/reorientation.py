@@ -25,7 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .correlation import origin_averaged_correlation
+from .correlation import jackknife_over_molecules, origin_averaged_correlation
 from .molecules import molecule_index
 
 __all__ = ["atom_vectors", "bisector_vectors", "dipole_vectors", "legendre_correlation", "correlation_time",
@@ -143,17 +143,9 @@ def reorientation_time(u, order: int, dt_ps: float, *, n_groups: int = 20, max_l
                        c_cut: float = 0.1, c_fit: float = 0.5) -> tuple:
     """(C_l averaged over molecules (max_lag + 1,), :class:`CorrelationTime` tau_l in ps with its standard
     error) for unit vectors ``u`` (F, n, 3) every ``dt_ps``.  The error is the delete-one-group jackknife over
-    ``n_groups`` disjoint groups of molecules (at most one group per molecule): tau recomputed from C_l
-    averaged over all groups but one, sqrt((G - 1) / G * sum (tau_(g) - mean)^2)."""
+    ``n_groups`` disjoint groups of molecules (:func:`~.correlation.jackknife_over_molecules`)."""
     c = legendre_correlation(u, order, max_lag)
-    n = c.shape[1]
-    if n_groups < 2 or n < 2:
-        raise ValueError(f"the error needs n_groups >= 2 and at least 2 molecules, got {n_groups} and {n}")
-    groups = np.array_split(np.arange(n), min(n_groups, n))
-    total = c.sum(axis=1)
-    result = correlation_time(total / n, dt_ps, c_cut, c_fit)
-    jack = np.array([correlation_time((total - c[:, g].sum(axis=1)) / (n - len(g)), dt_ps, c_cut, c_fit).tau
-                     for g in groups])
-    g = len(groups)
-    result.se = float(np.sqrt((g - 1) / g * ((jack - jack.mean()) ** 2).sum()))
-    return total / n, result
+    mean = c.mean(axis=1)
+    result = correlation_time(mean, dt_ps, c_cut, c_fit)
+    _, result.se = jackknife_over_molecules(c, lambda m: correlation_time(m, dt_ps, c_cut, c_fit).tau, n_groups)
+    return mean, result
