@@ -9,10 +9,12 @@ as pure-numpy functions of arrays (nm, ps, Da), each with known-answer tests in 
 - :mod:`.structure` - the radial distribution function g(r) under periodic boundaries and its first peak;
 - :mod:`.extrapolation` - an observable extrapolated to step size h -> 0 (fit a + b h^2);
 - :mod:`.molecules`, :mod:`.correlation` - the molecules' centre-of-mass frames along a trajectory, and
-  time correlation functions averaged over origins, shared by the above.
+  time correlation functions averaged over origins with their jackknife over molecules, shared by the above;
+- :mod:`.literature` - constants and published model data (viscosities) with their sources.
 
 The study that runs the rows and produces these figures is not built yet (docs/fidelity.md).
 """
-from . import angular, correlation, diffusion, extrapolation, molecules, reorientation, structure
+from . import angular, correlation, diffusion, extrapolation, literature, molecules, reorientation, structure
 
-__all__ = ["angular", "correlation", "diffusion", "extrapolation", "molecules", "reorientation", "structure"]
+__all__ = ["angular", "correlation", "diffusion", "extrapolation", "literature", "molecules", "reorientation",
+           "structure"]

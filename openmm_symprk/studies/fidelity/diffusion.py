@@ -29,20 +29,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from .correlation import origin_averaged_correlation
+from .literature import K_BOLTZMANN, NM2_PER_PS_IN_1E5_CM2_PER_S, VISCOSITY_MPAS, XI_CUBIC
 
 __all__ = ["unwrap", "remove_drift", "mean_squared_displacement", "DiffusionFit", "self_diffusion", "yeh_hummer",
            "VISCOSITY_MPAS", "XI_CUBIC", "NM2_PER_PS_IN_1E5_CM2_PER_S", "K_BOLTZMANN"]
-
-#: 1 nm^2/ps expressed in the literature's unit, 1e-5 cm^2/s.
-NM2_PER_PS_IN_1E5_CM2_PER_S = 1000.0
-#: Boltzmann's constant, J/K (exact, SI 2019).
-K_BOLTZMANN = 1.380649e-23
-#: xi of a cubic periodic lattice in the Yeh-Hummer correction (Yeh & Hummer, J. Phys. Chem. B 108, 15873, 2004).
-XI_CUBIC = 2.837297
-#: Shear viscosity of the rigid water models, mPa s, at 298 K and 1 bar, from equilibrium MD (Green-Kubo):
-#: M. A. González and J. L. F. Abascal, J. Chem. Phys. 132, 096101 (2010), "The shear viscosity of rigid water
-#: models" (experiment: 0.896 mPa s).  The models' viscosity, not water's, is what the correction needs.
-VISCOSITY_MPAS = {"spce": 0.729, "tip3p": 0.321}
 
 _UNWRAP_LIMIT = 0.4  # a stored step beyond this fraction of an edge cannot be unwrapped safely
 
