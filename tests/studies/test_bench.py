@@ -146,8 +146,8 @@ def test_dask_scheduler(tmp_path):
                                   dashboard_address=None) as cluster:
         res = run_sweep(cfg, str(tmp_path / "dask"), scheduler=cluster.scheduler_address, charts=False,
                         progress=False, log=lambda *a: None)
-    assert res.stats["computed"] == 4
-    assert all(r["status"] == "ok" for r in res.runs if r["step_fs"] == 1.0)
+    assert res["stats"]["computed"] == 4
+    assert all(r["status"] == "ok" for r in res["runs"] if r["step_fs"] == 1.0)
 
 
 def test_records_are_typed_and_versioned(tmp_path):

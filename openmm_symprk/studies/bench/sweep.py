@@ -28,9 +28,9 @@ import os
 import time
 import warnings
 
-from ..folders import FolderLock, FolderLockedError, write_json
+from ..core import FolderLock, FolderLockedError, progress_bar, write_json, write_text
+from ..core.executors import make_executor
 from . import presets
-from .executors import make_executor
 from .records import RunRecord
 from .runs import OPENMM_ROWS, RunSpec, label
 from .store import Store, run_key
@@ -76,7 +76,7 @@ def _evals(method):
 # -- scenes --------------------------------------------------------------------------------------
 def prepare_scenes(config: dict, out: str, reuse: bool = True, log=print) -> dict:
     """Build (or, with ``reuse``, load the saved copy of) every scene of ``config``."""
-    from .registry import BenchScene, build, user_scene
+    from .registry import build, load_scene, save_scene, user_scene
 
     folder = os.path.join(out, "scenes")
     result = {}
@@ -88,7 +88,7 @@ def prepare_scenes(config: dict, out: str, reuse: bool = True, log=print) -> dic
             with open(path) as fh:
                 saved = json.load(fh)["info"].get("meta", {}).get("params")
             if saved == json.loads(json.dumps(params)):
-                scene = BenchScene.load(folder, name)
+                scene = load_scene(folder, name)
         if scene is None:
             t = time.perf_counter()
             with warnings.catch_warnings():
@@ -96,7 +96,7 @@ def prepare_scenes(config: dict, out: str, reuse: bool = True, log=print) -> dic
                 scene = user_scene(name=name, **params) if sc.get("builder") == "user" else build(name, **params)
             scene.name = name
             scene.meta = dict(scene.meta, params=params)
-            scene.save(folder)
+            save_scene(scene, folder)
             log(f"built scene {name}: {scene.description} ({time.perf_counter() - t:.1f} s)")
         if sc.get("platform"):
             scene.platform = sc["platform"]
@@ -145,14 +145,26 @@ def plan(config: dict, scenes: dict) -> list:
 
 
 # -- execution -----------------------------------------------------------------------------------
-def _run_jobs(jobs, store, executor, fingerprints, progress=True, on_result=None):
-    from tqdm import tqdm
+_scenes: dict = {}
 
+
+def work(payload: dict, spec_dict: dict):
+    """One spec in whatever process executes it (each scene is rebuilt from its payload once per process);
+    returns (record, arrays)."""
+    from ...systems.scene import Scene
+    from .stability import run_spec
+
+    key = (payload["info"]["name"], payload["fingerprint"])
+    if key not in _scenes:
+        _scenes[key] = Scene.from_payload(payload)
+    return run_spec(RunSpec(**spec_dict), _scenes[key])
+
+
+def _run_jobs(jobs, store, executor, fingerprints, progress=True, on_result=None):
     counter = itertools.count()
     ready, inflight = [], {}
     stats = {"computed": 0, "reused": 0}
-    bar = tqdm(total=sum(j.remaining for j in jobs), desc="bench", unit="run", disable=not progress,
-               dynamic_ncols=True)
+    bar = progress_bar(sum(j.remaining for j in jobs), "bench", progress)
 
     def tick():
         bar.total = bar.n + sum(j.remaining for j in jobs)
@@ -181,7 +193,7 @@ def _run_jobs(jobs, store, executor, fingerprints, progress=True, on_result=None
         while ready or inflight:
             while ready and len(inflight) < executor.workers + 1:
                 _, _, job, spec, key = heapq.heappop(ready)
-                inflight[executor.submit(spec.to_dict(), spec.scene)] = (job, spec, key)
+                inflight[executor.submit(spec.scene, spec.to_dict())] = (job, spec, key)
             for fut in executor.wait(set(inflight)):
                 job, spec, key = inflight.pop(fut)
                 rec = _result(fut, spec)
@@ -241,8 +253,6 @@ def retime_sweep(config: dict, out: str, rounds: int = 3, workers: int = 1, char
     VerletIntegrator, in turns, ``rounds`` rounds), one at a time in this process, keeping everything else
     each run measured; then continue the sweep as ``resume=True`` does and rewrite its results.  For a sweep
     that shared its machine with other work: the ratios are taken in turns, but heavy load still blurs them."""
-    from tqdm import tqdm
-
     from .runs import retime
 
     if not os.path.isdir(os.path.join(out, "runs")) or not len(Store(out)):
@@ -261,9 +271,12 @@ def retime_sweep(config: dict, out: str, rounds: int = 3, workers: int = 1, char
             rec = store.get(key)
             if rec is not None and rec.wall_per_step and spec.timing_s > 0:
                 todo.append((spec, key, rec))
-        for spec, key, rec in tqdm(todo, desc="retime", unit="run", disable=not progress, dynamic_ncols=True):
+        bar = progress_bar(len(todo), "retime", progress)
+        for spec, key, rec in todo:
             retime(spec, scenes[spec.scene], rec, rounds)
             store.put(key, rec, store.arrays(key) if rec.has_arrays else None)
+            bar.update(1)
+        bar.close()
         log(f"timed {len(todo)} runs again")
     finally:
         lock.release()
@@ -281,7 +294,7 @@ def _sweep(config, out, workers, scheduler, resume, charts, progress, on_result,
     payloads = {name: sc.payload() for name, sc in scenes.items()}
     fingerprints = {name: p["fingerprint"] for name, p in payloads.items()}
     jobs = plan(config, scenes)
-    executor = make_executor(payloads, workers, scheduler)
+    executor = make_executor(work, payloads, workers, scheduler)
     t0 = time.perf_counter()
     try:
         stats = _run_jobs(jobs, store, executor, fingerprints, progress, on_result)
@@ -294,8 +307,7 @@ def _sweep(config, out, workers, scheduler, resume, charts, progress, on_result,
     results["stats"] = stats
     results["out"] = out
     write_json(os.path.join(out, "results.json"), results)
-    with open(os.path.join(out, "summary.txt"), "w") as fh:
-        fh.write(format_summary(results) + "\n")
+    write_text(os.path.join(out, "summary.txt"), format_summary(results) + "\n")
     if charts:
         from .charts import make_charts
 

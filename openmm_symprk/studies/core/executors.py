@@ -1,48 +1,39 @@
 """Where runs execute: in this process, in local worker processes, or on a Dask cluster.
 
-All three give the sweep the same two operations, ``submit(spec_dict, scene_name)`` -> future and
-``wait(futures)`` -> the finished ones.  Each worker receives every scene payload once (a process-pool
-initializer; ``Client.scatter`` on Dask) and keeps the deserialized scenes in a per-process cache.
+All three give a study the same operations: ``submit(name, *args)`` -> a future of ``work(shared[name], *args)``,
+``wait(futures)`` -> the finished ones, and ``shutdown``.  ``work`` is a module-level function (it is pickled);
+``shared`` maps names to the data every run of that name needs (a scene's payload, a model's replica states),
+sent to each worker once: a process-pool initializer, ``Client.scatter`` on Dask.
 
-Local workers are started with the "spawn" method: OpenMM's CPU platform keeps thread pools that a
-forked child must not inherit.  Dask is imported only when a scheduler address is given (install the
-``cluster`` extra: ``pip install "openmm_symprk[cluster]"``).
+Local workers are started with the "spawn" method: OpenMM's CPU platform keeps thread pools that a forked child
+must not inherit.  Dask is imported only when a scheduler address is given (install the ``cluster`` extra:
+``pip install "openmm_symprk[cluster]"``).
 """
 from __future__ import annotations
 
 import concurrent.futures as cf
 import multiprocessing as mp
+import warnings
 
-_payloads: dict = {}
-_scenes: dict = {}
+__all__ = ["SerialExecutor", "PoolExecutor", "DaskExecutor", "make_executor"]
 
-
-def _init_worker(payloads):
-    _payloads.clear()
-    _payloads.update(payloads)
-    _scenes.clear()
+_shared: dict = {}
 
 
-def _scene(name, payload=None):
-    from .registry import BenchScene
-
-    payload = payload if payload is not None else _payloads[name]
-    key = (name, payload["fingerprint"])
-    if key not in _scenes:
-        _scenes[key] = BenchScene.from_payload(payload)
-    return _scenes[key]
+def _init_worker(shared):
+    _shared.clear()
+    _shared.update(shared)
 
 
-def work(spec_dict: dict, scene_name: str, payload=None):
-    """Run one spec (in whatever process this is); returns (record, arrays)."""
-    import warnings
-
-    from .runs import RunSpec
-    from .stability import run_spec
-
+def _quietly(work, payload, args):
     with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        return run_spec(RunSpec(**spec_dict), _scene(scene_name, payload))
+        warnings.simplefilter("ignore")  # e.g. the periodic-box conservation warning, expected in a study
+        return work(payload, *args)
+
+
+def _call(work, name, args):
+    """In a pool worker: ``work`` on the shared data of ``name``."""
+    return _quietly(work, _shared[name], args)
 
 
 class _Done:
@@ -62,20 +53,23 @@ class _Done:
     def cancel(self):
         return False
 
+    def cancelled(self):
+        return False
+
     def done(self):
         return True
 
 
 class SerialExecutor:
-    """Runs each spec at submission, in this process (workers <= 1; tests and debugging)."""
+    """Runs each submission at once, in this process (workers <= 1; tests and debugging)."""
 
     workers = 1
 
-    def __init__(self, payloads):
-        _init_worker(payloads)
+    def __init__(self, work, shared):
+        self.work, self.shared = work, shared
 
-    def submit(self, spec_dict, scene_name):
-        return _Done(work, spec_dict, scene_name)
+    def submit(self, name, *args):
+        return _Done(_quietly, self.work, self.shared[name], args)
 
     def wait(self, futures):
         return set(futures)
@@ -87,22 +81,22 @@ class SerialExecutor:
 class PoolExecutor:
     """``concurrent.futures.ProcessPoolExecutor`` with ``workers`` spawned processes."""
 
-    def __init__(self, payloads, workers: int):
-        self.workers = workers
+    def __init__(self, work, shared, workers: int):
+        self.work, self.workers = work, workers
         self.pool = cf.ProcessPoolExecutor(max_workers=workers, mp_context=mp.get_context("spawn"),
-                                           initializer=_init_worker, initargs=(payloads,))
+                                           initializer=_init_worker, initargs=(shared,))
 
-    def submit(self, spec_dict, scene_name):
-        return self.pool.submit(work, spec_dict, scene_name)
+    def submit(self, name, *args):
+        return self.pool.submit(_call, self.work, name, args)
 
     def wait(self, futures):
         done, _ = cf.wait(futures, return_when=cf.FIRST_COMPLETED)
         return done
 
     def shutdown(self, cancel=False, grace: float = 3.0, inflight=()):
-        """Normal end: wait for the workers.  ``cancel`` (an interrupted sweep): drop queued runs, give
-        the running ones ``grace`` seconds to finish (their records are kept by the caller), then stop
-        the workers instead of waiting for long runs."""
+        """Normal end: wait for the workers.  ``cancel`` (an interrupted study): drop queued runs, give the
+        running ones ``grace`` seconds to finish (the caller keeps what finishes), then stop the workers instead
+        of waiting for long runs."""
         if not cancel:
             self.pool.shutdown(wait=True)
             return
@@ -123,20 +117,21 @@ class PoolExecutor:
 class DaskExecutor:
     """A Dask distributed scheduler at ``address`` (e.g. ``tcp://head:8786``); workers need this package."""
 
-    def __init__(self, payloads, address):
+    def __init__(self, work, shared, address):
         try:
             from dask.distributed import Client
         except ImportError:
             raise ImportError("--scheduler needs Dask distributed: pip install 'openmm_symprk[cluster]' "
                               "(or pip install 'dask[distributed]')") from None
+        self.work = work
         self.client = Client(address)
         info = self.client.scheduler_info()
         self.workers = max(1, sum(w.get("nthreads", 1) for w in info.get("workers", {}).values()))
         # a list of one: scattering a dict directly would scatter its values one by one
-        self.payloads = {k: self.client.scatter([v], broadcast=True)[0] for k, v in payloads.items()}
+        self.shared = {k: self.client.scatter([v], broadcast=True)[0] for k, v in shared.items()}
 
-    def submit(self, spec_dict, scene_name):
-        return self.client.submit(work, spec_dict, scene_name, self.payloads[scene_name], pure=False)
+    def submit(self, name, *args):
+        return self.client.submit(_quietly, self.work, self.shared[name], args, pure=False)
 
     def wait(self, futures):
         from dask.distributed import wait
@@ -150,9 +145,10 @@ class DaskExecutor:
         self.client.close()
 
 
-def make_executor(payloads, workers: int = 1, scheduler: str | None = None):
+def make_executor(work, shared: dict, workers: int = 1, scheduler: str | None = None):
+    """A Dask executor with ``scheduler``, else a pool of ``workers`` processes, else this process."""
     if scheduler:
-        return DaskExecutor(payloads, scheduler)
+        return DaskExecutor(work, shared, scheduler)
     if workers <= 1:
-        return SerialExecutor(payloads)
-    return PoolExecutor(payloads, workers)
+        return SerialExecutor(work, shared)
+    return PoolExecutor(work, shared, workers)

@@ -1,0 +1,123 @@
+"""The skeleton of a study: plan the runs, run one, store it under its key, summarise.
+
+A study subclasses :class:`Study` and gives
+
+* :meth:`Study.plan` -- every run the study needs, each a :class:`Run` (its key, what it needs, its cost);
+* :attr:`Study.work` -- a module-level function ``work(shared, *args) -> (arrays, info)`` that does one run in
+  whatever process executes it (``shared``: the data :meth:`Study.shared` gives under the run's ``name``);
+* :meth:`Study.summarise` -- the results from the stored runs.
+
+:meth:`Study.run` takes the folder's lock, skips every run already stored, executes the rest (in this process,
+spawned worker processes or on a Dask cluster, the most expensive first) with a progress bar, stores each run
+the moment it finishes (``runs/<key>.json`` with the run's ``meta`` and ``info``, ``runs/<key>.npz`` with its
+arrays), and summarises.  An interrupted study keeps every finished run; calling it again continues.  A study
+with per-run trajectory observables keeps them in the arrays, its replicas as runs of one row, and compares
+rows replica by replica in :meth:`Study.summarise` (:func:`openmm_symprk.stats.paired`).
+"""
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass, field
+
+from .executors import make_executor
+from .folders import FolderLock
+from .store import RunStore
+
+__all__ = ["Run", "Study", "progress_bar"]
+
+
+def progress_bar(total: int, desc: str, enabled: bool = True):
+    """A tqdm progress bar (disabled: a silent one with the same methods)."""
+    from tqdm import tqdm
+
+    return tqdm(total=total, desc=desc, unit="run", disable=not enabled, dynamic_ncols=True)
+
+
+@dataclass
+class Run:
+    key: str
+    name: str  # which entry of Study.shared() the run needs
+    args: tuple = ()  # passed to Study.work after the shared data (picklable)
+    meta: dict = field(default_factory=dict)  # stored with the run: what identifies it (row, replica, ...)
+    cost: float = 1.0  # relative cost, to start the longest runs first
+
+
+class Study:
+    """Base class of a study in the folder ``out`` (see the module's docstring)."""
+
+    #: The command named in the lock's error and the progress bar.
+    command = "symprk study"
+    #: ``work(shared, *args) -> (arrays, info)``: one run (a module-level function, set by the subclass).
+    work = None
+
+    def __init__(self, out: str, workers: int = 1, scheduler: str | None = None, progress: bool = True,
+                 log=print):
+        if int(workers) < 1:
+            raise ValueError(f"workers must be >= 1, got {workers!r}")
+        self.out, self.workers, self.scheduler, self.progress, self.log = out, int(workers), scheduler, progress, log
+        self.store: RunStore | None = None
+
+    # -- to be given by a study -----------------------------------------------------------------------------------
+    def plan(self) -> list:
+        raise NotImplementedError
+
+    def shared(self, runs: list) -> dict:
+        """{name: data} that the given (missing) runs need, shipped to each worker once."""
+        return {}
+
+    def summarise(self, runs: list):
+        raise NotImplementedError
+
+    def stored(self, run: Run, info: dict):
+        """Called in this process after each run is stored (e.g. to log a failed run)."""
+
+    # -- the skeleton ---------------------------------------------------------------------------------------------
+    def run(self):
+        """Run what is missing and return :meth:`summarise` of every planned run."""
+        os.makedirs(self.out, exist_ok=True)
+        lock = FolderLock(self.out, self.command)
+        try:
+            self.store = RunStore(self.out)
+            runs = self.plan()
+            todo = [r for r in runs if r.key not in self.store]
+            if len(runs) - len(todo):
+                self.log(f"reusing {len(runs) - len(todo)} finished runs in {self.out}")
+            if todo:
+                self.execute(todo)
+            return self.summarise(runs)
+        finally:
+            lock.release()
+
+    def execute(self, todo: list):
+        """Run ``todo``, storing each run as it finishes; on an interruption keep what finished."""
+        work = type(self).work
+        executor = make_executor(work, self.shared(todo), self.workers, self.scheduler)
+        ready = sorted(todo, key=lambda r: -r.cost)
+        inflight = {}
+        bar = progress_bar(len(todo), self.command.split()[-1] + " runs", self.progress)
+        try:
+            while ready or inflight:
+                while ready and len(inflight) < executor.workers + 1:
+                    run = ready.pop(0)
+                    inflight[executor.submit(run.name, *run.args)] = run
+                for fut in executor.wait(set(inflight)):
+                    self._keep(inflight.pop(fut), fut.result())
+                    bar.update(1)
+        except BaseException:
+            executor.shutdown(cancel=True, inflight=list(inflight))
+            for fut, run in inflight.items():  # keep what finished while stopping
+                if fut.done() and not fut.cancelled():
+                    try:
+                        self._keep(run, fut.result())
+                    except BaseException:  # noqa: BLE001 - the first error is the one raised
+                        pass
+            raise
+        finally:
+            bar.close()
+        executor.shutdown()
+
+    def _keep(self, run: Run, result):
+        arrays, info = result
+        info = dict(info, **run.meta)
+        self.store.put(run.key, info, arrays)
+        self.stored(run, info)
