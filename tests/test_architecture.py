@@ -11,9 +11,9 @@ import openmm_symprk
 
 ROOT = os.path.dirname(openmm_symprk.__file__)
 #: Layer of each sub-package (a module may import from lower layers and from its own sub-package).
-LAYERS = {"methods": 0, "physics": 0, "plugin": 0, "systems": 1, "integrators": 2, "conservation": 3, "rigid": 3,
+LAYERS = {"methods": 0, "physics": 0, "stats": 0, "plugin": 0, "systems": 1, "integrators": 2, "conservation": 3, "rigid": 3,
           "studies": 4, "cli": 5}
-PURE = ("methods", "physics")
+PURE = ("methods", "physics", "stats")
 
 
 def _modules():
