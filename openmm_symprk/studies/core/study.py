@@ -21,6 +21,7 @@ from dataclasses import dataclass, field
 
 from .executors import make_executor
 from .folders import FolderLock
+from .jobs import Job, run_jobs, single
 from .store import RunStore
 
 __all__ = ["Run", "Study", "progress_bar"]
@@ -88,36 +89,21 @@ class Study:
         finally:
             lock.release()
 
-    def execute(self, todo: list):
+    def execute(self, todo: list) -> dict:
         """Run ``todo``, storing each run as it finishes; on an interruption keep what finished."""
-        work = type(self).work
-        executor = make_executor(work, self.shared(todo), self.workers, self.scheduler)
-        ready = sorted(todo, key=lambda r: -r.cost)
-        inflight = {}
+        executor = make_executor(type(self).work, self.shared(todo), self.workers, self.scheduler)
         bar = progress_bar(len(todo), self.command.split()[-1] + " runs", self.progress)
         try:
-            while ready or inflight:
-                while ready and len(inflight) < executor.workers + 1:
-                    run = ready.pop(0)
-                    inflight[executor.submit(run.name, *run.args)] = run
-                for fut in executor.wait(set(inflight)):
-                    self._keep(inflight.pop(fut), fut.result())
-                    bar.update(1)
-        except BaseException:
-            executor.shutdown(cancel=True, inflight=list(inflight))
-            for fut, run in inflight.items():  # keep what finished while stopping
-                if fut.done() and not fut.cancelled():
-                    try:
-                        self._keep(run, fut.result())
-                    except BaseException:  # noqa: BLE001 - the first error is the one raised
-                        pass
-            raise
+            return run_jobs([Job(single(r), r.cost) for r in todo], executor,
+                            lambda run: self.store.info(run.key) if run.key in self.store else None,
+                            lambda ex, run: ex.submit(run.name, *run.args),
+                            lambda run, fut: self._keep(run, fut.result()), bar)
         finally:
             bar.close()
-        executor.shutdown()
 
-    def _keep(self, run: Run, result):
+    def _keep(self, run: Run, result) -> dict:
         arrays, info = result
         info = dict(info, **run.meta)
         self.store.put(run.key, info, arrays)
         self.stored(run, info)
+        return info
