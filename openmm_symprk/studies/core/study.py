@@ -101,6 +101,21 @@ class Study:
         finally:
             bar.close()
 
+    def results(self, runs: list, by: tuple) -> dict:
+        """The stored runs among ``runs`` grouped by the ``meta`` fields ``by`` (e.g. a row: model, method, step):
+        {(values...): [(arrays, info) sorted by the "replica" field when there is one]}; runs not stored are left
+        out.  The replicas of a row are what :func:`openmm_symprk.stats.paired` compares with a reference row."""
+        out = {}
+        for run in runs:
+            info = self.store.info(run.key)
+            if info is None:
+                continue
+            arrays = self.store.arrays(run.key) or {}
+            out.setdefault(tuple(run.meta[k] for k in by), []).append((arrays, info))
+        for reps in out.values():
+            reps.sort(key=lambda rep: rep[1].get("replica", 0))
+        return out
+
     def _keep(self, run: Run, result) -> dict:
         arrays, info = result
         info = dict(info, **run.meta)
