@@ -118,3 +118,11 @@ def test_runs_on_a_dask_cluster(tmp_path):
                             scheduler=cluster.scheduler_address)
     rows = summary["models"]["spce"]["rows"]
     assert [r["replicas"] for r in rows] == [1, 1] and all("dT" in r for r in rows)
+
+
+def test_run_keys_of_stored_studies_do_not_change():
+    """A study's stored runs are found by their keys: a change of the key (or of what it hashes) orphans every
+    stored run, so a re-summary would rerun them all.  This is the key the study has used since run version 2."""
+    from openmm_symprk.studies.equipartition.study import run_key
+
+    assert run_key(presets.full(), "spce", "omelyan-2", 4.0, 3) == "6ad2710190f9cc83"
