@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["statistical_inefficiency", "SeriesStats", "series_stats", "pymbar_timeseries"]
+__all__ = ["statistical_inefficiency", "SeriesStats", "series_stats", "equilibrated_from", "pymbar_timeseries"]
 
 _module = None
 
@@ -67,3 +67,14 @@ def series_stats(x, dt: float = 1.0) -> SeriesStats:
         raise ValueError(f"a series needs at least 2 samples, got {len(x)}")
     g = statistical_inefficiency(x)
     return SeriesStats(float(x.mean()), float(x.std(ddof=1) * np.sqrt(g / len(x))), 0.5 * g * dt, len(x), g)
+
+
+def equilibrated_from(x) -> int:
+    """The first sample of the equilibrated part of ``x``: the start that maximises the number of effectively
+    independent samples left (pymbar's ``detect_equilibration``, Chodera 2016); 0 for a series without a
+    transient, and for one too short (under 10 samples) or constant."""
+    x = np.asarray(x, dtype=np.float64)
+    if len(x) < 10 or not np.ptp(x) > 0:
+        return 0
+    t0, _, _ = pymbar_timeseries().detect_equilibration(x, fast=True)
+    return int(t0)

@@ -147,3 +147,18 @@ def test_pymbar_is_imported_quietly(capfd):
                           "import numpy as np; print(round(g(np.sin(np.arange(100) / 5)), 3) > 1)"],
                          capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "True" and out.stderr == "", out.stderr
+
+
+def test_the_end_of_a_transient_is_found():
+    """An AR(1) series that starts 20 units off and relaxes over ~50 samples: the equilibrated part starts after
+    the transient, well before the end; a stationary series is equilibrated from its start."""
+    from openmm_symprk.stats import equilibrated_from
+
+    rng = np.random.default_rng(12)
+    x = _ar1(0.5, 3000, rng) + 20.0 * np.exp(-np.arange(3000) / 50.0)
+    t0 = equilibrated_from(x)
+    assert 100 <= t0 <= 600
+    assert equilibrated_from(_ar1(0.5, 3000, rng)) < 100
+    assert equilibrated_from(np.ones(50)) == 0 and equilibrated_from([1.0, 2.0]) == 0
+    d = drift(np.arange(3000.0), _ar1(0.5, 3000, rng))
+    assert 600 < d.n_eff < 1500  # n / g with g = 3
