@@ -71,7 +71,9 @@ def maxwell_boltzmann(system: mm.System, positions, temperature: float, seed: in
     if angular_velocity is not None:
         spin = np.cross(np.asarray(angular_velocity, dtype=float), x - centre_of_mass(x, m))
         v += np.where(m[:, None] > 0, spin, 0.0)
-    return constrain_velocities(system, x, v)
+    v = constrain_velocities(system, x, v)
+    v[m == 0] = 0.0  # the momentum correction above moved them too
+    return v
 
 
 def equilibrate(system: mm.System, positions, temperature: float, picoseconds: float, seed: int,

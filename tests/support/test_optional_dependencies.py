@@ -211,11 +211,16 @@ FEATURES = {
     "bench toys": ("import openmm_symprk.studies.bench.toys", "scipy", "studies"),
     "equipartition chart": ("from openmm_symprk.studies.equipartition.report import chart\n"
                             "chart({'models': {}}, os.path.join(TMP, 'x.png'))", "matplotlib", "studies"),
-    "dask executor": ("from openmm_symprk.studies.bench.executors import DaskExecutor\n"
-                      "DaskExecutor({}, 'tcp://127.0.0.1:1')", "dask[distributed]", "cluster"),
+    "dask executor": ("from openmm_symprk.studies.core.executors import DaskExecutor\n"
+                      "DaskExecutor(print, {}, 'tcp://127.0.0.1:1')", "dask[distributed]", "cluster"),
+    "progress bar": ("from openmm_symprk.studies.core.study import progress_bar\n"
+                     "progress_bar(3, 'runs')", "tqdm", "studies"),
+    "statistics": ("from openmm_symprk.stats import statistical_inefficiency\n"
+                   "statistical_inefficiency(np.sin(np.arange(100.0)))", "pymbar", "studies"),
 }
 PROBE = """
 import json, os, sys
+import numpy as np
 TMP = sys.argv[1]
 results = {}
 for name, code in json.loads(sys.argv[2]).items():

@@ -104,7 +104,7 @@ def test_water_box_is_periodic_rigid_water_with_pme():
 @pytest.mark.parametrize("kwargs, message", [
     (dict(model="tip5p"), "unknown water model 'tip5p'; known: spce, tip3p"),
     (dict(n_waters=1), "n_waters must be >= 2, got 1"),
-    (dict(n_waters=40, cutoff_nm=0.9), "cutoff 0.9 nm needs a box wider than 1.8 nm"),
+    (dict(n_waters=40, cutoff_nm=0.9), "cutoff 0.9 nm needs a box at least 1.8 nm wide"),
 ])
 def test_water_box_refuses_bad_input(kwargs, message):
     from openmm_symprk.systems.scenes import water_box
