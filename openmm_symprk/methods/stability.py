@@ -11,7 +11,7 @@ import math
 
 import numpy as np
 
-from .splitting import Splitting
+from .resolved import resolve
 from .tableau import PRKTableau
 
 
@@ -79,12 +79,7 @@ def stability_interval(method, x_max: float = 20.0, resolution: float = 1e-3, to
     ``tol``.  Returns inf if the method is stable on the whole scan range."""
     from scipy.optimize import minimize_scalar
 
-    from .catalogue import Method, get_method
-
-    if isinstance(method, str):
-        method = get_method(method)
-    tab = method.tableau() if isinstance(method, Method) else (
-        PRKTableau.from_splitting(method) if isinstance(method, Splitting) else method)
+    tab = resolve(method).tableau_in(np.float64)  # the method's own PRK pair (a name, Method, Splitting, ...)
     grid = np.arange(resolution, x_max + resolution, resolution)
     g = _margin(tab, grid)
     first_bad = None
