@@ -93,18 +93,25 @@ def _restore_native(integrator):
     name = obj.getMethodName() or "user splitting"
     expected = obj.getExpectedNumParticles()
     constraints = bool(obj.getExpectedConstraints()) if expected >= 0 else True
-    # the plugin keeps the sub-steps as they run (force groups of multiple time stepping included): resolve them
-    resolved = resolve(Splitting(obj.substeps()), constraints=constraints, name=name)
-    flags = [int(obj.getSubstepFlags(i)) for i in range(obj.getNumSubsteps())]
-    if flags != [int(s.flags) for s in resolved.substeps]:
-        raise ValueError(f"the SymPRKIntegrator {name!r} read from XML has sub-step flags {flags} that its sub-steps "
-                         f"would not get ({[int(s.flags) for s in resolved.substeps]}): it was not built by "
-                         f"openmm_symprk")
-    if name in catalogue_methods:  # a catalogue method: its entry (orders, stability), as when it was built
-        entry = catalogue_methods[name]
-        resolved = replace(resolved, entry=entry, order=entry.order, constrained_order=entry.constrained_order,
-                           stability=entry.stability,
-                           kind=entry.family if entry.family in ("splitting", "composition") else resolved.kind)
+    plugin_steps = [(obj.getSubstepKind(i), obj.getSubstepCoefficient(i), obj.getSubstepForceGroups(i),
+                     obj.getSubstepFlags(i)) for i in range(obj.getNumSubsteps())]
+
+    def runs_as_plugin(r):
+        return [(int(s.kind), float(s.coefficient), s.group_mask, int(s.flags)) for s in r.substeps] == plugin_steps
+
+    # a catalogue method resolved again (exact coefficients) if that is what the plugin runs; otherwise (multiple
+    # time stepping, a user splitting) the plugin's sub-steps as they run, with the catalogue's orders if named
+    resolved = resolve(name, constraints=constraints) if name in catalogue_methods else None
+    if resolved is None or not runs_as_plugin(resolved):
+        resolved = resolve(Splitting(obj.substeps()), constraints=constraints, name=name)
+        if not runs_as_plugin(resolved):
+            raise ValueError(f"the SymPRKIntegrator {name!r} read from XML runs sub-steps {plugin_steps} (kind, "
+                             f"coefficient, force groups, flags) whose flags its sequence would not get: it was not "
+                             f"built by openmm_symprk")
+        if name in catalogue_methods:
+            entry = catalogue_methods[name]
+            resolved = replace(resolved, entry=entry, order=entry.order, constrained_order=entry.constrained_order,
+                               stability=entry.stability)
     obj._set_resolved(resolved)
     obj.__dict__.update(check_finite=True, max_speed=float(obj.getMaxSpeed()), exact_momentum=bool(obj.getExactMomentum()),
                         compiled_for=None)

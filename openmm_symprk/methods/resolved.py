@@ -281,10 +281,11 @@ def resolve(method, constraints: bool | None = False, groups=None, inner_method=
         inner_name = inner.name
         run = respa(list(lv))
         tableau = None
+    substeps = _substeps(run, constrained)  # (refuses labels that are neither kicks nor drifts)
     evals = {}
     for label in dict.fromkeys(lab for lab in run.labels if lab != DRIFT):
         evals[label_groups(label)] = run.force_evaluations(label)
     return ResolvedMethod(stages=tableau.stages if tableau is not None else None, splitting=run, tableau=tableau,
-                          substeps=_substeps(run, constrained), force_evals=sum(evals.values()),
+                          substeps=substeps, force_evals=sum(evals.values()),
                           evals_per_group=tuple(evals.items()) if list(evals) != [None] else (),
                           levels=lv, groups=given, inner_name=inner_name, **common)
