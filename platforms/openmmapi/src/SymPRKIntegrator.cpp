@@ -276,19 +276,17 @@ void SymPRKIntegrator::loadCheckpoint(istream& stream) {
         throw OpenMMException("SymPRKIntegrator: the checkpoint was not written by a SymPRKIntegrator (a checkpoint "
                 "of openmm_symprk's CustomIntegrator backend? Load it into SymplecticIntegrator(..., backend='custom') "
                 "with the same method and options as when it was saved)");
-    {
-        int64_t more[2];
-        stream.read((char*) more, sizeof(more));
-        string name(more[1] > 0 && more[1] < 4096 ? more[1] : 0, ' ');
-        if (!name.empty())
-            stream.read(&name[0], name.size());
-        if (!stream)
-            throw OpenMMException("SymPRKIntegrator: the checkpoint is truncated");
-        if (more[0] != getProgramSignature())
-            throw OpenMMException("SymPRKIntegrator: the checkpoint was written by a SymPRKIntegrator running another program "
-                    "(method '"+name+"'; this one runs '"+methodName+"' with exact momentum "+(exactMomentum ? "on" : "off")+
-                    "): create the integrator with the same method and options as when the checkpoint was saved");
-    }
+    int64_t more[2];
+    stream.read((char*) more, sizeof(more));
+    string name(more[1] > 0 && more[1] < 4096 ? more[1] : 0, ' ');
+    if (!name.empty())
+        stream.read(&name[0], name.size());
+    if (!stream)
+        throw OpenMMException("SymPRKIntegrator: the checkpoint is truncated");
+    if (more[0] != getProgramSignature())
+        throw OpenMMException("SymPRKIntegrator: the checkpoint was written by a SymPRKIntegrator running another program "
+                "(method '"+name+"'; this one runs '"+methodName+"' with exact momentum "+(exactMomentum ? "on" : "off")+
+                "): create the integrator with the same method and options as when the checkpoint was saved");
     stepsTaken = values[1];
     blowUpStep = values[2];
     if (context != NULL)
