@@ -144,7 +144,8 @@ class PRKIntegrator(IntegratorBase, mm.CustomIntegrator):
 
     def _reset_binding(self):
         self._context_ref = None
-        self._time_dt = self.getStepSize().value_in_unit(unit.picosecond)  # the step size the Context's time is known to advance by
+        # the step size (ps), and the one the Context's time is known to advance by
+        self._dt = self._time_dt = self.getStepSize().value_in_unit(unit.picosecond)
         self._checked_context = False
         self._checked_probe = False
         self._nonconverged_seen = 0
@@ -212,7 +213,7 @@ class PRKIntegrator(IntegratorBase, mm.CustomIntegrator):
         change of step size: OpenMM's CustomIntegrator on Reference and CPU advances the time by the step size
         the Context was created with, whatever setStepSize said since; the time is then set to what the steps
         took (read before and after, only while the step size differs from the one the time is known to follow)."""
-        dt = self.getStepSize().value_in_unit(unit.picosecond)
+        dt = self._dt
         if dt == self._time_dt:
             return super().step(steps)
         context = self._bound_context()
@@ -236,6 +237,11 @@ class PRKIntegrator(IntegratorBase, mm.CustomIntegrator):
                 context.setTime(expected)
             elif taken:
                 self._time_dt = dt  # this platform's time follows the step size
+
+    def setStepSize(self, size):
+        result = super().setStepSize(size)
+        self._dt = self.getStepSize().value_in_unit(unit.picosecond)
+        return result
 
     def _bound_context(self):
         """The Context this integrator is bound to (found once among the live Contexts, then kept weakly)."""
