@@ -113,7 +113,7 @@ def _cmd_info(args):
           f"custom for implicit and general tableaux")
     if not plugin.available():
         print(f"  to get the native plugin: {plugin.fix_hint()}")
-    print(f"  catalogue: {len(openmm_symprk.methods)} methods (symprk methods)")
+    print(f"  catalogue: {len(openmm_symprk.catalogue)} methods (symprk methods)")
     if args.require_native:
         wanted = [p.strip() for p in args.require_native.split(",") if p.strip()]
         missing = [p for p in wanted if details.get(p) != "native"]

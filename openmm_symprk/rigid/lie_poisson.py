@@ -40,7 +40,9 @@ from functools import lru_cache
 
 import numpy as np
 
+from ..methods.catalogue import UnknownMethodError
 from ..methods.catalogue import methods as catalogue_methods
+from ..methods.resolved import resolve
 from ..methods.splitting import Splitting, compose
 from ..support import require
 
@@ -94,13 +96,18 @@ METHODS: dict = _build_methods()
 def _resolve(method) -> RigidBodyMethod:
     if isinstance(method, RigidBodyMethod):
         return method
-    if not isinstance(method, str):
-        raise ValueError(f"method must be a name (one of {', '.join(METHODS)}), got {method!r}")
-    key = method.strip().lower().replace("_", "-").replace(" ", "-")
+    key = method.strip().lower().replace("_", "-").replace(" ", "-") if isinstance(method, str) else None
     if key in METHODS:
         return METHODS[key]
-    if key in catalogue_methods and catalogue_methods[key].family == "composition":  # catalogue aliases
-        return METHODS[catalogue_methods[key].name]
+    try:  # a catalogue composition by name or alias, as a Method or resolved: its weights over splitting-2
+        resolved = resolve(method)
+    except (UnknownMethodError, TypeError):
+        resolved = None
+    if resolved is not None and resolved.kind == "composition":
+        return METHODS[resolved.name]
+    if key is None:
+        raise ValueError(f"method must be a name (one of {', '.join(METHODS)}) or a catalogue composition, "
+                         f"got {method!r}")
     close = difflib.get_close_matches(key, list(METHODS), n=3, cutoff=0.5)
     hint = f" Did you mean {', '.join(repr(c) for c in close)}?" if close else ""
     raise ValueError(f"unknown rigid-body method {method!r}.{hint} Known methods: {', '.join(METHODS)}.")

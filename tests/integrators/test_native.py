@@ -13,7 +13,7 @@ import openmm.unit as unit
 import pytest
 
 from helpers import counted, drift_after, stiff_diatomic
-from openmm_symprk import SymplecticIntegrator, methods
+from openmm_symprk import SymplecticIntegrator, catalogue
 from openmm_symprk import plugin
 from openmm_symprk.integrators import (NativeMethodError, NativeSymplecticIntegrator, NativeUnavailableError,
                                        SimulationBlowUpError, deserialize)
@@ -21,7 +21,7 @@ from openmm_symprk.integrators import (NativeMethodError, NativeSymplecticIntegr
 needs_native = pytest.mark.skipif(not plugin.available(),
                                   reason=f"native plugin unavailable: {plugin.unavailable_reason()}")
 
-SPLITTINGS = [m.name for m in methods.splittings()]
+SPLITTINGS = [m.name for m in catalogue.splittings()]
 N = NativeSymplecticIntegrator
 
 
@@ -111,13 +111,13 @@ def test_force_evaluations_per_step(name, scene_name, request):
     ig.step(1)
     counter.n = 0
     ig.step(40)
-    assert counter.n == 40 * methods[name].force_evals
-    assert ig.force_evals == methods[name].force_evals
+    assert counter.n == 40 * catalogue[name].force_evals
+    assert ig.force_evals == catalogue[name].force_evals
     # Reference keeps the cached forces through an energy evaluation: one evaluation for the energy, none more.
     counter.n = 0
     ctx.getState(getEnergy=True)
     ig.step(10)
-    assert counter.n == 1 + 10 * methods[name].force_evals
+    assert counter.n == 1 + 10 * catalogue[name].force_evals
 
 
 # -- OpenCL (PoCL in CI) ---------------------------------------------------------------------------------------
@@ -357,7 +357,7 @@ def test_errors(water8):
     assert isinstance(ig, N) and isinstance(ig, mm.Integrator)
     ctx = water8.context(ig)  # noqa: F841
     with pytest.raises(mm.OpenMMException, match="bound to a Context"):
-        ig.setSubsteps([0], [1.0])
+        ig.setSubsteps([0], [1.0], [-1], [0])
 
 
 @needs_native
