@@ -4,7 +4,6 @@ Skipped as a whole, with the loader's reason, when the plugin is not built.  Ref
 for bit (the two backends run the same operations in the same order); OpenCL (PoCL) within its precision.
 """
 import copy
-import os
 
 import numpy as np
 import openmm as mm
@@ -370,27 +369,3 @@ def test_unavailable_reason_is_reported(monkeypatch):
     assert not plugin.available() and plugin.platforms() == []
     with pytest.raises(NativeUnavailableError, match="test: no plugin.*To fix it"):
         N(1 * unit.femtoseconds, "verlet")
-
-
-# -- the build driver's failure path (runs whether or not the plugin is built) ---------------------------------------
-def _build_driver():
-    import importlib.util
-
-    path = os.path.join(os.path.dirname(__file__), "..", "..", "platforms", "build_native.py")
-    if not os.path.exists(path):
-        pytest.skip("not a source checkout (platforms/build_native.py absent)")
-    spec = importlib.util.spec_from_file_location("symprk_build_native_test", path)
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
-
-
-@pytest.mark.parametrize("env,match", [({"SYMPRK_NATIVE": "0"}, "disabled"),
-                                       ({"CXX": "no-such-compiler-symprk"}, "no C\\+\\+ compiler")])
-def test_build_driver_fails_cleanly(env, match, tmp_path, monkeypatch):
-    bn = _build_driver()
-    for k, v in env.items():
-        monkeypatch.setenv(k, v)
-    with pytest.raises(bn.NativeBuildError, match=match):
-        bn.build(tmp_path / "native", tmp_path / "tmp", log=lambda *a: None)
-    assert not (tmp_path / "native" / "_build_info.json").exists()
