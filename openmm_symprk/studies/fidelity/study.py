@@ -31,7 +31,7 @@ RUN_VERSION = 1
 
 
 def run_key(cfg: dict, row: dict, replica: int) -> str:
-    return hash_key({"cfg": {k: cfg[k] for k in RUN_KEYS}, "row": row, "replica": int(replica),
+    return hash_key({"cfg": {k: cfg[k] for k in RUN_KEYS}, "row": check_row(row), "replica": int(replica),
                      "states": STATE_VERSION, "version": RUN_VERSION})
 
 
