@@ -14,8 +14,8 @@ from openmm_symprk.studies.fidelity import presets
 from openmm_symprk.studies.fidelity.cli import main
 from openmm_symprk.studies.fidelity.observe import OBSERVABLES
 from openmm_symprk.studies.fidelity.report import K_SE, summarise
-from openmm_symprk.studies.fidelity.rows import UNAVAILABLE_THERMOSTAT, check_row, describe, label
-from openmm_symprk.studies.fidelity.study import run_key, run_study
+from openmm_symprk.studies.fidelity.rowspec import UNAVAILABLE_THERMOSTAT, check_row, describe, label
+from openmm_symprk.studies.fidelity.simulation import run_key, run_study
 
 
 @pytest.fixture(scope="module")
@@ -123,7 +123,7 @@ def test_an_unavailable_thermostat_row_is_reported_not_run(tmp_path, monkeypatch
 
 def test_an_unrelated_integrator_error_is_not_hidden(monkeypatch):
     import openmm_symprk.integrators as integrators
-    from openmm_symprk.studies.fidelity.rows import availability
+    from openmm_symprk.studies.fidelity.simulation.engines import availability
 
     def broken(*args, **kwargs):
         raise ValueError("stepSize must be positive")

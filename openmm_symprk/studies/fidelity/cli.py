@@ -30,7 +30,7 @@ def build_parser():
 
 def select_rows(cfg: dict, text: str) -> list:
     """The reference row and the preset rows whose labels are named in ``text`` (comma-separated)."""
-    from .rows import label
+    from .rowspec import label
 
     wanted = [w.strip() for w in text.split(",") if w.strip()]
     labels = [label(r) for r in cfg["rows"]]
@@ -55,7 +55,7 @@ def main(argv=None) -> int:
         if os.path.isfile(args.out):
             raise ValueError(f"--out {args.out} is a file; give a folder")
         from .report import format_summary
-        from .study import run_study
+        from .simulation import run_study
 
         summary = run_study(cfg, args.out, workers=args.workers, timing=not args.no_timing,
                             progress=not args.no_progress, scheduler=args.scheduler)

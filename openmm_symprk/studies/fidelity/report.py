@@ -19,7 +19,7 @@ from ...support import require
 from .diffusion import VISCOSITY_MPAS, yeh_hummer
 from .extrapolation import extrapolate_h2
 from .observe import OBSERVABLES
-from .rows import describe
+from .rowspec import describe
 
 __all__ = ["K_SE", "MATCHED", "summarise", "format_summary", "chart", "claim"]
 

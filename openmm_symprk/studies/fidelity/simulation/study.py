@@ -1,7 +1,7 @@
 """Run the fidelity study: the equipartition study's replica states, one run per (row, replica), kept on disk.
 
     from openmm_symprk.studies.fidelity import presets
-    from openmm_symprk.studies.fidelity.study import run_study
+    from openmm_symprk.studies.fidelity.simulation import run_study
     summary = run_study(presets.quick(), "fidelity-quick", workers=2)
 
 ``<out>/states/<model>-<key>.npz`` holds the replica states (the same file, key and states as
@@ -16,10 +16,11 @@ from __future__ import annotations
 import os
 import warnings
 
-from ...systems.checks import ConservationWarning
-from ..core import Run, Study, run_key as hash_key, write_json, write_text
-from ..equipartition.study import STATE_KEYS, STATE_VERSION, replica_state_set
-from .rows import availability, check_row, describe
+from ....systems.checks import ConservationWarning
+from ...core import Run, Study, run_key as hash_key, write_json, write_text
+from ...equipartition.study import STATE_KEYS, STATE_VERSION, replica_state_set
+from ..rowspec import check_row, describe
+from .engines import availability
 
 __all__ = ["FidelityStudy", "run_study", "run_key", "RUN_KEYS", "RUN_VERSION"]
 
@@ -40,7 +41,7 @@ _boxes: dict = {}
 
 def work(shared: dict, row: dict, replica: int):
     """One run in whatever process executes it (the box is built once per process)."""
-    from ..equipartition.runs import build_box
+    from ...equipartition.runs import build_box
     from .runs import run_row
 
     cfg = shared["cfg"]
@@ -93,7 +94,7 @@ class FidelityStudy(Study):
             return self._plan()
 
     def _plan(self) -> list:
-        from ..equipartition.runs import build_box
+        from ...equipartition.runs import build_box
 
         cfg = self.cfg
         self.states = replica_state_set(cfg, cfg["model"], self.out, self.log)
@@ -121,7 +122,7 @@ class FidelityStudy(Study):
             self.log(f"{info['row']} replica {info['replica']}: {info['status']}")
 
     def summarise(self, runs) -> dict:
-        from .report import chart, format_summary, summarise
+        from ..report import chart, format_summary, summarise
 
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", ConservationWarning)
@@ -146,8 +147,8 @@ class FidelityStudy(Study):
     def timings(self) -> dict:
         """Seconds per simulated ps of each available row on replica 0, measured in turns
         (:func:`openmm_symprk.studies.timing.interleaved`), so the ratios hold under the machine's load."""
-        from ..timing import interleaved
-        from .rows import Engine
+        from ...timing import interleaved
+        from .engines import Engine
         from .runs import replica_seed
 
         x, v = self.states
@@ -165,7 +166,7 @@ class FidelityStudy(Study):
 
 def run_study(cfg: dict, out: str, workers: int = 2, timing: bool = True, progress: bool = True, log=print,
               scheduler: str | None = None) -> dict:
-    """Run (or finish, or only re-summarise) the study in ``out``; returns the summary (:func:`.report.summarise`)
+    """Run (or finish, or only re-summarise) the study in ``out``; returns the summary (:func:`..report.summarise`)
     and writes ``summary.txt``, ``results.json``, ``fidelity.png`` (bias against force evaluations per ps) and,
     with timing, ``fidelity-wall.png`` (against wall time per simulated ps) there."""
     return FidelityStudy(cfg, out, workers, timing, progress, log, scheduler).run()

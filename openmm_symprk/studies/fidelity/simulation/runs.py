@@ -6,7 +6,7 @@ then samples every ``sample_fs`` for ``length_ps``: the kinetic temperatures (:m
 3 N - 3 translational degrees of freedom when the row keeps the total momentum), potential and effective energy
 (total + heat bath), the molecules' centres of mass, dipole and H-H unit vectors, and every ``rdf_every``-th
 frame's oxygen positions.  Frames are reduced in the worker; what is kept is each observable with its error
-(:mod:`.observe`), the time series of the equipartition study (t, T_trans, T_rot, pe, etot) and the curves.
+(:mod:`..observe`), the time series of the equipartition study (t, T_trans, T_rot, pe, etot) and the curves.
 """
 from __future__ import annotations
 
@@ -16,14 +16,15 @@ import numpy as np
 import openmm as mm
 import openmm.unit as unit
 
-from ...physics.momenta import kinetic_energy
-from ...physics.temperature import kinetic_temperatures
-from ..equipartition.runs import steps_per_sample
-from .angular import angular_velocities
-from .molecules import centre_of_mass_trajectory
-from .observe import observables
-from .reorientation import atom_vectors, dipole_vectors
-from .rows import Engine, describe
+from ....physics.momenta import kinetic_energy
+from ....physics.temperature import kinetic_temperatures
+from ...equipartition.runs import steps_per_sample
+from ..angular import angular_velocities
+from ..molecules import centre_of_mass_trajectory
+from ..observe import observables
+from ..reorientation import atom_vectors, dipole_vectors
+from ..rowspec import describe
+from .engines import Engine
 
 __all__ = ["run_row", "replica_seed", "charges"]
 

@@ -1,98 +1,30 @@
-"""The fidelity study's rows made into running integrators (the OpenMM side; the rows are data in
-:mod:`.presets`).
+"""The fidelity study's rows made into running OpenMM integrators (the rows are data in :mod:`..presets`, what
+they are in :mod:`..rowspec`).
 
-:func:`check_row` validates a row and names what is wrong; :func:`describe` gives its label, ensemble, force
-evaluations per step, whether it keeps the total momentum and whether it has a conserved effective energy;
-:func:`availability` says whether this installation can run it (the package's thermostat rows need an
-integrator that accepts ``temperature=``); :class:`Engine` runs one row from a replica state.
+:func:`availability` says whether this installation can run a row (the package's thermostat rows need an
+integrator that accepts ``temperature=``); :func:`make_integrator` builds a row's integrator; :class:`Engine`
+runs one row from a replica state.
 """
 from __future__ import annotations
 
+import numpy as np
 import openmm as mm
 import openmm.unit as unit
 
-from ...methods.catalogue import get_method
-from ...systems.properties import masses
-from ...systems.repartition import repartition_hydrogen_mass, rigid_velocities_for_masses
+from ....systems.properties import masses
+from ....systems.repartition import repartition_hydrogen_mass, rigid_velocities_for_masses
+from ..rowspec import UNAVAILABLE_THERMOSTAT, describe
 
-__all__ = ["KINDS", "UNAVAILABLE_THERMOSTAT", "RowUnavailable", "check_row", "describe", "label", "availability",
-           "Engine"]
-
-#: Options each kind of row takes (besides kind, step_fs and hmr_da).
-KINDS = {"symprk": {"method", "collision_time_ps"}, "langevin": {"friction_per_ps"},
-         "mts-langevin": {"friction_per_ps", "inner_steps"}, "nose-hoover": {"collision_frequency_per_ps"},
-         "dpd": {"friction_per_ps", "cutoff_nm"}}
-_REQUIRED = {"symprk": {"method"}, "langevin": {"friction_per_ps"}, "mts-langevin": {"friction_per_ps", "inner_steps"},
-             "nose-hoover": {"collision_frequency_per_ps"}, "dpd": {"friction_per_ps"}}
-
-#: What the output says for a thermostat row this installation cannot run.
-UNAVAILABLE_THERMOSTAT = "unavailable: needs the thermostat"
+__all__ = ["RowUnavailable", "availability", "make_integrator", "Engine"]
 
 
 class RowUnavailable(RuntimeError):
     """This installation cannot run the row (e.g. the integrator does not accept ``temperature=``)."""
 
 
-def check_row(row: dict) -> dict:
-    """``row`` with step_fs as a float; ValueError naming the row and the bad field otherwise."""
-    if not isinstance(row, dict) or row.get("kind") not in KINDS:
-        raise ValueError(f"row {row!r}: kind must be one of {', '.join(KINDS)}")
-    kind = row["kind"]
-    extra = set(row) - KINDS[kind] - {"kind", "step_fs", "hmr_da"}
-    missing = _REQUIRED[kind] - set(row)
-    if extra or missing:
-        raise ValueError(f"row {row!r}: a {kind} row takes {', '.join(sorted(KINDS[kind] | {'step_fs', 'hmr_da'}))}"
-                         + (f"; unknown: {', '.join(sorted(extra))}" if extra else "")
-                         + (f"; missing: {', '.join(sorted(missing))}" if missing else ""))
-    for k, v in row.items():
-        if k not in ("kind", "method") and (isinstance(v, bool) or not float(v) > 0):
-            raise ValueError(f"row {row!r}: {k} must be a positive number, got {v!r}")
-    if kind == "symprk":
-        m = get_method(row["method"])
-        if not m.is_splitting:
-            raise ValueError(f"row {row!r}: {m.name} is a {m.family} method; rigid water runs kick/drift splittings "
-                             f"and compositions only (e.g. verlet, omelyan-2, pefrl)")
-    if "inner_steps" in row and int(row["inner_steps"]) != row["inner_steps"]:
-        raise ValueError(f"row {row!r}: inner_steps must be a whole number")
-    return dict(row, step_fs=float(row["step_fs"]))
-
-
-def _g(x) -> str:
-    return f"{float(x):g}"
-
-
-def label(row: dict) -> str:
-    """e.g. 'verlet 0.5 fs', 'omelyan-2 4 fs SVR 1 ps', 'langevin 4 fs friction 1/ps HMR 3 Da'."""
-    kind, h = row["kind"], _g(row["step_fs"])
-    if kind == "symprk":
-        text = f"{row['method']} {h} fs" + (f" SVR {_g(row['collision_time_ps'])} ps" if "collision_time_ps" in row
-                                            else "")
-    elif kind == "mts-langevin":
-        text = f"mts-langevin {h}/{int(row['inner_steps'])} fs friction {_g(row['friction_per_ps'])}/ps"
-    elif kind == "nose-hoover":
-        text = f"nose-hoover {h} fs {_g(row['collision_frequency_per_ps'])}/ps"
-    else:
-        text = f"{kind} {h} fs friction {_g(row['friction_per_ps'])}/ps"
-    return text + (f" HMR {_g(row['hmr_da'])} Da" if "hmr_da" in row else "")
-
-
-def describe(row: dict) -> dict:
-    """label; ensemble ("NVE" or "NVT"); evals_per_step (force evaluations; MTS: force-group evaluations, one
-    reciprocal-space and inner_steps direct-space); keeps_momentum; heat_bath (a conserved effective energy:
-    NVE's total energy, or total + heat-bath energy); family ("symprk" or "openmm")."""
-    kind = row["kind"]
-    nvt = kind != "symprk" or "collision_time_ps" in row
-    evals = {"symprk": lambda: get_method(row["method"]).force_evals,
-             "mts-langevin": lambda: 1 + int(row["inner_steps"])}.get(kind, lambda: 1)()
-    return {"label": label(row), "ensemble": "NVT" if nvt else "NVE", "evals_per_step": evals,
-            "keeps_momentum": kind not in ("langevin", "mts-langevin"),
-            "effective_energy": kind in ("symprk", "nose-hoover"), "family": "symprk" if kind == "symprk" else "openmm",
-            "hmr": "hmr_da" in row}
-
-
 def _thermostatted(row, system, temperature, seed):
     """The package's thermostatted integrator, or RowUnavailable when the integrator has no thermostat yet."""
-    from ...integrators import SymplecticIntegrator
+    from ....integrators import SymplecticIntegrator
 
     try:
         return SymplecticIntegrator(row["step_fs"] * unit.femtoseconds, row["method"], system=system,
@@ -113,7 +45,7 @@ def make_integrator(row: dict, system: mm.System, temperature: float, seed: int,
     if kind == "symprk":
         if "collision_time_ps" in row:
             return _thermostatted(row, system, temperature, seed)
-        from ...integrators import SymplecticIntegrator
+        from ....integrators import SymplecticIntegrator
 
         return SymplecticIntegrator(h, row["method"], system=system)
     if kind == "langevin":
@@ -193,8 +125,6 @@ class Engine:
 
     def sample(self, velocities: bool = True, energy: bool = True):
         """(x nm, v nm/ps or None, potential energy kJ/mol or None) now."""
-        import numpy as np
-
         st = self.context.getState(getPositions=True, getVelocities=velocities, getEnergy=energy)
         x = np.asarray(st.getPositions(asNumpy=True).value_in_unit(unit.nanometer))
         v = np.asarray(st.getVelocities(asNumpy=True).value_in_unit(unit.nanometer / unit.picosecond)) \
