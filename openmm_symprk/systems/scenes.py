@@ -185,7 +185,8 @@ _G_PER_DA = 1.66053906660e-24
 
 
 def water_box(model: str = "spce", n_waters: int | None = None, cutoff_nm: float = 0.9, box_nm: float | None = None,
-              ewald_tolerance: float | None = None, forcefields=None, density_g_cm3: float | None = WATER_DENSITY_G_CM3):
+              ewald_tolerance: float | None = None, forcefields=None,
+              density_g_cm3: float | None = WATER_DENSITY_G_CM3):
     """A periodic box of rigid waters (SETTLE), PME with ``cutoff_nm``, no CMMotionRemover (so an NVE run conserves
     the total momentum and the translational degrees of freedom are 3 N - 3): ``n_waters`` molecules (default 216),
     or a cubic box of side ``box_nm``.  ``ewald_tolerance``: OpenMM's ewaldErrorTolerance (default 5e-4);

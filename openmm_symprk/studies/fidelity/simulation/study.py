@@ -158,7 +158,8 @@ class FidelityStudy(Study):
             if lab not in self.unavailable:
                 engines[lab] = (row["step_fs"], Engine(self.box, x[0], v[0], row, float(self.cfg["temperature"]),
                                                        replica_seed(self.cfg, 0), self.cfg.get("threads", 1)))
-        steps = {k: max(1, int(round(50.0 / h))) for k, (h, _) in engines.items()}  # 50 fs per block
+        block = float(self.cfg.get("timing_fs", 50.0))
+        steps = {k: max(1, int(round(block / h))) for k, (h, _) in engines.items()}
         res = interleaved({k: e.step for k, (_, e) in engines.items()}, steps, rounds=3)
         self.log(f"timed {len(engines)} rows in turns")
         return {k: tm.best / (engines[k][0] * 1e-3) for k, tm in res.items()}
