@@ -40,7 +40,7 @@ def test_quick_prints_every_observable_for_every_row(quick):
                  "PE/mol", "Trot-Ttr K", "gOO r nm", "gOO height", "drift", "Yeh-Hummer", "cheapest NVE",
                  "issue #4280", "issue #2520", "extrapolated to h -> 0"):
         assert name in text, name
-    for name in ("summary.txt", "results.json", "fidelity.png", "fidelity-wall.png"):
+    for name in ("summary.txt", "equipartition.txt", "results.json", "fidelity.png", "fidelity-wall.png"):
         assert os.path.getsize(os.path.join(out, name)) > 0
     with open(os.path.join(out, "results.json")) as fh:
         res = json.load(fh)
@@ -60,6 +60,24 @@ def test_quick_prints_every_observable_for_every_row(quick):
         assert (r["values"]["drift"] is not None) == has_bath, lab
         assert r["evals_per_ps"] == pytest.approx(describe(r["row"])["evals_per_step"] * 1000 / r["row"]["step_fs"])
         assert r["s_per_ps"] > 0
+
+
+def test_the_equipartition_view_is_made_from_the_same_runs(quick):
+    """symprk equipartition's table (T_rot - T_trans, PE, drift, the Verlet trend) of the fidelity runs of the
+    package's NVE rows: the same replicas, the same numbers as the fidelity table's."""
+    _, out, _ = quick
+    with open(os.path.join(out, "results.json")) as fh:
+        res = json.load(fh)
+    view = res["temperature_view"]["models"]["spce"]
+    fid = {r["label"]: r for r in res["rows"]}
+    assert view["reference"] == "verlet 0.5 fs"
+    assert [r["label"] for r in view["rows"]] == ["verlet 0.5 fs", "verlet 1 fs", "verlet 2 fs", "verlet 3 fs",
+                                                  "omelyan-2 4 fs", "pefrl 4 fs"]
+    for r in view["rows"]:
+        assert r["replicas"] == 2 and r["dT"]["mean"] == pytest.approx(fid[r["label"]]["values"]["dT"]["mean"])
+        assert r["pe"]["mean"] == pytest.approx(fid[r["label"]]["values"]["pe"]["mean"])
+    with open(os.path.join(out, "equipartition.txt")) as fh:
+        assert "Published trend" in fh.read()
 
 
 def test_replica_states_are_at_the_stated_density_with_zero_momentum(quick):

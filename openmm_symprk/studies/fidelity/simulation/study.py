@@ -22,7 +22,7 @@ from ...equipartition.study import STATE_KEYS, STATE_VERSION, replica_state_set
 from ..rowspec import check_row, describe
 from .engines import availability
 
-__all__ = ["FidelityStudy", "run_study", "run_key", "RUN_KEYS", "RUN_VERSION"]
+__all__ = ["FidelityStudy", "run_study", "run_key", "temperature_view", "RUN_KEYS", "RUN_VERSION"]
 
 #: What a run depends on besides its row and replica (the observables are computed in the run: their settings too).
 RUN_KEYS = STATE_KEYS + ("model", "settle_ps", "omega_ps", "omega_fs", "omega_max_lag_ps", "length_ps",
@@ -129,7 +129,13 @@ class FidelityStudy(Study):
             timings = self.timings() if self.timing else {}
         grouped = {k[0]: v for k, v in self.results(runs, ("row",)).items()}
         summary = summarise(self.cfg, self.rows, grouped, timings, self.unavailable, self.box_edge())
+        summary["temperature_view"] = temperature_view(self.cfg, self.rows, grouped, timings)
         write_text(os.path.join(self.out, "summary.txt"), format_summary(summary) + "\n")
+        if summary["temperature_view"]:
+            from ...equipartition.report import format_summary as equipartition_summary
+
+            write_text(os.path.join(self.out, "equipartition.txt"),
+                       equipartition_summary(summary["temperature_view"]) + "\n")
         write_json(os.path.join(self.out, "results.json"), summary)
         try:
             chart(summary, os.path.join(self.out, "fidelity.png"))
@@ -165,9 +171,30 @@ class FidelityStudy(Study):
         return {k: tm.best / (engines[k][0] * 1e-3) for k, tm in res.items()}
 
 
+def temperature_view(cfg: dict, rows: list, grouped: dict, timings: dict) -> dict | None:
+    """The equipartition study's summary (:func:`openmm_symprk.studies.equipartition.report.summarise`: T_rot -
+    T_trans, T_trans, PE per molecule, drift, the published Verlet trend, the cheapest match) of this study's
+    stored runs of the package's NVE rows without HMR: every such run keeps the equipartition study's time
+    series (t, T_trans, T_rot, pe, etot), so the view needs no run of its own.  None without such rows."""
+    from ...equipartition.report import summarise as equipartition_summarise
+
+    nve = [r for r in rows if r["kind"] == "symprk" and describe(r)["ensemble"] == "NVE" and "hmr_da" not in r]
+    if not nve:
+        return None
+    model = cfg["model"]
+    eq_cfg = {k: cfg[k] for k in ("n_waters", "cutoff_nm", "density_g_cm3", "temperature", "settle_ps",
+                                  "length_ps", "sample_fs")}
+    eq_cfg.update(reference=[nve[0]["method"], nve[0]["step_fs"]],
+                  models={model: [[r["method"], r["step_fs"]] for r in nve]})
+    runs = {(model, r["method"], r["step_fs"]): grouped.get(describe(r)["label"], []) for r in nve}
+    eq_timings = {(model, r["method"], r["step_fs"]): timings[describe(r)["label"]] for r in nve
+                  if describe(r)["label"] in timings}
+    return equipartition_summarise(eq_cfg, runs, eq_timings)
+
+
 def run_study(cfg: dict, out: str, workers: int = 2, timing: bool = True, progress: bool = True, log=print,
               scheduler: str | None = None) -> dict:
     """Run (or finish, or only re-summarise) the study in ``out``; returns the summary (:func:`..report.summarise`)
-    and writes ``summary.txt``, ``results.json``, ``fidelity.png`` (bias against force evaluations per ps) and,
+    and writes ``summary.txt``, ``equipartition.txt`` (:func:`temperature_view`), ``results.json``, ``fidelity.png`` (bias against force evaluations per ps) and,
     with timing, ``fidelity-wall.png`` (against wall time per simulated ps) there."""
     return FidelityStudy(cfg, out, workers, timing, progress, log, scheduler).run()
