@@ -110,6 +110,24 @@ def test_a_second_call_reuses_every_run(quick):
     assert {r["label"]: r.get("values") for r in jsonable(again)["rows"]} == first  # the same runs, summarised again
 
 
+def test_an_interrupted_study_runs_only_what_is_missing(quick, tmp_path):
+    """A copy of the finished study with one run lost (as if interrupted before it was stored): a call runs that
+    one alone and stores it under the same key."""
+    import shutil
+
+    _, out, _ = quick
+    copy_ = str(tmp_path / "copy")
+    shutil.copytree(out, copy_, ignore=shutil.ignore_patterns(".lock"))
+    lost = sorted(glob.glob(os.path.join(copy_, "runs", "*.json")))[0]
+    os.remove(lost)
+    os.remove(lost[:-5] + ".npz")
+    logs = []
+    summary = run_study(presets.quick(), copy_, workers=1, timing=False, progress=False, log=logs.append)
+    stored = sum(r["replicas"] for r in summary["rows"])
+    assert any(f"reusing {stored - 1} finished runs" in line for line in logs), logs
+    assert os.path.exists(lost) and len(glob.glob(os.path.join(copy_, "runs", "*.json"))) == stored
+
+
 def test_an_unavailable_thermostat_row_is_reported_not_run(tmp_path, monkeypatch):
     """A SymplecticIntegrator without the thermostat (TypeError on temperature=): the row is planned no run,
     stored nowhere and reported 'unavailable: needs the thermostat'; the other rows run."""
