@@ -10,7 +10,7 @@ from ..physics import centre_of_mass
 from ..physics.temperature import R_KJ
 from .properties import has_constraints, masses
 
-__all__ = ["minimise", "constrain_velocities", "maxwell_boltzmann", "equilibrate", "R_KJ"]
+__all__ = ["minimise", "constrain_velocities", "maxwell_boltzmann", "equilibrate", "without_net_momentum", "R_KJ"]
 
 
 def _context(system, platform="Reference", properties=None):
@@ -65,14 +65,27 @@ def maxwell_boltzmann(system: mm.System, positions, temperature: float, seed: in
     m = masses(system)
     x = _nm(positions)
     kT = R_KJ * temperature
-    v = rng.normal(size=(len(m), 3)) * np.sqrt(kT / np.where(m > 0, m, 1.0))[:, None]
-    v -= (m[:, None] * v).sum(0) / m.sum()
-    v[m == 0] = 0.0  # after the net momentum is taken out (it would give them the centre-of-mass velocity)
+    v = without_net_momentum(rng.normal(size=(len(m), 3)) * np.sqrt(kT / np.where(m > 0, m, 1.0))[:, None], m)
     if angular_velocity is not None:
         spin = np.cross(np.asarray(angular_velocity, dtype=float), x - centre_of_mass(x, m))
         v += np.where(m[:, None] > 0, spin, 0.0)
     v = constrain_velocities(system, x, v)
     v[m == 0] = 0.0  # the momentum correction above moved them too
+    return v
+
+
+def without_net_momentum(velocities, m) -> np.ndarray:
+    """``velocities`` (N, 3) nm/ps less the centre-of-mass velocity P / M of the particles with mass (masses
+    ``m`` (N,) Da, or a System): the total momentum is zero to round-off.  Massless particles stay at rest.
+    Velocity constraints stay satisfied (a uniform translation does not change any relative velocity)."""
+    m = masses(m) if isinstance(m, mm.System) else np.asarray(m, dtype=np.float64)
+    v = np.array(velocities, dtype=np.float64)
+    if v.shape != (len(m), 3):
+        raise ValueError(f"velocities must have shape ({len(m)}, 3) (one per particle), got {v.shape}")
+    if not m.sum() > 0:
+        raise ValueError("no particle has mass: the total momentum cannot be set to zero")
+    v -= (m[:, None] * v).sum(axis=0) / m.sum()
+    v[m == 0] = 0.0
     return v
 
 

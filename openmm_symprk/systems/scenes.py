@@ -178,13 +178,25 @@ def protein_vacuum(constraints=app.HBonds, temperature: float = 300.0, angular_v
 WATER_MODELS = {"spce": ("amber14/spce.xml", "spce"), "tip3p": ("amber14/tip3p.xml", "tip3p")}
 
 
+#: Density of liquid water at 298 K and 1 bar, g/cm^3: the default of :func:`water_box`'s ``n_waters`` boxes.
+WATER_DENSITY_G_CM3 = 0.997
+#: Grams per dalton (1 / Avogadro's number).
+_G_PER_DA = 1.66053906660e-24
+
+
 def water_box(model: str = "spce", n_waters: int | None = None, cutoff_nm: float = 0.9, box_nm: float | None = None,
-              ewald_tolerance: float | None = None, forcefields=None):
+              ewald_tolerance: float | None = None, forcefields=None,
+              density_g_cm3: float | None = WATER_DENSITY_G_CM3):
     """A periodic box of rigid waters (SETTLE), PME with ``cutoff_nm``, no CMMotionRemover (so an NVE run conserves
     the total momentum and the translational degrees of freedom are 3 N - 3): ``n_waters`` molecules (default 216),
     or a cubic box of side ``box_nm``.  ``ewald_tolerance``: OpenMM's ewaldErrorTolerance (default 5e-4);
     ``forcefields``: the force-field files (default the model's own).  The one place a water box is built.
-    Returns (system, topology, positions in nm); positions are Modeller's, not minimised."""
+
+    ``density_g_cm3`` (``n_waters`` boxes): Modeller's ``addSolvent(numAdded=...)`` leaves the box at about
+    0.86 g/cm^3 (216 SPC/E waters), so the molecules' centres of mass and the box are scaled about the origin to
+    this density (default 0.997 g/cm^3, liquid water at 298 K; None keeps Modeller's box).  Molecules keep their
+    shape; a ``box_nm`` box is Modeller's filling of that box, unscaled.
+    Returns (system, topology, positions in nm); positions are not minimised."""
     if model not in WATER_MODELS:
         raise ValueError(f"unknown water model {model!r}; known: {', '.join(WATER_MODELS)}")
     if box_nm is not None and n_waters is not None:
@@ -193,6 +205,9 @@ def water_box(model: str = "spce", n_waters: int | None = None, cutoff_nm: float
         n_waters = 216
     if n_waters is not None and (isinstance(n_waters, bool) or int(n_waters) < 2):
         raise ValueError(f"n_waters must be >= 2, got {n_waters!r}")
+    if density_g_cm3 is not None and (isinstance(density_g_cm3, bool) or not 0 < float(density_g_cm3) < 10):
+        raise ValueError(f"density_g_cm3 must be a density in g/cm^3 between 0 and 10 (e.g. 0.997), or None for "
+                         f"Modeller's own box, got {density_g_cm3!r}")
     ffname, name = WATER_MODELS[model]
     ff = app.ForceField(*(forcefields or (ffname,)))
     mod = app.Modeller(app.Topology(), [])
@@ -200,6 +215,9 @@ def water_box(model: str = "spce", n_waters: int | None = None, cutoff_nm: float
         mod.addSolvent(ff, model=name, boxSize=mm.Vec3(box_nm, box_nm, box_nm) * unit.nanometer)
     else:
         mod.addSolvent(ff, model=name, numAdded=int(n_waters))
+    positions = np.array(mod.positions.value_in_unit(unit.nanometer))
+    if box_nm is None and density_g_cm3 is not None:
+        positions = _scale_to_density(mod.topology, positions, float(density_g_cm3))
     box = min(mod.topology.getUnitCellDimensions().value_in_unit(unit.nanometer))
     if not 2 * cutoff_nm <= box:
         raise ValueError(f"cutoff {cutoff_nm} nm needs a box at least {2 * cutoff_nm} nm wide; "
@@ -208,4 +226,19 @@ def water_box(model: str = "spce", n_waters: int | None = None, cutoff_nm: float
     extra = {} if ewald_tolerance is None else {"ewaldErrorTolerance": ewald_tolerance}
     system = ff.createSystem(mod.topology, nonbondedMethod=app.PME, nonbondedCutoff=cutoff_nm * unit.nanometer,
                              constraints=app.HBonds, rigidWater=True, removeCMMotion=False, **extra)
-    return system, mod.topology, np.array(mod.positions.value_in_unit(unit.nanometer))
+    return system, mod.topology, positions
+
+
+def _scale_to_density(topology, positions, density_g_cm3):
+    """Scale the cubic box of ``topology`` (set in place) and the residues' centres of mass in ``positions``
+    about the origin so that the box's density is ``density_g_cm3``; returns the new positions (nm)."""
+    mass = np.array([a.element.mass.value_in_unit(unit.dalton) for a in topology.atoms()])
+    edge = float((mass.sum() * _G_PER_DA / density_g_cm3 * 1e21) ** (1.0 / 3.0))  # 1 cm^3 = 1e21 nm^3
+    scale = edge / float(topology.getUnitCellDimensions().value_in_unit(unit.nanometer)[0])
+    out = positions.copy()
+    for res in topology.residues():
+        idx = [a.index for a in res.atoms()]
+        com = (mass[idx, None] * positions[idx]).sum(axis=0) / mass[idx].sum()
+        out[idx] += (scale - 1.0) * com
+    topology.setUnitCellDimensions(mm.Vec3(edge, edge, edge) * unit.nanometer)
+    return out

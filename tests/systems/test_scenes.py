@@ -3,6 +3,7 @@ spun about the centre of mass, reproducible from its seed) and water_box (period
 CMMotionRemover)."""
 import numpy as np
 import openmm as mm
+import openmm.unit as unit
 import pytest
 
 from openmm_symprk.physics.momenta import angular_momentum, inertia_tensor, linear_momentum
@@ -111,3 +112,47 @@ def test_water_box_refuses_bad_input(kwargs, message):
 
     with pytest.raises(ValueError, match=message):
         water_box(**kwargs)
+
+
+def _density(system):
+    from openmm_symprk.systems.properties import masses
+
+    edge = system.getDefaultPeriodicBoxVectors()[0][0].value_in_unit(unit.nanometer)
+    return masses(system).sum() * 1.66053906660e-24 / (edge ** 3 * 1e-21)
+
+
+def test_water_box_is_at_the_stated_density_with_whole_molecules():
+    """Modeller's addSolvent(numAdded=...) leaves 216 SPC/E waters at 0.864 g/cm^3; the box is scaled to 0.997
+    (or the density asked for) by moving the molecules' centres: each molecule keeps its shape."""
+    from openmm_symprk.systems.scenes import water_box
+
+    loose, _, x0 = water_box("spce", 216, 0.9, density_g_cm3=None)
+    assert _density(loose) == pytest.approx(0.864, abs=0.002)
+    system, topology, x = water_box("spce", 216, 0.9)
+    assert _density(system) == pytest.approx(0.997, rel=1e-6)
+    edge = system.getDefaultPeriodicBoxVectors()[0][0].value_in_unit(unit.nanometer)
+    assert topology.getUnitCellDimensions()[0].value_in_unit(unit.nanometer) == pytest.approx(edge)
+    mol = np.arange(len(x)).reshape(-1, 3)
+    for a, b in ((0, 1), (0, 2), (1, 2)):  # O-H, O-H, H-H distances unchanged
+        np.testing.assert_allclose(np.linalg.norm(x[mol[:, a]] - x[mol[:, b]], axis=1),
+                                   np.linalg.norm(x0[mol[:, a]] - x0[mol[:, b]], axis=1), atol=1e-12)
+    dense, _, _ = water_box("tip3p", 64, 0.55, density_g_cm3=1.2)
+    assert _density(dense) == pytest.approx(1.2, rel=1e-6)
+    with pytest.raises(ValueError, match="density_g_cm3 must be a density in g/cm.3 .* got -1"):
+        water_box("spce", 64, 0.55, density_g_cm3=-1)
+    with pytest.raises(ValueError, match="cutoff 0.7 nm needs a box at least 1.4 nm wide; 64 waters give 1.243"):
+        water_box("spce", 64, 0.7)
+
+
+def test_velocities_without_net_momentum():
+    from openmm_symprk.systems.prepare import without_net_momentum
+
+    rng = np.random.default_rng(4)
+    m = np.array([16.0, 1.0, 1.0, 0.0, 12.0])
+    v = rng.normal(size=(5, 3)) + 0.3
+    out = without_net_momentum(v, m)
+    np.testing.assert_allclose((m[:, None] * out).sum(axis=0), 0.0, atol=1e-13)
+    np.testing.assert_allclose(out[:3] - out[0], v[:3] - v[0], atol=1e-14)  # relative velocities kept
+    assert not out[3].any()  # massless: at rest
+    with pytest.raises(ValueError, match="shape \\(5, 3\\)"):
+        without_net_momentum(v[:4], m)

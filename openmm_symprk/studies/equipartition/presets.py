@@ -14,11 +14,11 @@ RIGID_PREFIX = "rigid:"
 
 
 def full() -> dict:
-    """The study as reported in docs/equipartition.md: 216 waters (the smallest cubic box that fits a 0.9 nm
-    PME cutoff), 4 replicas 5 ps apart after 20 ps of Langevin equilibration, 2 ps of NVE to settle, then
+    """The study as reported in docs/equipartition.md: 216 waters at 0.997 g/cm^3 (a 1.864-nm box, the smallest
+    cubic box that fits a 0.9 nm PME cutoff), 4 replicas 5 ps apart after 20 ps of Langevin equilibration, 2 ps of NVE to settle, then
     20 ps of NVE measured every 24 fs.  About an hour on 2 cores."""
     return {
-        "n_waters": 216, "cutoff_nm": 0.9, "temperature": 300.0, "seed": 2024,
+        "n_waters": 216, "cutoff_nm": 0.9, "density_g_cm3": 0.997, "temperature": 300.0, "seed": 2024,
         "equilibrate_ps": 20.0, "spacing_ps": 5.0, "replicas": 4,
         "settle_ps": 2.0, "length_ps": 20.0, "sample_fs": 24.0, "threads": 1,
         "reference": ["verlet", 0.5],

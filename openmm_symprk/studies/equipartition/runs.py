@@ -17,9 +17,9 @@ from ...methods.catalogue import get_method
 from ...physics.momenta import kinetic_energy
 from ...physics.temperature import kinetic_temperatures
 from ...rigid.bodies import RigidBodies
-from ...systems.prepare import equilibrate, minimise
+from ...systems.prepare import equilibrate, minimise, without_net_momentum
 from ...systems.scene import Scene
-from ...systems.scenes import water_box
+from ...systems.scenes import WATER_DENSITY_G_CM3, water_box
 from .presets import RIGID_PREFIX
 
 __all__ = ["build_box", "replica_states", "run_nve", "steps_per_sample", "force_evals_per_step", "make_engine"]
@@ -28,7 +28,8 @@ __all__ = ["build_box", "replica_states", "run_nve", "steps_per_sample", "force_
 def build_box(cfg: dict, model: str) -> Scene:
     """The study's water box for one model (:func:`openmm_symprk.systems.scenes.water_box`) as a Scene whose
     ``meta["model"]`` names the model; its state is Modeller's (see :func:`replica_states`)."""
-    system, topology, x = water_box(model, cfg["n_waters"], cfg["cutoff_nm"])
+    system, topology, x = water_box(model, cfg["n_waters"], cfg["cutoff_nm"],
+                                    density_g_cm3=cfg.get("density_g_cm3", WATER_DENSITY_G_CM3))
     return Scene(f"water-box-{model}", system, x, np.zeros_like(x), f"{cfg['n_waters']} rigid {model} waters, PME",
                  topology, purpose="production", platform="CPU", invariants=("energy", "momentum"),
                  temperature=float(cfg["temperature"]), meta={"model": model})
@@ -36,8 +37,11 @@ def build_box(cfg: dict, model: str) -> Scene:
 
 def replica_states(box: Scene, cfg: dict, log=print, start=None):
     """(x, v) arrays of shape (replicas, N, 3): minimise, Langevin ``equilibrate_ps`` at ``temperature``,
-    then one state every ``spacing_ps`` of further Langevin dynamics (replica r with seed ``seed + r``).
-    ``start``: the (x, v) arrays of replicas already built, which the chain continues from."""
+    then one state every ``spacing_ps`` of further Langevin dynamics (replica r with seed ``seed + r``).  Each
+    state's total momentum is set to zero (Langevin dynamics without a CMMotionRemover leaves the box drifting
+    as a whole, ~0.04 nm/ps for 216 waters, which NVE keeps and which biases a diffusion coefficient); the
+    chain itself continues from the Langevin state.  ``start``: the (x, v) arrays of replicas already built,
+    which the chain continues from."""
     platform, props = "CPU", {"Threads": str(cfg.get("threads", 1))}
     t0 = time.perf_counter()
     seed = int(cfg["seed"])
@@ -46,7 +50,7 @@ def replica_states(box: Scene, cfg: dict, log=print, start=None):
         x = minimise(box.system, box.positions, platform=platform, properties=props, max_iterations=500)
         x, v = equilibrate(box.system, x, cfg["temperature"], cfg["equilibrate_ps"], seed, platform=platform,
                            properties=props)
-        xs, vs = [x], [v]
+        xs, vs = [x], [without_net_momentum(v, box.masses())]
     else:
         xs, vs = list(start[0]), list(start[1])
         x, v = xs[-1], vs[-1]
@@ -54,7 +58,7 @@ def replica_states(box: Scene, cfg: dict, log=print, start=None):
         x, v = equilibrate(box.system, x, cfg["temperature"], cfg["spacing_ps"], seed + r, platform=platform,
                            properties=props)
         xs.append(x)
-        vs.append(v)
+        vs.append(without_net_momentum(v, box.masses()))
     log(f"{box.meta['model']}: {len(box.molecules)} waters, {len(xs)} replica states ({cfg['equilibrate_ps']} + "
         f"{cfg['spacing_ps']} ps apart of Langevin dynamics; {len(xs) - n_old} new, "
         f"{time.perf_counter() - t0:.0f} s)")

@@ -18,17 +18,23 @@ import numpy as np
 from ..core import Run, Study, run_key as hash_key, write_json, write_npz, write_text
 from .report import summarise
 
-__all__ = ["run_study", "run_key", "load_runs", "EquipartitionStudy"]
+__all__ = ["run_study", "run_key", "state_key", "replica_state_set", "load_runs", "EquipartitionStudy"]
 
 #: What a replica state depends on.  Not the number of replicas: replica r is the same state whatever that number,
 #: so a study asked for more replicas later extends the chain and reuses every finished run.
-_STATE_KEYS = ("n_waters", "cutoff_nm", "temperature", "seed", "equilibrate_ps", "spacing_ps", "threads")
-_RUN_KEYS = _STATE_KEYS + ("settle_ps", "length_ps", "sample_fs")
+STATE_KEYS = ("n_waters", "cutoff_nm", "density_g_cm3", "temperature", "seed", "equilibrate_ps", "spacing_ps",
+              "threads")
+_RUN_KEYS = STATE_KEYS + ("settle_ps", "length_ps", "sample_fs")
 
-#: Version of what a run stores (2: T_trans without the kinetic energy of the box's centre of mass); a run
-#: stored by another version is never reused.  The error bars are computed at summary time from the stored
-#: series, so a change of estimator needs no new version: calling the study again re-summarises.
-RUN_VERSION = 2
+#: Version of the replica states (2: the box at a stated density, 0.997 g/cm^3, instead of Modeller's 0.864, and
+#: each state's total momentum zero).
+STATE_VERSION = 2
+
+#: Version of what a run stores (2: T_trans without the kinetic energy of the box's centre of mass; 3: the
+#: states of STATE_VERSION 2); a run stored by another version is never reused.  The error bars are computed at
+#: summary time from the stored series, so a change of estimator needs no new version: calling the study again
+#: re-summarises.
+RUN_VERSION = 3
 
 
 def run_key(cfg: dict, model: str, method: str, step_fs: float, replica: int) -> str:
@@ -36,11 +42,18 @@ def run_key(cfg: dict, model: str, method: str, step_fs: float, replica: int) ->
                      "replica": int(replica), "version": RUN_VERSION})
 
 
-def _states(cfg, model, out, log):
-    """The model's replica states (at least ``cfg["replicas"]``), built or extended and kept in ``<out>/states``."""
+def state_key(cfg: dict) -> str:
+    """The key of a model's replica states: what they depend on (not the number of replicas)."""
+    return hash_key({"cfg": {k: cfg[k] for k in STATE_KEYS}, "version": STATE_VERSION})
+
+
+def replica_state_set(cfg: dict, model: str, out: str, log=print):
+    """The model's replica states (x, v), at least ``cfg["replicas"]`` of them, built or extended and kept in
+    ``<out>/states/<model>-<key>.npz``: every study of rigid water boxes (equipartition, fidelity) with the
+    same state settings starts from these same states."""
     from .runs import build_box, replica_states
 
-    path = os.path.join(out, "states", f"{model}-{hash_key({k: cfg[k] for k in _STATE_KEYS})}.npz")
+    path = os.path.join(out, "states", f"{model}-{state_key(cfg)}.npz")
     start = None
     if os.path.exists(path):
         with np.load(path) as d:
@@ -131,7 +144,7 @@ class EquipartitionStudy(Study):
 
     def plan(self) -> list:
         cfg = self.cfg
-        self.states = {model: _states(cfg, model, self.out, self.log) for model in cfg["models"]}
+        self.states = {model: replica_state_set(cfg, model, self.out, self.log) for model in cfg["models"]}
         runs = []
         for model, rows in cfg["models"].items():
             for method, h in rows:

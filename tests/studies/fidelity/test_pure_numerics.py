@@ -1,4 +1,5 @@
-"""The fidelity observables are pure numerics: no module of studies/fidelity imports OpenMM."""
+"""The fidelity observables are pure numerics: no module directly in studies/fidelity (the observables, the rows'
+description, the report) imports OpenMM; the study's OpenMM side is the sub-package studies/fidelity/simulation."""
 import ast
 import os
 

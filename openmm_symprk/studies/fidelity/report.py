@@ -1,0 +1,317 @@
+"""Summary, verdicts and chart of the fidelity study (numpy; matplotlib for the chart only).
+
+Per row and observable (:data:`.observe.OBSERVABLES`): the mean over replicas with the larger of the within- and
+between-replica standard errors (:func:`openmm_symprk.stats.combine`); the bias against the reference row
+(Verlet 0.5 fs NVE), replica by replica (:func:`openmm_symprk.stats.paired`: every row starts from the same
+replica states); and the bias against a second reference, Verlet extrapolated to h -> 0: for each replica and
+observable, a + b h^2 fitted to that replica's Verlet NVE rows (:func:`.extrapolation.extrapolate_h2`, weights
+from their errors), the row paired with the a's.  A row *matches* the reference when none of the compared
+observables (all but T_trans) differs from it beyond ``K_SE`` = 3 paired standard errors; with 13 observables,
+a row equal to the reference fails that by chance about 3% of the time (2 SE: 49%).  Effects are claimed at
+3 SE too; below that they are "not resolved".
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ...stats import combine, paired
+from ...support import require
+from .diffusion import VISCOSITY_MPAS, yeh_hummer
+from .extrapolation import extrapolate_h2
+from .observe import OBSERVABLES
+from .rowspec import describe
+
+__all__ = ["K_SE", "MATCHED", "summarise", "format_summary", "chart", "claim"]
+
+#: Standard errors beyond which a difference counts.
+K_SE = 3.0
+#: Observables a row must match (T_trans is reported, not matched: it is a thermostat's target, not a result).
+MATCHED = tuple(k for k, _, _ in OBSERVABLES if k != "T_trans")
+#: Number formats of the tables.
+FORMAT = {"D": ".2f", "tau1_dip": ".2f", "tau2_dip": ".3f", "tau1_hh": ".2f", "tau2_hh": ".3f", "w_zero": ".2f",
+          "w_min": ".3f", "w_int": ".2f", "pe": ".3f", "dT": ".2f", "T_trans": ".1f", "g_r": ".4f", "g_h": ".3f",
+          "drift": ".4f"}
+
+
+def _per_replica(reps, key) -> dict:
+    """{replica: (value, se)} of the finished replicas that have ``key``."""
+    out = {}
+    for _, info in reps:
+        val = (info.get("obs") or {}).get(key)
+        if val is None or val[0] is None or not np.isfinite(val[0]):
+            continue
+        se = val[1] if val[1] is not None and np.isfinite(val[1]) else 0.0
+        out[int(info["replica"])] = (float(val[0]), float(se))
+    return out
+
+
+def _combined(per: dict):
+    if not per:
+        return None
+    rs = sorted(per)
+    return combine([per[r][0] for r in rs], [per[r][1] for r in rs])
+
+
+def _paired(a: dict, b: dict):
+    e = paired(a, b) if a and b else None
+    return None if e is None or not (e.se > 0 or e.mean != 0) else e
+
+
+def _is_verlet_nve(row) -> bool:
+    return row["kind"] == "symprk" and row.get("method") == "verlet" and describe(row)["ensemble"] == "NVE" \
+        and "hmr_da" not in row
+
+
+def _extrapolated(rows, per) -> tuple:
+    """({key: {replica: (a, a_se)}} per replica, {key: fit of the rows' combined values}) of the Verlet NVE rows."""
+    verlet = [(r["step_fs"], describe(r)["label"]) for r in rows if _is_verlet_nve(r) and describe(r)["label"] in per]
+    by_rep, fits = {}, {}
+    for key, _, _ in OBSERVABLES:
+        reps = {}
+        replicas = sorted(set().union(*(per[lab][key].keys() for _, lab in verlet))) if verlet else []
+        for rep in replicas:
+            pts = [(h, *per[lab][key][rep]) for h, lab in verlet if rep in per[lab][key]]
+            if len({h for h, _, _ in pts}) < 2 or any(not se > 0 for _, _, se in pts):
+                continue
+            fit = extrapolate_h2(*zip(*pts))
+            reps[rep] = (fit.a, fit.a_se)
+        by_rep[key] = reps
+        pts = [(h, e.mean, e.se) for h, lab in verlet for e in [_combined(per[lab][key])] if e is not None and e.se > 0]
+        if len({h for h, _, _ in pts}) >= 2:
+            f = extrapolate_h2(*zip(*pts))
+            fits[key] = {"a": f.a, "a_se": f.a_se, "b": f.b, "b_se": f.b_se, "chi2_red": f.chi2_red, "dof": f.dof,
+                         "steps_fs": [h for h, _, _ in pts]}
+    return by_rep, fits
+
+
+def claim(per: dict, a: str, b: str, published: float, what: str) -> dict:
+    """D of row ``a`` against row ``b`` (paired by replica), relative to b's D, against the ``published``
+    relative difference: the verdict at K_SE standard errors."""
+    if a not in per or b not in per:
+        return {"text": f"{what}: not run (rows {a!r} and {b!r} needed)", "reproduced": None}
+    e = _paired(per[a]["D"], per[b]["D"])
+    base = _combined(per[b]["D"])
+    if e is None or base is None or not base.mean > 0:
+        return {"text": f"{what}: no paired replicas yet", "reproduced": None}
+    rel, rel_se = e.mean / base.mean, e.se / base.mean
+    z = e.mean / e.se if e.se > 0 else float("inf") * np.sign(e.mean)
+    if abs(z) < K_SE:
+        verdict, reproduced = f"not resolved (|difference| < {K_SE:g} SE)", None
+    elif np.sign(z) == np.sign(published):
+        verdict, reproduced = "reproduced in direction", True
+    else:
+        verdict, reproduced = "contradicted (the opposite sign)", False
+    consistent = abs(rel - published) <= K_SE * rel_se
+    return {"a": a, "b": b, "diff": e.as_dict(), "relative": rel, "relative_se": rel_se, "z": z,
+            "published": published, "reproduced": reproduced, "consistent_with_published": bool(consistent),
+            "text": (f"{what}: D({a}) - D({b}) = {e.mean:+.3f} ± {e.se:.3f} x 1e-5 cm^2/s paired over {e.replicas} "
+                     f"replicas, {100 * rel:+.1f} ± {100 * rel_se:.1f}% ({z:+.1f} SE; "
+                     f"published {100 * published:+.0f}%"
+                     f", {'within' if consistent else 'beyond'} {K_SE:g} SE of it): {verdict}")}
+
+
+def summarise(cfg: dict, rows: list, grouped: dict, timings: dict | None = None, unavailable: dict | None = None,
+              box_nm: float | None = None) -> dict:
+    """The study's results from its finished runs (``grouped``: {row label: [(arrays, info) per replica]}),
+    timings ({label: wall seconds per simulated ps}) and unavailable rows ({label: why})."""
+    timings, unavailable = timings or {}, unavailable or {}
+    ref_label = describe(rows[0])["label"]
+    yh = yeh_hummer(box_nm, cfg["temperature"], VISCOSITY_MPAS[cfg["model"]]) if box_nm else None
+    table, per = [], {}
+    for row in rows:
+        d = describe(row)
+        lab = d["label"]
+        entry = {"label": lab, "row": row, "ensemble": d["ensemble"], "family": d["family"], "hmr": d["hmr"],
+                 "evals_per_ps": d["evals_per_step"] * 1000.0 / row["step_fs"], "s_per_ps": timings.get(lab),
+                 "status": unavailable.get(lab, "ok"), "replicas": 0, "failed": []}
+        table.append(entry)
+        if lab in unavailable:
+            continue
+        reps = grouped.get(lab, [])
+        good = [(a, i) for a, i in reps if i.get("status") == "ok"]
+        entry["failed"] = [i["status"] for _, i in reps if i.get("status") != "ok"]
+        entry["replicas"] = len(good)
+        if not good:
+            continue
+        per[lab] = {k: _per_replica(good, k) for k, _, _ in OBSERVABLES}
+        entry["values"] = {k: (lambda e: e.as_dict() if e else None)(_combined(per[lab][k])) for k, _, _ in OBSERVABLES}
+        notes = {}
+        for _, info in good:
+            for k, why in (info.get("notes") or {}).items():
+                notes.setdefault(k, why)
+        entry["notes"] = notes
+        if entry["values"]["D"] and yh is not None:
+            entry["D_yeh_hummer"] = entry["values"]["D"]["mean"] + yh
+    extrap, fits = _extrapolated(rows, per)
+    ref = per.get(ref_label)
+    for entry in table:
+        mine = per.get(entry["label"])
+        if mine is None:
+            continue
+        entry["vs_ref"], entry["vs_extrapolated"] = {}, {}
+        for k, _, _ in OBSERVABLES:
+            e = _paired(mine[k], ref[k]) if ref and entry["label"] != ref_label else None
+            entry["vs_ref"][k] = e.as_dict() if e else None
+            e = _paired(mine[k], extrap.get(k, {}))
+            entry["vs_extrapolated"][k] = e.as_dict() if e else None
+        z = {k: abs(v["mean"]) / v["se"] for k in MATCHED for v in [entry["vs_ref"][k]] if v and v["se"] > 0}
+        entry["max_z"] = max(z.values()) if z else None
+        entry["differs"] = sorted(k for k, zz in z.items() if zz > K_SE)
+        entry["matches_ref"] = bool(z) and not entry["differs"] and not entry["failed"]
+    ref_entry = next(e for e in table if e["label"] == ref_label)
+    ref_s = ref_entry["s_per_ps"]
+    for entry in table:
+        entry["evals_vs_ref"] = entry["evals_per_ps"] / ref_entry["evals_per_ps"]
+        entry["wall_vs_ref"] = entry["s_per_ps"] / ref_s if entry["s_per_ps"] and ref_s else None
+    cheapest = {}
+    for ens in ("NVE", "NVT"):
+        cands = [e for e in table if e["ensemble"] == ens and e.get("matches_ref") and e["label"] != ref_label]
+        best = min(cands, key=lambda e: (e["evals_per_ps"], e["s_per_ps"] or float("inf"))) if cands else None
+        cheapest[ens] = None if best is None else {k: best[k] for k in ("label", "evals_vs_ref", "wall_vs_ref",
+                                                                         "max_z")}
+    labels = {describe(r)["label"]: r for r in rows}
+    lang = {r.get("friction_per_ps"): lab for lab, r in labels.items()
+            if r["kind"] == "langevin" and r["step_fs"] == 2.0 and "hmr_da" not in r}
+    mts = next((lab for lab, r in labels.items() if r["kind"] == "mts-langevin"), None)
+    claims = {
+        "langevin_friction": claim(per, lang.get(1.0, "langevin 2 fs friction 1/ps"),
+                                   lang.get(0.1, "langevin 2 fs friction 0.1/ps"), (4.7 - 5.4) / 5.4,
+                                   "Langevin friction 1/ps against 0.1/ps (OpenMM issue #4280: 4.7 against 5.4)"),
+        # against Langevin at the same friction and temperature: against the NVE reference the comparison
+        # would mix in the NVE replicas' own temperatures (D follows T: ~2-3% per kelvin)
+        "baoab_respa": claim(per, mts or "mts-langevin", lang.get(1.0, "langevin 2 fs friction 1/ps"), -0.06,
+                             "BAOAB-RESPA 3 fs (MTSLangevinIntegrator) against LangevinMiddle 2 fs, friction 1/ps "
+                             "(OpenMM issue #2520: 6% low)"),
+    }
+    resolution = {}
+    for k, _, _ in OBSERVABLES:
+        ses = [e["vs_ref"][k]["se"] for e in table if e.get("vs_ref", {}).get(k)]
+        resolution[k] = K_SE * float(np.median(ses)) if ses else None
+    return {"config": cfg, "reference": ref_label, "rows": table, "extrapolated": fits, "yeh_hummer": yh,
+            "box_nm": box_nm, "cheapest": cheapest, "claims": claims, "resolution": resolution, "k_se": K_SE}
+
+
+def _pm(d, spec) -> str:
+    if not d:
+        return "-"
+    return f"{format(d['mean'], spec)}±{format(d['se'], spec)}"
+
+
+_SHORT = {"D": "D", "tau1_dip": "tau1 dip ps", "tau2_dip": "tau2 dip ps", "tau1_hh": "tau1 HH ps",
+          "tau2_hh": "tau2 HH ps", "w_zero": "w0 fs", "w_min": "w Cmin", "w_int": "w int fs", "pe": "PE/mol",
+          "dT": "Trot-Ttr K", "T_trans": "T_trans K", "g_r": "gOO r nm", "g_h": "gOO height", "drift": "drift"}
+
+
+def _table(summary, field, title, extra=True) -> list:
+    w = 18
+    head = f"{'row':36s} {'n':>2s} " + " ".join(f"{_SHORT[k]:>{w}s}" for k, _, _ in OBSERVABLES)
+    if extra:
+        head += f" {'evals/ps':>8s} {'wall/ref':>8s} {'max z':>5s} match"
+    lines = [title, head]
+    for e in summary["rows"]:
+        if e["status"] != "ok" or not e["replicas"]:
+            why = e["status"] if e["status"] != "ok" else (e["failed"][0] if e["failed"] else "no finished runs")
+            lines.append(f"{e['label']:36s} {why}")
+            continue
+        vals = e.get(field) or {}
+        line = f"{e['label']:36s} {e['replicas']:2d} " + " ".join(f"{_pm(vals.get(k), FORMAT[k]):>{w}s}"
+                                                                  for k, _, _ in OBSERVABLES)
+        if extra:
+            wr = f"{e['wall_vs_ref']:.2f}" if e["wall_vs_ref"] else "-"
+            mark = "ref" if e["label"] == summary["reference"] else ("yes" if e["matches_ref"] else "no")
+            z = f"{e['max_z']:.1f}" if e.get("max_z") is not None else "-"
+            line += f" {e['evals_per_ps']:8.0f} {wr:>8s} {z:>5s} {mark}"
+            if e["failed"]:
+                line += f" ({len(e['failed'])} failed: {e['failed'][0]})"
+        lines.append(line)
+    return lines
+
+
+def format_summary(summary: dict) -> str:
+    cfg = summary["config"]
+    lines = [f"Fidelity of dynamics: {cfg['n_waters']} rigid {cfg['model']} waters at {cfg['density_g_cm3']} g/cm^3 "
+             f"(box {summary['box_nm'] or float('nan'):.3f} nm), PME {cfg['cutoff_nm']} nm, {cfg['temperature']:g} K; "
+             f"per run {cfg['settle_ps']:g} ps settling, {cfg['omega_ps']:g} ps of frames every <= "
+             f"{cfg['omega_fs']:g} fs "
+             f"(omega), {cfg['length_ps']:g} ps of frames every {cfg['sample_fs']:g} fs; mean ± SE over replicas.",
+             "Units: D 1e-5 cm^2/s (uncorrected for the box; Yeh-Hummer adds "
+             + (f"{summary['yeh_hummer']:.3f}" if summary["yeh_hummer"] else "-")
+             + "), omega ACF: first zero and integral in fs, value at the first minimum; PE kJ/mol per molecule; "
+               "drift kT/ns/dof of the (effective) energy; '-': not measured or not applicable.", ""]
+    lines += _table(summary, "values", "Values", extra=False)
+    lines.append("")
+    lines += _table(summary, "vs_ref", f"Bias against the reference ({summary['reference']}), paired by replica; "
+                                       f"match: no observable beyond {summary['k_se']:g} SE")
+    lines.append("")
+    lines += _table(summary, "vs_extrapolated", "Bias against Verlet extrapolated to h -> 0 (a + b h^2 per replica), "
+                                                "paired by replica", extra=False)
+    fits = summary["extrapolated"]
+    if fits:
+        lines.append("Verlet extrapolated to h -> 0 (fit of the rows' means): " + "; ".join(
+            f"{_SHORT[k]} {format(f['a'], FORMAT[k])}±{format(f['a_se'], FORMAT[k])}"
+            + (f" (chi2/dof {f['chi2_red']:.1f})" if f["dof"] > 0 else "") for k, f in fits.items()))
+    lines.append("")
+    yh = summary["yeh_hummer"]
+    for e in summary["rows"]:
+        if e.get("D_yeh_hummer") is not None and e["label"] == summary["reference"]:
+            lines.append(f"D of the reference with the Yeh-Hummer correction (literature comparison): "
+                         f"{e['D_yeh_hummer']:.2f} ± {e['values']['D']['se']:.2f} x 1e-5 cm^2/s (+{yh:.3f})")
+    for ens, c in summary["cheapest"].items():
+        if c:
+            wall = f", {c['wall_vs_ref']:.2f}x its wall time" if c["wall_vs_ref"] else ""
+            lines.append(f"cheapest {ens} configuration matching {summary['reference']} in every observable: "
+                         f"{c['label']} ({c['evals_vs_ref']:.2f}x the force evaluations{wall}; largest difference "
+                         f"{c['max_z']:.1f} SE)")
+        else:
+            lines.append(f"no {ens} configuration matches {summary['reference']} in every observable")
+    res = summary["resolution"]
+    lines.append("resolved at 3 SE (median paired error x 3): " + "; ".join(
+        f"{_SHORT[k]} {format(v, FORMAT[k])}" for k, v in res.items() if v is not None))
+    for c in summary["claims"].values():
+        lines.append(c["text"])
+    notes = {}
+    for e in summary["rows"]:
+        for k, why in (e.get("notes") or {}).items():
+            notes.setdefault(k, (why, []))[1].append(e["label"])
+    for k, (why, where) in notes.items():
+        lines.append(f"{_SHORT[k]} not measured in {len(where)} row(s) ({', '.join(where[:3])}"
+                     f"{', ...' if len(where) > 3 else ''}), e.g.: {why}")
+    return "\n".join(lines)
+
+
+def chart(summary: dict, path: str, x: str = "evals_per_ps"):
+    """One panel per observable: the bias against the reference (paired, error bars ± 3 SE) against the cost
+    ``x`` ("evals_per_ps" or "s_per_ps"; rows of equal cost drawn side by side); the package's NVE rows blue, its thermostatted rows green, OpenMM's
+    integrators orange, HMR rows hollow."""
+    require("matplotlib", "studies", "openmm_symprk.studies.fidelity.report.chart").use("Agg")
+    plt = require("matplotlib.pyplot", "studies", "openmm_symprk.studies.fidelity.report.chart")
+
+    fig, axes = plt.subplots(4, 4, figsize=(18, 15))
+    axes = axes.ravel()
+    markers = "osD^v<>phH*Xd8P"
+    rows = [e for e in summary["rows"] if e.get("vs_ref") and e[x] and e["label"] != summary["reference"]]
+    for i, e in enumerate(rows):
+        colour = "tab:orange" if e["family"] == "openmm" else ("tab:green" if e["ensemble"] == "NVT" else "tab:blue")
+        style = dict(marker=markers[i % len(markers)], color=colour, mfc="none" if e["hmr"] else colour,
+                     linestyle="none", capsize=3, label=e["label"])
+        for ax, (k, what, unit_) in zip(axes, OBSERVABLES):
+            d = e["vs_ref"].get(k)
+            if d:
+                # rows of one cost side by side: spread by up to +-12% along the (log) cost axis
+                ax.errorbar([e[x] * 1.04 ** (i % 7 - 3)], [d["mean"]], [K_SE * d["se"]], **style)
+    for ax, (k, what, unit_) in zip(axes, OBSERVABLES):
+        ax.axhline(0.0, color="grey", lw=0.7)
+        ax.set_xscale("log")
+        ax.set_title(f"{what}" + (f" ({unit_})" if unit_ else ""), fontsize=9)
+        ax.grid(alpha=0.3)
+    handles, labels = axes[0].get_legend_handles_labels()
+    for ax in axes[len(OBSERVABLES):]:
+        ax.axis("off")
+    axes[-1].legend(handles, labels, fontsize=7, loc="center")
+    xlabel = "force evaluations per ps" if x == "evals_per_ps" else "wall seconds per simulated ps"
+    for ax in axes[:len(OBSERVABLES)]:
+        ax.set_xlabel(xlabel, fontsize=8)
+    fig.suptitle(f"Bias against {summary['reference']} (paired by replica, error bars ± {K_SE:g} SE) against cost")
+    fig.tight_layout()
+    fig.savefig(path, dpi=90)
+    plt.close(fig)

@@ -1,0 +1,101 @@
+"""One fidelity run (the OpenMM side): a row from a replica state, its frames, its observables.
+
+A run settles for ``settle_ps``, stores positions and velocities every ``omega_fs`` (rounded to whole steps,
+at most the step itself) for ``omega_ps`` (the angular velocities, whose correlation lives within 0.1 ps),
+then samples every ``sample_fs`` for ``length_ps``: the kinetic temperatures (:mod:`openmm_symprk.physics.temperature`,
+3 N - 3 translational degrees of freedom when the row keeps the total momentum), potential and effective energy
+(total + heat bath), the molecules' centres of mass, dipole and H-H unit vectors, and every ``rdf_every``-th
+frame's oxygen positions.  Frames are reduced in the worker; what is kept is each observable with its error
+(:mod:`..observe`), the time series of the equipartition study (t, T_trans, T_rot, pe, etot) and the curves.
+"""
+from __future__ import annotations
+
+import time
+
+import numpy as np
+import openmm as mm
+import openmm.unit as unit
+
+from ....physics.momenta import kinetic_energy
+from ....physics.temperature import kinetic_temperatures
+from ...equipartition.runs import steps_per_sample
+from ..angular import angular_velocities
+from ..molecules import centre_of_mass_trajectory
+from ..observe import observables
+from ..reorientation import atom_vectors, dipole_vectors
+from ..rowspec import describe
+from .engines import Engine
+
+__all__ = ["run_row", "replica_seed", "charges"]
+
+
+def replica_seed(cfg: dict, replica: int) -> int:
+    """The random seed of a stochastic row's run on ``replica`` (> 0: reproducible)."""
+    return int(cfg["seed"]) * 1000 + 17 * int(replica) + 1
+
+
+def charges(system) -> np.ndarray:
+    nb = next(f for f in system.getForces() if isinstance(f, mm.NonbondedForce))
+    return np.array([nb.getParticleParameters(i)[0].value_in_unit(unit.elementary_charge)
+                     for i in range(system.getNumParticles())])
+
+
+def run_row(scene, x, v, row: dict, cfg: dict, replica: int):
+    """One run of ``row`` from the replica state (x, v) of ``scene``; returns (arrays, info).  info: status
+    ("ok" or "blew up at step S"), wall_s, steps, force_evals, obs {key: [value, se] or None}, notes."""
+    t0 = time.perf_counter()
+    eng = Engine(scene, x, v, row, float(cfg["temperature"]), replica_seed(cfg, replica), cfg.get("threads", 1))
+    h, info = row["step_fs"], describe(row)
+    mols, m, q = scene.molecules, eng.masses, charges(scene.system)
+    n_constraints = scene.system.getNumConstraints()
+    box = float(scene.system.getDefaultPeriodicBoxVectors()[0][0].value_in_unit(unit.nanometer))  # cubic
+    steps, status = 0, "ok"
+
+    def advance(n):
+        nonlocal steps
+        eng.step(n)
+        steps += n
+
+    advance(max(0, int(round(cfg["settle_ps"] * 1000.0 / h))))
+    every_w = steps_per_sample(h, cfg["omega_fs"])
+    xs_w, vs_w = [], []
+    for i in range(int(round(cfg["omega_ps"] * 1000.0 / (every_w * h))) + 1):
+        if i:
+            advance(every_w)
+        xw, vw, _ = eng.sample(energy=False)
+        xs_w.append(xw)
+        vs_w.append(vw)
+    every = steps_per_sample(h, cfg["sample_fs"])
+    n = int(round(cfg["length_ps"] * 1000.0 / (every * h))) + 1
+    keys = ("t", "T_trans", "T_rot", "pe", "etot")
+    out = {k: np.full(n, np.nan) for k in keys}
+    com, dip, hh, oxygen = [], [], [], []
+    for i in range(n):
+        if i:
+            advance(every)
+        xs, vs, pe = eng.sample()
+        kt = kinetic_temperatures(xs, vs, m, mols, info["keeps_momentum"], n_constraints)
+        bath = eng.heat_bath()
+        etot = pe + kinetic_energy(vs, m) + (bath or 0.0)
+        out["t"][i], out["T_trans"][i], out["T_rot"][i], out["pe"][i], out["etot"][i] = \
+            i * every * h * 1e-3, kt.translational, kt.rotational, pe, etot
+        if not np.isfinite(etot) or abs(kt.translational) > 1e5:
+            status = f"blew up at step {steps}"
+            break
+        frame = xs[None]
+        com.append(centre_of_mass_trajectory(frame, m, mols)[0])
+        dip.append(dipole_vectors(frame, mols, q)[0])
+        hh.append(atom_vectors(frame, mols, 1, 2)[0])
+        if i % int(cfg["rdf_every"]) == 0:
+            oxygen.append(xs[[g[0] for g in mols]])
+    info = {"status": status, "steps": steps, "force_evals": steps * info["evals_per_step"],
+            "sample_ps": every * h * 1e-3, "omega_ps_between": every_w * h * 1e-3}
+    if status != "ok":
+        info["wall_s"] = time.perf_counter() - t0
+        return {k: out[k] for k in keys}, info
+    xs_w, vs_w = np.array(xs_w), np.array(vs_w)
+    series = dict(out, com=np.array(com), dip=np.array(dip), hh=np.array(hh), oxygen=np.array(oxygen),
+                  omega=angular_velocities(xs_w, vs_w, m, mols, frame="space"), dt_omega=every_w * h * 1e-3)
+    obs, curves, notes = observables(series, cfg, len(mols), box, describe(row)["effective_energy"])
+    info.update(obs=obs, notes=notes, wall_s=time.perf_counter() - t0)
+    return dict({k: out[k] for k in keys}, **curves), info

@@ -1,0 +1,200 @@
+"""Run the fidelity study: the equipartition study's replica states, one run per (row, replica), kept on disk.
+
+    from openmm_symprk.studies.fidelity import presets
+    from openmm_symprk.studies.fidelity.simulation import run_study
+    summary = run_study(presets.quick(), "fidelity-quick", workers=2)
+
+``<out>/states/<model>-<key>.npz`` holds the replica states (the same file, key and states as
+``symprk equipartition`` makes for the same box and equilibration settings), ``<out>/runs/<key>.json`` (+ .npz)
+one finished run each; a key hashes everything a run depends on (box, states, row, replica, lengths, the
+observables' settings), so a second call reuses every finished run and a changed setting never reuses a stale
+one.  Rows this installation cannot run (the package's thermostat rows before the thermostat exists) are planned
+no runs and reported "unavailable: ..."; nothing of theirs is stored, so they run once the thermostat is there.
+"""
+from __future__ import annotations
+
+import os
+import warnings
+
+from ....systems.checks import ConservationWarning
+from ...core import Run, Study, run_key as hash_key, write_json, write_text
+from ...equipartition.study import STATE_KEYS, STATE_VERSION, replica_state_set
+from ..rowspec import check_row, describe
+from .engines import availability
+
+__all__ = ["FidelityStudy", "run_study", "run_key", "temperature_view", "RUN_KEYS", "RUN_VERSION"]
+
+#: What a run depends on besides its row and replica (the observables are computed in the run: their settings too).
+RUN_KEYS = STATE_KEYS + ("model", "settle_ps", "omega_ps", "omega_fs", "omega_max_lag_ps", "length_ps",
+                         "sample_fs", "rdf_every", "msd_window_ps", "tau_fit", "rdf_r_min_nm")
+#: Version of what a run stores; a run stored by another version is never reused.
+RUN_VERSION = 1
+
+
+def run_key(cfg: dict, row: dict, replica: int) -> str:
+    return hash_key({"cfg": {k: cfg[k] for k in RUN_KEYS}, "row": check_row(row), "replica": int(replica),
+                     "states": STATE_VERSION, "version": RUN_VERSION})
+
+
+_boxes: dict = {}
+
+
+def work(shared: dict, row: dict, replica: int):
+    """One run in whatever process executes it (the box is built once per process)."""
+    from ...equipartition.runs import build_box
+    from .runs import run_row
+
+    cfg = shared["cfg"]
+    key = (cfg["model"], cfg["n_waters"], cfg["cutoff_nm"], cfg["density_g_cm3"])
+    if key not in _boxes:
+        _boxes[key] = build_box(cfg, cfg["model"])
+    return run_row(_boxes[key], shared["x"][replica], shared["v"][replica], row, cfg, replica)
+
+
+def check(cfg: dict) -> list:
+    """The config's rows, checked (step sizes as floats); ValueError naming what is wrong."""
+    for k in ("replicas", "n_waters", "rdf_every"):
+        if isinstance(cfg[k], bool) or int(cfg[k]) < 1:
+            raise ValueError(f"{k} must be >= 1, got {cfg[k]!r}")
+    for k in ("length_ps", "sample_fs", "omega_ps", "omega_fs", "equilibrate_ps", "cutoff_nm", "temperature"):
+        if not float(cfg[k]) > 0:
+            raise ValueError(f"{k} must be positive, got {cfg[k]!r}")
+    if float(cfg["omega_fs"]) > 4.0:
+        raise ValueError(f"omega_fs must be <= 4 fs (the angular-velocity correlation falls to zero within "
+                         f"~20 fs), got {cfg['omega_fs']}")
+    rows = [check_row(r) for r in cfg["rows"]]
+    if not rows:
+        raise ValueError("no rows")
+    ref = rows[0]
+    if not (ref["kind"] == "symprk" and describe(ref)["ensemble"] == "NVE" and "hmr_da" not in ref):
+        raise ValueError(f"the first row is the reference and must be an NVE row of this package, got {ref}")
+    labels = [describe(r)["label"] for r in rows]
+    dup = sorted({x for x in labels if labels.count(x) > 1})
+    if dup:
+        raise ValueError(f"rows given twice: {', '.join(dup)}")
+    return rows
+
+
+class FidelityStudy(Study):
+    """One run per (available row, replica) from the replica states of the model's box."""
+
+    command = "symprk fidelity"
+    work = work
+
+    def __init__(self, cfg: dict, out: str, workers: int = 2, timing: bool = True, progress: bool = True,
+                 log=print, scheduler: str | None = None):
+        self.rows = check(cfg)
+        super().__init__(out, workers, scheduler, progress, log)
+        self.cfg, self.timing = cfg, timing
+        self.states, self.unavailable, self.box = None, {}, None
+
+    def plan(self) -> list:
+        with warnings.catch_warnings():  # the periodic box's angular-momentum warning: expected here
+            warnings.simplefilter("ignore", ConservationWarning)
+            return self._plan()
+
+    def _plan(self) -> list:
+        from ...equipartition.runs import build_box
+
+        cfg = self.cfg
+        self.states = replica_state_set(cfg, cfg["model"], self.out, self.log)
+        self.box = build_box(cfg, cfg["model"])
+        runs = []
+        for row in self.rows:
+            lab = describe(row)["label"]
+            why = availability(row, self.box, float(cfg["temperature"]))
+            if why:
+                self.unavailable[lab] = why
+                self.log(f"{lab}: {why}")
+                continue
+            for r in range(int(cfg["replicas"])):
+                cost = describe(row)["evals_per_step"] * (cfg["settle_ps"] + cfg["omega_ps"] + cfg["length_ps"]) \
+                    / row["step_fs"]
+                runs.append(Run(run_key(cfg, row, r), "box", (row, r), {"row": lab, "replica": r}, cost))
+        return runs
+
+    def shared(self, runs) -> dict:
+        x, v = self.states
+        return {"box": {"cfg": self.cfg, "x": x, "v": v}}
+
+    def stored(self, run, info):
+        if info["status"] != "ok":
+            self.log(f"{info['row']} replica {info['replica']}: {info['status']}")
+
+    def summarise(self, runs) -> dict:
+        from ..report import chart, format_summary, summarise
+
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", ConservationWarning)
+            timings = self.timings() if self.timing else {}
+        grouped = {k[0]: v for k, v in self.results(runs, ("row",)).items()}
+        summary = summarise(self.cfg, self.rows, grouped, timings, self.unavailable, self.box_edge())
+        summary["temperature_view"] = temperature_view(self.cfg, self.rows, grouped, timings)
+        write_text(os.path.join(self.out, "summary.txt"), format_summary(summary) + "\n")
+        if summary["temperature_view"]:
+            from ...equipartition.report import format_summary as equipartition_summary
+
+            write_text(os.path.join(self.out, "equipartition.txt"),
+                       equipartition_summary(summary["temperature_view"]) + "\n")
+        write_json(os.path.join(self.out, "results.json"), summary)
+        try:
+            chart(summary, os.path.join(self.out, "fidelity.png"))
+            if timings:
+                chart(summary, os.path.join(self.out, "fidelity-wall.png"), x="s_per_ps")
+        except ImportError as exc:  # MissingDependencyError says which extra installs matplotlib
+            self.log(f"no chart: {exc}")
+        return summary
+
+    def box_edge(self) -> float:
+        import openmm.unit as unit
+
+        return float(self.box.system.getDefaultPeriodicBoxVectors()[0][0].value_in_unit(unit.nanometer))
+
+    def timings(self) -> dict:
+        """Seconds per simulated ps of each available row on replica 0, measured in turns
+        (:func:`openmm_symprk.studies.timing.interleaved`), so the ratios hold under the machine's load."""
+        from ...timing import interleaved
+        from .engines import Engine
+        from .runs import replica_seed
+
+        x, v = self.states
+        engines = {}
+        for row in self.rows:
+            lab = describe(row)["label"]
+            if lab not in self.unavailable:
+                engines[lab] = (row["step_fs"], Engine(self.box, x[0], v[0], row, float(self.cfg["temperature"]),
+                                                       replica_seed(self.cfg, 0), self.cfg.get("threads", 1)))
+        block = float(self.cfg.get("timing_fs", 50.0))
+        steps = {k: max(1, int(round(block / h))) for k, (h, _) in engines.items()}
+        res = interleaved({k: e.step for k, (_, e) in engines.items()}, steps, rounds=3)
+        self.log(f"timed {len(engines)} rows in turns")
+        return {k: tm.best / (engines[k][0] * 1e-3) for k, tm in res.items()}
+
+
+def temperature_view(cfg: dict, rows: list, grouped: dict, timings: dict) -> dict | None:
+    """The equipartition study's summary (:func:`openmm_symprk.studies.equipartition.report.summarise`: T_rot -
+    T_trans, T_trans, PE per molecule, drift, the published Verlet trend, the cheapest match) of this study's
+    stored runs of the package's NVE rows without HMR: every such run keeps the equipartition study's time
+    series (t, T_trans, T_rot, pe, etot), so the view needs no run of its own.  None without such rows."""
+    from ...equipartition.report import summarise as equipartition_summarise
+
+    nve = [r for r in rows if r["kind"] == "symprk" and describe(r)["ensemble"] == "NVE" and "hmr_da" not in r]
+    if not nve:
+        return None
+    model = cfg["model"]
+    eq_cfg = {k: cfg[k] for k in ("n_waters", "cutoff_nm", "density_g_cm3", "temperature", "settle_ps",
+                                  "length_ps", "sample_fs")}
+    eq_cfg.update(reference=[nve[0]["method"], nve[0]["step_fs"]],
+                  models={model: [[r["method"], r["step_fs"]] for r in nve]})
+    runs = {(model, r["method"], r["step_fs"]): grouped.get(describe(r)["label"], []) for r in nve}
+    eq_timings = {(model, r["method"], r["step_fs"]): timings[describe(r)["label"]] for r in nve
+                  if describe(r)["label"] in timings}
+    return equipartition_summarise(eq_cfg, runs, eq_timings)
+
+
+def run_study(cfg: dict, out: str, workers: int = 2, timing: bool = True, progress: bool = True, log=print,
+              scheduler: str | None = None) -> dict:
+    """Run (or finish, or only re-summarise) the study in ``out``; returns the summary (:func:`..report.summarise`)
+    and writes ``summary.txt``, ``equipartition.txt`` (:func:`temperature_view`), ``results.json``, ``fidelity.png`` (bias against force evaluations per ps) and,
+    with timing, ``fidelity-wall.png`` (against wall time per simulated ps) there."""
+    return FidelityStudy(cfg, out, workers, timing, progress, log, scheduler).run()
