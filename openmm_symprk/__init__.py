@@ -1,11 +1,14 @@
 """openmm_symprk: symplectic partitioned Runge-Kutta integrators for OpenMM.
 
-    from openmm_symprk import SymplecticIntegrator, methods
+    from openmm_symprk import SymplecticIntegrator, catalogue
     integrator = SymplecticIntegrator(2*unit.femtoseconds, "yoshida-4", system=system)
+    catalogue["yoshida-4"].order                    # the catalogue: name or alias -> Method
 
 The package by layer (each imports only from the ones above it):
 
-* :mod:`.methods` -- tableaux, splittings, the catalogue, pure-numpy reference integrators (no OpenMM);
+* :mod:`.support` -- optional dependencies imported on first use (an error names the extra installing them);
+* :mod:`.methods` -- tableaux, splittings, the catalogue (``catalogue`` here), :func:`resolve`, pure-numpy
+  reference integrators (no OpenMM);
 * :mod:`.physics` -- momenta and inertia on arrays, about a stated point (no OpenMM);
 * :mod:`.systems` -- facts of an OpenMM System, conservation checks, initial states, minimal scenes;
 * :mod:`.plugin` -- the compiled OpenMM plugin and its loader;
@@ -20,7 +23,8 @@ from importlib import import_module
 from .integrators import (CheckpointMismatchError, CustomSymplecticIntegrator, NativeSymplecticIntegrator,
                           PRKIntegrator, SimulationBlowUpError, SymplecticIntegrator, SystemMismatchError, deserialize,
                           restore, step_size_in_ps)
-from .methods import PRKTableau, Splitting, TableauError, UnknownMethodError, compose, get_method, methods
+from .methods import PRKTableau, ResolvedMethod, Splitting, TableauError, UnknownMethodError, compose, get_method, resolve
+from .methods.catalogue import methods as catalogue
 
 __version__ = "0.2.0"
 
@@ -49,6 +53,6 @@ def __getattr__(name):
 
 
 __all__ = ["SymplecticIntegrator", "PRKIntegrator", "CustomSymplecticIntegrator", "NativeSymplecticIntegrator",
-           "PRKTableau", "Splitting", "compose", "methods", "get_method", "UnknownMethodError", "TableauError",
+           "PRKTableau", "Splitting", "compose", "catalogue", "get_method", "resolve", "ResolvedMethod", "UnknownMethodError", "TableauError",
            "SimulationBlowUpError", "SystemMismatchError", "CheckpointMismatchError", "restore", "deserialize",
            "step_size_in_ps", *_LAZY]

@@ -113,7 +113,7 @@ def _cmd_info(args):
           f"custom for implicit and general tableaux")
     if not plugin.available():
         print(f"  to get the native plugin: {plugin.fix_hint()}")
-    print(f"  catalogue: {len(openmm_symprk.methods)} methods (symprk methods)")
+    print(f"  catalogue: {len(openmm_symprk.catalogue)} methods (symprk methods)")
     if args.require_native:
         wanted = [p.strip() for p in args.require_native.split(",") if p.strip()]
         missing = [p for p in wanted if details.get(p) != "native"]
@@ -172,9 +172,10 @@ def _user_errors():
 
     from .integrators import SimulationBlowUpError
     from .methods import TableauError, UnknownMethodError
+    from .support import MissingDependencyError
 
     return (CommandError, UnknownMethodError, TableauError, SimulationBlowUpError, mm.OpenMMException, ValueError,
-            TypeError, OSError)
+            TypeError, OSError, MissingDependencyError)
 
 
 def main(argv=None):
@@ -182,7 +183,13 @@ def main(argv=None):
     if argv and argv[0] in DELEGATED:
         import importlib
 
-        return importlib.import_module(DELEGATED[argv[0]]).main(argv[1:]) or 0
+        from .support import MissingDependencyError
+
+        try:  # a study's module may need an extra (matplotlib, scipy, ...): say which, in one line
+            return importlib.import_module(DELEGATED[argv[0]]).main(argv[1:]) or 0
+        except MissingDependencyError as exc:
+            print(f"symprk {argv[0]}: error: {exc}", file=sys.stderr)
+            return 2
     args = build_parser().parse_args(argv)
     try:
         rc = args.func(args)

@@ -30,10 +30,12 @@ from __future__ import annotations
 import numpy as np
 import openmm as mm
 import openmm.unit as unit
-from MDAnalysis.analysis.base import AnalysisBase
 
 from ..physics import momenta, temperature
+from ..support import require
 from ..systems.properties import masses as system_masses
+
+AnalysisBase = require("MDAnalysis.analysis.base", "analysis", "openmm_symprk.conservation.analysis").AnalysisBase
 
 __all__ = ["LinearMomentum", "AngularMomentum", "KineticTemperatures", "universe", "FLOAT32_FLOOR"]
 
@@ -198,7 +200,7 @@ def universe(topology, trajectory=None, system: mm.System | None = None, positio
     bonds) with the System's masses, optionally loading ``trajectory`` (e.g. a TRR written by
     :class:`~.reporters.VelocityTRRReporter`).  Without a trajectory, ``positions``
     (nm) give a single frame."""
-    import MDAnalysis as mda
+    mda = require("MDAnalysis", "analysis", "openmm_symprk.conservation.analysis.universe")
 
     atoms = list(topology.atoms())
     residues = list(topology.residues())

@@ -11,7 +11,7 @@ momentum that is being reported.
 
 :class:`ConservationReporter` writes, like ``StateDataReporter``, one line per report: step, time,
 total energy, its drift (slope of a least-squares line through all reports so far, in kJ/mol per ns
-per degree of freedom), |P - P0|, |L - L0|/|L0| (L about the centre of mass, or about the origin),
+per degree of freedom; :class:`openmm_symprk.stats.RunningLine`, constant work per report), |P - P0|, |L - L0|/|L0| (L about the centre of mass, or about the origin),
 the largest relative constraint violation, and the translational and rotational kinetic temperatures of the
 molecules (:mod:`openmm_symprk.physics.temperature`); every figure is computed in float64 from the State
 (:mod:`openmm_symprk.physics`).  At its first report it warns once, with the reason, about
@@ -21,11 +21,13 @@ the System's issues and thermostatting integrators, one :class:`ConservationWarn
 :class:`VelocityTRRReporter` writes positions (nm), velocities (nm/ps), step and time to a GROMACS TRR
 file with MDAnalysis' XDR library (no extra dependency); MDAnalysis reads it back with velocities.
 TRR stores float32: figures recomputed from the file are limited to ~1e-7 relative
-(:mod:`openmm_symprk.conservation.analysis`).  Each frame is complete on disk when ``report()`` returns, so
+(:mod:`openmm_symprk.conservation.analysis`).  Virtual sites, which OpenMM reports with zero velocity, are
+written with their true velocity, computed from their parents' (:mod:`openmm_symprk.systems.virtual_sites`).  Each frame is complete on disk when ``report()`` returns, so
 the file can be read while the simulation runs.  :func:`write_topology` writes the matching PDB.
 """
 from __future__ import annotations
 
+import numbers
 import os
 import sys
 
@@ -36,10 +38,21 @@ import openmm.unit as unit
 
 from ..physics import momenta
 from ..physics.temperature import kinetic_temperatures
+from ..support import require
+from ..stats.drift import RunningLine
 from ..systems.checks import conservation_issues, integrator_issues, warn_conservation, warn_once
 from ..systems.properties import constraint_arrays, constraint_violation, degrees_of_freedom, masses, molecules
+from ..systems.virtual_sites import VirtualSiteVelocities
 
 _NM, _NM_PS, _KJ = unit.nanometer, unit.nanometer / unit.picosecond, unit.kilojoule_per_mole
+
+
+def report_interval(value) -> int:
+    """``value`` as a number of steps: a positive integer (a float such as 2.5, or True, is refused, not truncated)."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral) or int(value) < 1:
+        raise ValueError(f"reportInterval must be a positive whole number of steps (an int such as 100), "
+                         f"got {value!r}")
+    return int(value)
 
 
 def _open(file, append):
@@ -76,11 +89,9 @@ class ConservationReporter:
 
     def __init__(self, file, reportInterval: int, about: str = "com", separator: str = ",",
                  append: bool = False, warn: bool = True):
-        if int(reportInterval) < 1:
-            raise ValueError(f"reportInterval must be a positive number of steps, got {reportInterval!r}")
+        self._interval = report_interval(reportInterval)
         if about not in ("com", "origin"):
             raise ValueError(f"about must be 'com' or 'origin', got {about!r}")
-        self._interval = int(reportInterval)
         self._about = about
         self._sep = separator
         self._append = append
@@ -110,13 +121,8 @@ class ConservationReporter:
         step = simulation.currentStep
         if self._P0 is None:
             self._P0, self._L0 = P, L
-        self._t.append(t)
-        self._e.append(total)
-        if len(self._t) >= 2 and self._t[-1] > self._t[0]:
-            slope = np.polyfit(np.asarray(self._t) - self._t[0], np.asarray(self._e) - self._e[0], 1)[0]
-            drift = float(slope) * 1000.0 / max(self._dof, 1)  # per ps -> per ns
-        else:
-            drift = float("nan")
+        slope = self._line.add(t, total).slope  # NaN until two reports at different times
+        drift = slope * 1000.0 / max(self._dof, 1)  # per ps -> per ns
         nL0 = float(np.linalg.norm(self._L0))
         temps = kinetic_temperatures(x, v, m, self._molecules, True, self._system.getNumConstraints())
         rec = {"step": step, "time": t, "total_energy": total, "energy_drift": drift,
@@ -142,7 +148,7 @@ class ConservationReporter:
         self._molecules = [list(g) for g in molecules(simulation.context)]
         self._dof = degrees_of_freedom(self._system)
         self._P0 = self._L0 = None
-        self._t, self._e = [], []
+        self._line = RunningLine()
         self.issues = conservation_issues(self._system) + integrator_issues(simulation.integrator)
         if self._warn:
             warn_conservation(self._system, context="ConservationReporter", stacklevel=4)
@@ -173,17 +179,18 @@ class VelocityTRRReporter:
     the simulation runs; ``append=True`` (a restart) adds frames after the existing ones without rewriting
     them.  MDAnalysis reads it with velocities: ``mda.Universe("top.pdb", "traj.trr")`` (MDAnalysis converts
     to Angstrom and Angstrom/ps), or :func:`openmm_symprk.conservation.analysis.universe`.  Virtual sites are
-    written like any particle."""
+    written with the velocity they move with (OpenMM's State gives them zero), computed from their parents'
+    velocities for every OpenMM virtual-site type; a type it does not know keeps zero, with one warning."""
 
     def __init__(self, file: str, reportInterval: int, append: bool = False, forces: bool = False):
         import tempfile
 
-        from MDAnalysis.lib.formats.libmdaxdr import TRRFile  # noqa: F401 (fail here, not at the first report)
+        # fail here, not at the first report
+        require("MDAnalysis.lib.formats.libmdaxdr", "analysis", "openmm_symprk.conservation.VelocityTRRReporter")
 
-        if int(reportInterval) < 1:
-            raise ValueError(f"reportInterval must be a positive number of steps, got {reportInterval!r}")
-        self._interval = int(reportInterval)
+        self._interval = report_interval(reportInterval)
         self._forces = forces
+        self._sites = None
         self.path = str(file)
         self.frames = self._count_frames() if append else 0
         with open(self.path, "ab" if append else "wb"):
@@ -192,7 +199,8 @@ class VelocityTRRReporter:
         os.close(fd)
 
     def _count_frames(self) -> int:
-        from MDAnalysis.lib.formats.libmdaxdr import TRRFile
+        TRRFile = require("MDAnalysis.lib.formats.libmdaxdr", "analysis",
+                          "openmm_symprk.conservation.VelocityTRRReporter").TRRFile
 
         if not os.path.exists(self.path) or os.path.getsize(self.path) == 0:
             return 0
@@ -205,10 +213,21 @@ class VelocityTRRReporter:
         return {"steps": steps, "periodic": False, "include": include}
 
     def report(self, simulation, state):
-        from MDAnalysis.lib.formats.libmdaxdr import TRRFile
+        TRRFile = require("MDAnalysis.lib.formats.libmdaxdr", "analysis",
+                          "openmm_symprk.conservation.VelocityTRRReporter").TRRFile
 
-        x = np.asarray(state.getPositions(asNumpy=True).value_in_unit(_NM), dtype=np.float32)
-        v = np.asarray(state.getVelocities(asNumpy=True).value_in_unit(_NM_PS), dtype=np.float32)
+        if self._sites is None:
+            self._sites = VirtualSiteVelocities(simulation.system)
+            for i, kind in self._sites.unsupported[:1]:
+                warn_once(f"virtual-site-{kind}", f"VelocityTRRReporter: virtual sites of type {kind} (particle {i}"
+                          f"{' and others' if len(self._sites.unsupported) > 1 else ''}) are written with OpenMM's "
+                          f"zero velocity: their velocity from the parents' is not known for that type",
+                          category=UserWarning, stacklevel=3)
+        x = np.asarray(state.getPositions(asNumpy=True).value_in_unit(_NM), dtype=np.float64)
+        v = np.asarray(state.getVelocities(asNumpy=True).value_in_unit(_NM_PS), dtype=np.float64)
+        if self._sites:
+            v = self._sites(x, v)
+        x, v = x.astype(np.float32), v.astype(np.float32)
         f = None
         if self._forces:
             f = np.asarray(state.getForces(asNumpy=True).value_in_unit(_KJ / _NM), dtype=np.float32)

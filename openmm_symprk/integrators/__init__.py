@@ -7,6 +7,9 @@
 * :mod:`.program` compiles the programs, :mod:`.projection` the exact-momentum kicks,
   :mod:`.convergence` measures orders of compiled integrators, :mod:`.restore` gives an integrator read
   from XML its class back.
+
+Both backends take the method resolved once (:func:`openmm_symprk.methods.resolved.resolve`, called by
+:func:`.backend.prepare` together with the option checks they share) and keep it as ``integrator.resolved``.
 """
 from .backend import BackendWarning, NativeMethodError, NativeUnavailableError, choose_backend
 from .base import (CheckpointMismatchError, ConvergenceWarning, IntegratorBase, SimulationBlowUpError,

@@ -20,6 +20,7 @@ from __future__ import annotations
 import math
 import operator
 
+import numpy as np
 import openmm as mm
 import openmm.unit as unit
 
@@ -47,6 +48,10 @@ class CheckpointMismatchError(RuntimeError):
 
 def step_size_in_ps(step_size) -> float:
     """Validate a step size: a positive time Quantity, or a positive number taken as picoseconds."""
+    raw = step_size._value if unit.is_quantity(step_size) else step_size
+    if isinstance(raw, (bool, np.bool_)):
+        raise TypeError(f"step size {step_size!r} is a truth value, not a time: give e.g. 2*unit.femtoseconds "
+                        f"or a number of picoseconds")
     if unit.is_quantity(step_size):
         if not step_size.unit.is_compatible(unit.picoseconds):
             raise TypeError(f"step size {step_size} is not a time: give it in time units, e.g. "
@@ -102,6 +107,9 @@ class IntegratorBase:
     check_finite: bool = True
     max_speed: float = 0.0
     compiled_for = None  # SystemSignature of system=, or None
+    resolved = None  # the ResolvedMethod it runs (openmm_symprk.methods.resolved), None if not known
+    #: attributes a copy does not carry (the C++ object, per-Context handles)
+    _transient: tuple = ("this", "thisown")
 
     # -- the step ---------------------------------------------------------------------------------
     def step(self, steps):
@@ -149,7 +157,7 @@ class IntegratorBase:
 
     def _stability(self) -> str:
         try:
-            st = (self.method or get_method(self.method_name)).stability
+            st = (self.resolved or self.method or get_method(self.method_name)).stability
         except Exception:
             return "unknown"
         return "unbounded" if st is None or math.isinf(st) else f"{st:.4f}"
@@ -171,7 +179,7 @@ class IntegratorBase:
     # -- copies ---------------------------------------------------------------------------------------
     def _python_state(self) -> dict:
         """The Python attributes a copy needs (everything but the C++ object; catalogue methods by name)."""
-        state = {k: v for k, v in self.__dict__.items() if k not in ("this", "thisown")}
+        state = {k: v for k, v in self.__dict__.items() if k not in self._transient}
         if state.get("method") is not None:
             state["method"] = state["method"].name
         return state

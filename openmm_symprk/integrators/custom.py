@@ -19,16 +19,13 @@ import math
 import warnings
 
 import openmm as mm
+import openmm.unit as unit
 
-from ..methods.catalogue import Method, get_method
-from ..methods.splitting import Splitting
-from ..methods.tableau import PRKTableau, TableauError
-from ..systems.checks import validate_system, warn_once
-from ..systems.properties import masses, signature
+from ..systems.checks import warn_once
+from ..systems.properties import masses
 from . import program
-from .base import (CheckpointMismatchError, ConvergenceWarning, IntegratorBase, SystemMismatchError,
-                   check_max_speed, step_size_in_ps)
-from .mts import describe_levels, mts_splitting
+from .backend import CUSTOM_OPTIONS, NATIVE_OPTIONS, check_option_names, prepare
+from .base import CheckpointMismatchError, ConvergenceWarning, IntegratorBase, SystemMismatchError, step_size_in_ps
 from .projection import set_masses
 from .symplectic import SymplecticIntegrator
 
@@ -39,16 +36,13 @@ __all__ = ["PRKIntegrator", "CustomSymplecticIntegrator", "META_PREFIX", "read_m
 META_PREFIX = "symprk_meta_"
 
 
+#: The keyword options of PRKIntegrator and CustomSymplecticIntegrator (for the misspelt-keyword message).
+_PRK_ARGS = (*sorted(NATIVE_OPTIONS | CUSTOM_OPTIONS), "name")
+_CATALOGUE_ARGS = (*sorted(NATIVE_OPTIONS | CUSTOM_OPTIONS),)
+
+
 class TimeWarning(UserWarning):
     """OpenMM's CustomIntegrator keeps the Context's time on the old step size after setStepSize."""
-
-
-def _is_splitting(tab: PRKTableau) -> bool:
-    try:
-        tab.to_splitting()
-        return True
-    except TableauError:
-        return False
 
 
 def read_metadata(integrator: mm.CustomIntegrator) -> dict | None:
@@ -100,76 +94,58 @@ class PRKIntegrator(IntegratorBase, mm.CustomIntegrator):
     def __init__(self, stepSize, tableau, system: mm.System | None = None, constraints: bool | None = None,
                  allow_nonsymplectic: bool = False, exact_momentum: bool = False, check_finite: bool = True,
                  max_speed=None, groups=None, inner_method=None, tolerance: float = 1e-12, max_iterations: int = 60,
-                 name: str | None = None):
-        dt = step_size_in_ps(stepSize)
-        method = self._resolve(tableau)
-        if inner_method is not None and groups is None:
-            raise ValueError("inner_method= needs groups= (the force groups of the levels of multiple time stepping)")
-        tab = method.tableau() if isinstance(method, Method) else (
-            PRKTableau.from_splitting(method, name=name) if isinstance(method, Splitting) else method)
-        self.method_name = name or getattr(method, "name", None) or "user tableau"
-        self.method = method if isinstance(method, Method) else None
-        tab.check_symplectic(allow_nonsymplectic)
-        if not (isinstance(tolerance, (int, float)) and tolerance > 0 and math.isfinite(tolerance)):
+                 name: str | None = None, **unknown):
+        check_option_names(unknown, _PRK_ARGS, type(self).__name__)
+        if constraints is not None and not isinstance(constraints, bool):
+            raise TypeError(f"constraints must be True, False or None (from system=), got {constraints!r}")
+        if not (isinstance(tolerance, (int, float)) and not isinstance(tolerance, bool) and tolerance > 0
+                and math.isfinite(tolerance)):
             raise ValueError(f"tolerance must be a positive number of nm, got {tolerance!r}")
-        if int(max_iterations) < 1:
+        if isinstance(max_iterations, bool) or int(max_iterations) < 1:
             raise ValueError(f"max_iterations must be at least 1, got {max_iterations!r}")
-        max_speed = check_max_speed(max_speed)
-        if exact_momentum and system is None:
-            raise ValueError("exact_momentum=True needs system= (the System the integrator will run): the projection "
-                             "is only right for an isolated System, which is checked, and it uses the System's masses")
-        splitting = isinstance(method, Splitting) or (isinstance(method, Method) and method.is_splitting) or (
-            isinstance(method, PRKTableau) and _is_splitting(method))
-        if system is not None:
-            validate_system(system, f"{type(self).__name__}({self.method_name})", exact_momentum)
-            sig = signature(system)
-            has_constraints, has_sites = sig.constraints, sig.virtual_sites
-        else:
-            sig, has_sites = None, True
-            has_constraints = splitting  # RATTLE steps are harmless (and cheap) on a System without constraints
-        if constraints is not None:
-            has_constraints = bool(constraints)
-        self.mts_levels = None
-        if groups is not None:
-            if isinstance(method, PRKTableau):
-                method = method.to_splitting()
-            method, self.mts_levels = mts_splitting(method, groups, inner_method, has_constraints, system)
-            tab = None
-        mm.CustomIntegrator.__init__(self, dt)
-        self.tableau = tab
-        try:
-            self.program_info = program.compile_program(
-                self, method, has_constraints, has_sites, exact_momentum=exact_momentum, check_finite=check_finite,
-                max_speed=max_speed, tolerance=tolerance, max_iterations=int(max_iterations))
-        except program.ConstraintSupportError as exc:
-            raise program.ConstraintSupportError(str(exc).replace("user tableau", self.method_name)) from None
-        self.check_finite = bool(check_finite)
-        self.max_speed = max_speed
-        self.exact_momentum = bool(exact_momentum)
-        self.compiled_for = sig
-        self._masses = masses(system) if (exact_momentum and system is not None) else None
+        p = prepare(type(self).__name__, stepSize, tableau, system, exact_momentum=exact_momentum,
+                    check_finite=check_finite, max_speed=max_speed, groups=groups, inner_method=inner_method,
+                    constraints=constraints, name=name)
+        r = p.method
+        r.check_symplectic(allow_nonsymplectic)
+        has_sites = p.system.virtual_sites if p.system is not None else True
+        mm.CustomIntegrator.__init__(self, p.dt)
+        self._set_resolved(r)
+        self.program_info = program.compile_program(
+            self, r, has_sites, exact_momentum=p.exact_momentum, check_finite=p.check_finite, max_speed=p.max_speed,
+            tolerance=tolerance, max_iterations=int(max_iterations))
+        self.check_finite = p.check_finite
+        self.max_speed = p.max_speed
+        self.exact_momentum = p.exact_momentum
+        self.compiled_for = sig = p.system
+        self._masses = masses(system) if p.exact_momentum else None
         self._signature = float(self.program_info.signature)
         self._reset_binding()
         meta = {"class": type(self).__name__, "method": self.method_name,
                 "catalogue": self.method.name if self.method is not None else None,
                 "options": {"exact_momentum": self.exact_momentum, "check_finite": self.check_finite,
-                            "max_speed": self.max_speed, "groups": None if groups is None else [list(g) for g in groups],
-                            "inner_method": getattr(inner_method, "name", inner_method)},
+                            "max_speed": self.max_speed, "groups": None if r.groups is None else [list(g) for g in r.groups],
+                            "inner_method": r.inner_name},
                 "system": None if sig is None else {"n_particles": sig.n_particles, "constraints": sig.constraints,
                                                     "virtual_sites": sig.virtual_sites,
                                                     "total_mass": sig.total_mass, "masses_digest": sig.masses_digest}}
         self.addGlobalVariable(META_PREFIX + json.dumps(meta, separators=(",", ":")).encode().hex(), 0.0)
 
-    @staticmethod
-    def _resolve(tableau):
-        if isinstance(tableau, (PRKTableau, Splitting, Method)):
-            return tableau
-        if isinstance(tableau, str):
-            return get_method(tableau)
-        raise TypeError(f"expected a PRKTableau, Splitting, catalogue method or method name, got {tableau!r}")
+    def _set_resolved(self, r):
+        """Record the resolved method (None: a program restored from XML whose method is not in the catalogue)."""
+        self.resolved = r
+        self.method = r.entry if r is not None else None
+        self.method_name = r.name if r is not None else self.method_name
+        self.mts_levels = (list(r.levels) or None) if r is not None else None
+        self.tableau = r.tableau if r is not None else None
 
     # -- per-Context checks ----------------------------------------------------------------------------
+    _transient = IntegratorBase._transient + ("_context_ref",)
+
     def _reset_binding(self):
+        self._context_ref = None
+        # the step size (ps), and the one the Context's time is known to advance by
+        self._dt = self._time_dt = self.getStepSize().value_in_unit(unit.picosecond)
         self._checked_context = False
         self._checked_probe = False
         self._nonconverged_seen = 0
@@ -231,15 +207,53 @@ class PRKIntegrator(IntegratorBase, mm.CustomIntegrator):
     def _raw_steps_taken(self) -> int:
         return int(self.getGlobalVariableByName(program.STEP_VAR))
 
-    def setStepSize(self, size):
-        new = step_size_in_ps(size)
-        if self._checked_context and new != self.getStepSize():
+    # -- the Context's time -------------------------------------------------------------------------------
+    def step(self, steps):
+        """Advance ``steps`` steps (see :meth:`IntegratorBase.step`), keeping the Context's time right after a
+        change of step size: OpenMM's CustomIntegrator on Reference and CPU advances the time by the step size
+        the Context was created with, whatever setStepSize said since; the time is then set to what the steps
+        took (read before and after, only while the step size differs from the one the time is known to follow)."""
+        dt = self._dt
+        if dt == self._time_dt:
+            return super().step(steps)
+        context = self._bound_context()
+        if context is None:
             warn_once("custom-setstepsize-time",
-                      f"{type(self).__name__}: on the Reference and CPU platforms OpenMM's CustomIntegrator keeps "
-                      f"advancing the Context's time by the step size it had when the Context was created (the "
-                      f"dynamics use the new one). Call context.reinitialize(preserveState=True) after setStepSize "
-                      f"to make the time right, or use the native backend.", TimeWarning)
-        return mm.CustomIntegrator.setStepSize(self, new)
+                      f"{type(self).__name__}: the step size changed since the integrator was created, and its "
+                      f"Context could not be found to keep its time right (on Reference and CPU OpenMM's "
+                      f"CustomIntegrator advances the time by the step size the Context was created with). Call "
+                      f"context.reinitialize(preserveState=True) after setStepSize, or use the native backend.",
+                      TimeWarning)
+            return super().step(steps)
+        t0 = context.getState().getTime().value_in_unit(unit.picosecond)
+        n0 = self._raw_steps_taken()
+        try:
+            return super().step(steps)
+        finally:
+            taken = self._raw_steps_taken() - n0
+            expected = t0 + taken * dt
+            t1 = context.getState().getTime().value_in_unit(unit.picosecond)
+            if abs(t1 - expected) > 1e-9 * max(taken, 1) * dt:
+                context.setTime(expected)
+            elif taken:
+                self._time_dt = dt  # this platform's time follows the step size
+
+    def setStepSize(self, size):
+        result = super().setStepSize(size)
+        self._dt = self.getStepSize().value_in_unit(unit.picosecond)
+        return result
+
+    def _bound_context(self):
+        """The Context this integrator is bound to (found once among the live Contexts, then kept weakly)."""
+        context = self._context_ref() if self._context_ref is not None else None
+        if context is None:
+            import gc
+            import weakref
+
+            context = next((o for o in gc.get_objects()
+                            if isinstance(o, mm.Context) and getattr(o, "_integrator", None) is self), None)
+            self._context_ref = weakref.ref(context) if context is not None else None
+        return context
 
     def describe(self) -> str:
         info = self.program_info
@@ -251,7 +265,7 @@ class PRKIntegrator(IntegratorBase, mm.CustomIntegrator):
                  ("  multiple time stepping" if self.mts_levels else "  (tableau not restored)")]
         lines += [f"  {n}" for n in info.notes]
         if self.mts_levels:
-            lines.append("  " + describe_levels(self.mts_levels, info.evals_per_group))
+            lines.append("  " + self.resolved.describe_levels())
         return "\n".join(lines)
 
 
@@ -263,5 +277,5 @@ class CustomSymplecticIntegrator(SymplecticIntegrator, PRKIntegrator, backend="c
     def __init__(self, stepSize, method="verlet", system: mm.System | None = None, backend: str = "custom",
                  **options):
         self._check_backend(backend)
-        m = get_method(method)
-        PRKIntegrator.__init__(self, stepSize, m, system=system, name=m.name, **options)
+        check_option_names(options, _CATALOGUE_ARGS, type(self).__name__)
+        PRKIntegrator.__init__(self, stepSize, method, system=system, **options)

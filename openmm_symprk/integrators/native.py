@@ -17,14 +17,9 @@ from __future__ import annotations
 import openmm as mm
 
 from .. import plugin
-from ..methods.catalogue import get_method
-from ..methods.respa import evaluations_per_step, kick_label
-from ..methods.splitting import DRIFT
-from ..systems.checks import validate_system
-from ..systems.properties import has_constraints, signature
-from .backend import NativeMethodError
-from .base import IntegratorBase, check_max_speed, step_size_in_ps
-from .mts import describe_levels, kick_masks, mts_splitting
+from ..methods.resolved import Substep, SubstepKind
+from .backend import NATIVE_OPTIONS, check_option_names, prepare
+from .base import IntegratorBase
 from .program import ProgramInfo
 from .symplectic import SymplecticIntegrator
 
@@ -34,6 +29,8 @@ _swig = plugin.swig_module()
 #: The plugin's SWIG class (openmm.Integrator when the plugin is unavailable: the class below then exists,
 #: for isinstance checks and documentation, but cannot be instantiated).
 _PluginIntegrator = _swig.SymPRKIntegrator if _swig is not None else mm.Integrator
+#: The keyword options of NativeSymplecticIntegrator (for the misspelt-keyword message).
+NATIVE_OPTIONS_ARGS = ("backend", *sorted(NATIVE_OPTIONS))
 
 
 def native_available() -> bool:
@@ -52,55 +49,44 @@ class NativeSymplecticIntegrator(SymplecticIntegrator, _PluginIntegrator, backen
     and NativeMethodError for implicit and general tableaux, which only the CustomIntegrator backend runs."""
 
     def __init__(self, stepSize, method="verlet", system=None, backend="native", exact_momentum=False,
-                 check_finite=True, max_speed=None, groups=None, inner_method=None):
+                 check_finite=True, max_speed=None, groups=None, inner_method=None, **unknown):
         self._check_backend(backend)
+        check_option_names(unknown, NATIVE_OPTIONS_ARGS, type(self).__name__)
         if _swig is None:
             raise plugin.NativeUnavailableError(f"the native backend is unavailable: {plugin.unavailable_reason()}. "
                                                 f"To fix it, {plugin.fix_hint()}.")
-        dt = step_size_in_ps(stepSize)
-        m = get_method(method)
-        if not m.is_splitting:
-            raise NativeMethodError(
-                f"method {m.name!r} is a general ({m.family}) PRK tableau; the native backend runs kick/drift "
-                f"splittings and compositions only. Use SymplecticIntegrator(..., backend='custom') for it.")
-        max_speed = check_max_speed(max_speed)
-        if exact_momentum and system is None:
-            raise ValueError("exact_momentum=True needs system= (the System the integrator will run): the projection "
-                             "is only right for an isolated System, which is checked")
-        if system is not None:
-            # the native kernels place virtual sites after every drift: no CustomIntegrator caveat
-            validate_system(system, f"NativeSymplecticIntegrator({m.name})", exact_momentum, skip=("virtualsites",))
-        constraints = True if system is None else has_constraints(system)
-        self.mts_levels = None
-        if inner_method is not None and groups is None:
-            raise ValueError("inner_method= needs groups= (the force groups of the levels of multiple time stepping)")
-        if groups is not None:
-            splitting, self.mts_levels = mts_splitting(m, groups, inner_method, constraints, system)
-        else:
-            splitting = m.constrained_splitting if constraints else m.splitting
-        coeffs = splitting.coefficients()
-        _PluginIntegrator.__init__(self, dt, [1 if label == DRIFT else 0 for label, _ in coeffs],
-                                   [float(c) for _, c in coeffs])
-        if groups is not None:
-            self.setSubsteps([1 if label == DRIFT else 0 for label, _ in coeffs], [float(c) for _, c in coeffs],
-                             kick_masks(splitting))
-        self.setMethodName(m.name)
-        self.setExactMomentum(bool(exact_momentum))
-        self.setMaxSpeed(max_speed)
-        if system is not None:
-            self.setExpectedSystem(system.getNumParticles(), constraints)
-        self.method = m
-        self.method_name = m.name
-        self.splitting = splitting
-        self.check_finite = bool(check_finite)
-        self.max_speed = max_speed
-        self.exact_momentum = bool(exact_momentum)
-        self.compiled_for = None if system is None else signature(system)
-        per_group = evaluations_per_step(splitting)
-        self.program_info = ProgramInfo("splitting", constraints, sum(per_group.values()), len(splitting),
-                                        bool(exact_momentum), ["native SymPRKIntegrator plugin"],
-                                        signature=int(self.getProgramSignature()),
-                                        evals_per_group=per_group if list(per_group) != [None] else None)
+        # the native kernels place virtual sites after every drift: no CustomIntegrator caveat
+        p = prepare(type(self).__name__, stepSize, method, system, exact_momentum=exact_momentum,
+                    check_finite=check_finite, max_speed=max_speed, groups=groups, inner_method=inner_method,
+                    splittings_only="the native backend runs kick/drift splittings and compositions only. Use "
+                                    "SymplecticIntegrator(..., backend='custom') for it.", skip_checks=("virtualsites",))
+        r = p.method
+        subs = r.substeps
+        _PluginIntegrator.__init__(self, p.dt, [int(s.kind) for s in subs], [float(s.coefficient) for s in subs],
+                                   [s.group_mask for s in subs], [int(s.flags) for s in subs])
+        self.setMethodName(r.name)
+        self.setExactMomentum(p.exact_momentum)
+        self.setMaxSpeed(p.max_speed)
+        if p.system is not None:
+            self.setExpectedSystem(p.system.n_particles, r.constraints)
+        self._set_resolved(r)
+        self.check_finite = p.check_finite
+        self.max_speed = p.max_speed
+        self.exact_momentum = p.exact_momentum
+        self.compiled_for = p.system
+
+    def _set_resolved(self, r):
+        """Record the resolved method and what the plugin reports of its program."""
+        self.resolved = r
+        self.method = r.entry
+        self.method_name = r.name
+        self.splitting = r.splitting
+        self.mts_levels = list(r.levels) or None
+        per_group = r.evaluations
+        self.program_info = ProgramInfo("splitting", r.constraints, int(self.getForceEvaluationsPerStep()),
+                                        self.getNumSubsteps(), bool(self.getExactMomentum()),
+                                        ["native SymPRKIntegrator plugin"], signature=int(self.getProgramSignature()),
+                                        evals_per_group=per_group or None)
 
     # -- backend hooks -------------------------------------------------------------------------------------
     def _blowup_step(self) -> int:
@@ -130,12 +116,9 @@ class NativeSymplecticIntegrator(SymplecticIntegrator, _PluginIntegrator, backen
         force groups only (multiple time stepping)."""
         out = []
         for i in range(self.getNumSubsteps()):
-            mask = self.getSubstepForceGroups(i)
-            if self.getSubstepKind(i) == 1:
-                label = DRIFT
-            else:
-                label = "kick" if mask == -1 else kick_label([g for g in range(32) if mask >> g & 1])
-            out.append((label, self.getSubstepCoefficient(i)))
+            mask, c = self.getSubstepForceGroups(i), self.getSubstepCoefficient(i)
+            groups = None if mask == -1 else tuple(g for g in range(32) if mask >> g & 1)
+            out.append((Substep(SubstepKind(self.getSubstepKind(i)), c, groups).label, c))
         return out
 
     def describe(self) -> str:
@@ -144,7 +127,7 @@ class NativeSymplecticIntegrator(SymplecticIntegrator, _PluginIntegrator, backen
                 f"  program: splitting, {self.getNumSubsteps()} kicks and drifts, constraints="
                 f"{'RATTLE' if self.program_info.constraints else 'none'}, force evaluations per step: "
                 f"{self.force_evals}, exact momentum: {self.getExactMomentum()}"
-                + (f"\n  {describe_levels(self.mts_levels, self.program_info.evals_per_group)}" if self.mts_levels else ""))
+                + (f"\n  {self.resolved.describe_levels()}" if self.mts_levels else ""))
 
 
 # IntegratorBase.step must come before the plugin's own step in the method resolution order.

@@ -33,9 +33,8 @@ from dataclasses import dataclass, field
 import numpy as np
 import openmm as mm
 
-from ..methods.respa import evaluations_per_step, label_groups
-from ..methods.splitting import DRIFT, Splitting
-from ..methods.tableau import PRKTableau, TableauError
+from ..methods.resolved import ConstraintSupportError, ResolvedMethod, SubstepKind
+from ..methods.tableau import PRKTableau
 
 #: Global variables every compiled program has, in this order (read by the integrator classes).
 SIGNATURE_VAR = "symprk_signature"
@@ -50,10 +49,6 @@ NONCONV_VAR = "symprk_nonconverged"
 ITER_VAR = "symprk_iterations"
 #: Squared speed limit used when only NaN and infinity count as a blow-up (inf in single precision too).
 NONFINITE_LIMIT2 = "1e300"
-
-
-class ConstraintSupportError(ValueError):
-    """The method cannot be used on a system with constraints."""
 
 
 @dataclass
@@ -156,7 +151,8 @@ class _Emitter:
                 self.ig.addComputePerDof("v", f"v + {_num(c)}*dt*{force}/m")
 
     def project_velocities(self):
-        """A velocity projection inside a step (see Splitting.projected_drifts)."""
+        """A velocity projection inside a step (a drift flagged ``project_before``, see
+        :func:`openmm_symprk.methods.resolved.projected_drifts`)."""
         if not self.constraints:
             return
         if self.exact_momentum:
@@ -201,26 +197,23 @@ class _Emitter:
         return signature
 
 
-def compile_splitting(integrator, splitting: Splitting, constraints: bool, exact_momentum=False,
+def compile_splitting(integrator, method: ResolvedMethod, constraints: bool, exact_momentum=False,
                       check_finite=True, update_context_state=True, max_speed=0.0) -> ProgramInfo:
-    """Emit the program of a kick/drift sequence (RATTLE when ``constraints``)."""
+    """Emit the program of a resolved kick/drift method: its sub-steps as they run, with a velocity projection
+    before every drift flagged for one.  ``constraints``: emit the RATTLE steps (the System has constraints, or
+    virtual sites that only ConstrainPositions places on the Common platforms)."""
     em = _Emitter(integrator, constraints, exact_momentum, update_context_state)
-    projected = set(splitting.projected_drifts())
-    for i, (label, c) in enumerate(splitting.coefficients(np.float64)):
-        if label == DRIFT:
-            if i in projected:
+    for sub in method.substeps:
+        c = float(sub.coefficient)
+        if sub.kind == SubstepKind.DRIFT:
+            if sub.project_before:
                 em.project_velocities()
             em.drift(c)
         else:
-            try:
-                groups = label_groups(label)
-            except ValueError:
-                raise TableauError(f"a kick/drift splitting cannot contain a {label!r} sub-flow") from None
-            em.kick(c, groups)
+            em.kick(c, sub.groups)
     sig = em.finish(check_finite, max_speed)
-    per_group = evaluations_per_step(splitting)
-    return ProgramInfo("splitting", constraints, sum(per_group.values()), len(splitting), exact_momentum,
-                       signature=sig, evals_per_group=per_group if list(per_group) != [None] else None)
+    return ProgramInfo("splitting", constraints, method.force_evals, len(method.substeps), exact_momentum,
+                       signature=sig, evals_per_group=method.evaluations or None)
 
 
 def _lincomb(base: str, coeffs, names) -> str:
@@ -316,36 +309,15 @@ def compile_tableau(integrator, tab: PRKTableau, exact_momentum=False, check_fin
     return ProgramInfo(kind, False, evals, s, exact_momentum, notes, signature=sig)
 
 
-def compile_program(integrator, method, constraints: bool, virtual_sites: bool = False, **options) -> ProgramInfo:
-    """Compile a catalogue Method, a Splitting or a PRKTableau into ``integrator``'s program.
+def compile_program(integrator, method: ResolvedMethod, virtual_sites: bool = False, **options) -> ProgramInfo:
+    """Compile a resolved method (:func:`openmm_symprk.methods.resolved.resolve`) into ``integrator``'s program.
 
-    ``constraints``: the System has constraints (RATTLE steps; compositions are taken over the RATTLE base;
-    general tableaux are refused).  ``virtual_sites``: it has virtual sites (splittings get the RATTLE steps,
-    whose ConstrainPositions places them; general tableaux end the step with one)."""
-    from ..methods.catalogue import Method
-
-    if isinstance(method, Method):
-        name = method.name
-        if method.is_splitting:
-            method = method.constrained_splitting if constraints else method.splitting
-        else:
-            method = method.tableau()
-    else:
-        name = getattr(method, "name", "user tableau")
-    if isinstance(method, PRKTableau):
-        try:
-            method = method.to_splitting()
-        except TableauError:
-            pass
+    A kick/drift method gets RATTLE steps where it was resolved with constraints or the System has
+    ``virtual_sites`` (whose ConstrainPositions places them); a general PRK pair (resolved without constraints)
+    ends the step with a ConstrainPositions where there are virtual sites."""
     common = ("exact_momentum", "check_finite", "update_context_state", "max_speed")
-    if isinstance(method, Splitting):
+    if method.is_splitting:
         keep = {k: v for k, v in options.items() if k in common}
-        return compile_splitting(integrator, method, constraints or virtual_sites, **keep)
-    if constraints:
-        raise ConstraintSupportError(
-            f"method {name!r} is a general (non-splitting) PRK tableau and cannot keep constraints: the "
-            f"system has constraints (rigid water, HBonds, ...). Use a kick/drift method instead, e.g. "
-            f"'verlet' (RATTLE), 'yoshida-4' or 'blanes-moan-srkn6b-4', or create the system with "
-            f"constraints=None and rigidWater=False.")
+        return compile_splitting(integrator, method, method.constraints or virtual_sites, **keep)
     keep = {k: v for k, v in options.items() if k in common + ("tolerance", "max_iterations")}
-    return compile_tableau(integrator, method, place_virtual_sites=virtual_sites, **keep)
+    return compile_tableau(integrator, method.tableau, place_virtual_sites=virtual_sites, **keep)

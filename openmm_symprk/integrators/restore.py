@@ -10,14 +10,17 @@ from what the XML carries (the metadata of a CustomIntegrator program; the plugi
 """
 from __future__ import annotations
 
+from dataclasses import replace
+
 import openmm as mm
 
 from .. import plugin
-from ..methods.catalogue import get_method
+from ..methods.catalogue import methods as catalogue_methods
+from ..methods.resolved import resolve
+from ..methods.splitting import Splitting
 from ..systems.properties import SystemSignature
 from . import program
 from .custom import CustomSymplecticIntegrator, PRKIntegrator, read_metadata
-from .mts import mts_splitting
 from .native import NativeSymplecticIntegrator, native_available
 from .program import ProgramInfo
 
@@ -60,24 +63,26 @@ def _restore_custom(integrator: mm.CustomIntegrator):
     kind = "implicit" if program.NONCONV_VAR in names else (
         "splitting" if not any(var.startswith("symprk_k") for _, var, _ in steps) else "explicit")
     constraints = any(k == mm.CustomIntegrator.ConstrainPositions for k, _, _ in steps) and kind == "splitting"
-    method = get_method(catalogue) if catalogue else None
     options = meta.get("options", {})
     system = meta.get("system")
-    mts_levels = None
-    if options.get("groups") and method is not None:
-        mts_levels = mts_splitting(method, [tuple(g) for g in options["groups"]], options.get("inner_method"),
-                                   constraints)[1]
+    catalogue = meta.get("catalogue")
+    # a catalogue method is resolved again as it was compiled (its sub-steps, orders, levels); a user tableau's
+    # program carries no description of it
+    groups = options.get("groups")
+    resolved = resolve(catalogue, constraints=constraints, groups=[tuple(g) for g in groups] if groups else None,
+                       inner_method=options.get("inner_method") if groups else None) if catalogue else None
+    obj.method_name = meta.get("method", "user tableau")
+    obj._set_resolved(resolved)
     obj.__dict__.update(
-        method=method, method_name=meta.get("method", "user tableau"), mts_levels=mts_levels,
-        tableau=method.tableau() if method is not None and mts_levels is None else None,
         check_finite=bool(options.get("check_finite", True)), max_speed=float(options.get("max_speed") or 0.0),
         exact_momentum=bool(options.get("exact_momentum", False)),
         compiled_for=SystemSignature(**system) if system else None, _masses=None,
         _signature=obj.getGlobalVariable(0),
-        program_info=ProgramInfo(kind, constraints, method.force_evals if method is not None else None,
-                                 len(method.splitting) if method is not None and method.is_splitting else 0,
+        program_info=ProgramInfo(kind, constraints, resolved.force_evals if resolved is not None else None,
+                                 len(resolved.substeps) if resolved is not None else 0,
                                  bool(options.get("exact_momentum", False)), ["restored from XML"],
-                                 signature=int(obj.getGlobalVariable(0))))
+                                 signature=int(obj.getGlobalVariable(0)),
+                                 evals_per_group=(resolved.evaluations or None) if resolved is not None else None))
     obj._reset_binding()
     return obj
 
@@ -85,18 +90,31 @@ def _restore_custom(integrator: mm.CustomIntegrator):
 def _restore_native(integrator):
     obj = object.__new__(NativeSymplecticIntegrator)
     obj._adopt(integrator)
-    m = get_method(obj.getMethodName()) if obj.getMethodName() else None
-    from ..methods.splitting import Splitting
-
-    splitting = Splitting(obj.substeps())  # force groups of a multiple-time-step method live in the plugin
+    name = obj.getMethodName() or "user splitting"
     expected = obj.getExpectedNumParticles()
-    obj.__dict__.update(
-        method=m, method_name=obj.getMethodName() or "user splitting", splitting=splitting, check_finite=True,
-        mts_levels=None,
-        max_speed=float(obj.getMaxSpeed()), exact_momentum=bool(obj.getExactMomentum()), compiled_for=None,
-        program_info=ProgramInfo("splitting", bool(obj.getExpectedConstraints()) if expected >= 0 else True,
-                                 int(obj.getForceEvaluationsPerStep()), obj.getNumSubsteps(),
-                                 bool(obj.getExactMomentum()), ["native SymPRKIntegrator plugin", "restored from XML"],
-                                 signature=int(obj.getProgramSignature())))
+    constraints = bool(obj.getExpectedConstraints()) if expected >= 0 else True
+    plugin_steps = [(obj.getSubstepKind(i), obj.getSubstepCoefficient(i), obj.getSubstepForceGroups(i),
+                     obj.getSubstepFlags(i)) for i in range(obj.getNumSubsteps())]
+
+    def runs_as_plugin(r):
+        return [(int(s.kind), float(s.coefficient), s.group_mask, int(s.flags)) for s in r.substeps] == plugin_steps
+
+    # a catalogue method resolved again (exact coefficients) if that is what the plugin runs; otherwise (multiple
+    # time stepping, a user splitting) the plugin's sub-steps as they run, with the catalogue's orders if named
+    resolved = resolve(name, constraints=constraints) if name in catalogue_methods else None
+    if resolved is None or not runs_as_plugin(resolved):
+        resolved = resolve(Splitting(obj.substeps()), constraints=constraints, name=name)
+        if not runs_as_plugin(resolved):
+            raise ValueError(f"the SymPRKIntegrator {name!r} read from XML runs sub-steps {plugin_steps} (kind, "
+                             f"coefficient, force groups, flags) whose flags its sequence would not get: it was not "
+                             f"built by openmm_symprk")
+        if name in catalogue_methods:
+            entry = catalogue_methods[name]
+            resolved = replace(resolved, entry=entry, order=entry.order, constrained_order=entry.constrained_order,
+                               stability=entry.stability)
+    obj._set_resolved(resolved)
+    obj.__dict__.update(check_finite=True, max_speed=float(obj.getMaxSpeed()), exact_momentum=bool(obj.getExactMomentum()),
+                        compiled_for=None)
+    obj.program_info.notes.append("restored from XML")
     obj._reset_binding()
     return obj

@@ -12,6 +12,7 @@ from typing import Callable
 import numpy as np
 
 from .orders import observed_orders
+from .resolved import resolve
 from .splitting import KICK, Splitting
 from .tableau import PRKTableau
 
@@ -95,27 +96,22 @@ def prk_step(tab: PRKTableau, force: Callable, q, p, h, tol=None, max_iter=100):
 
 
 def integrate(method, force: Callable, q0, p0, h, n_steps: int, dtype=np.float64, trajectory=False):
-    """Integrate ``n_steps`` steps of a catalogue Method, Splitting or PRKTableau.
+    """Integrate ``n_steps`` steps of a method name, catalogue Method, Splitting, PRKTableau or ResolvedMethod
+    (resolved without constraints: a model problem has none).
 
-    Returns (q, p) at the end, or arrays of shape (n_steps+1, ...) with ``trajectory=True``."""
-    from .catalogue import Method, get_method
-
-    if isinstance(method, str):
-        method = get_method(method)
+    A kick/drift method runs its sequence; a PRKTableau given as such (even one in splitting form) and every
+    general pair run their stages.  Returns (q, p) at the end, or arrays of shape (n_steps+1, ...) with
+    ``trajectory=True``."""
+    r = resolve(method)
     q = np.array(q0, dtype=dtype)
     p = np.array(p0, dtype=dtype)
     h = dtype(h) if not isinstance(h, np.ndarray) else h.astype(dtype)
-    if isinstance(method, Method):
-        method = method.splitting if method.is_splitting else method.tableau(dtype)
-    if isinstance(method, Splitting):
-        coeffs = method.coefficients(dtype)
-        step = lambda q, p: splitting_step(method, force, q, p, h, coefficients=coeffs)
-    elif isinstance(method, PRKTableau):
-        if method.dtype != np.dtype(dtype):
-            method = PRKTableau(method.A, method.b, method.A_hat, method.b_hat, name=method.name, dtype=dtype)
-        step = lambda q, p: prk_step(method, force, q, p, h)
+    if r.is_splitting and not isinstance(method, PRKTableau):
+        coeffs = r.splitting.coefficients(dtype)
+        step = lambda q, p: splitting_step(r.splitting, force, q, p, h, coefficients=coeffs)
     else:
-        raise TypeError(f"expected a method name, Method, Splitting or PRKTableau, got {method!r}")
+        tab = r.tableau_in(dtype)
+        step = lambda q, p: prk_step(tab, force, q, p, h)
     qs, ps = [q], [p]
     for _ in range(n_steps):
         q, p = step(q, p)

@@ -11,6 +11,7 @@ at the end (:meth:`Splitting.coefficients`).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 from fractions import Fraction
 from typing import Iterable, Sequence
 
@@ -92,42 +93,29 @@ class Splitting:
         w = exact(weight)
         return Splitting((label, w * c) for label, c in self.steps)
 
+    @cached_property
+    def evaluating_kicks(self) -> frozenset:
+        """Indices (into ``steps``) of the sub-flows that need a fresh evaluation of their forces in a long run.
+
+        The one rule of the package for cached forces: a sub-flow of a kick label needs an evaluation when the
+        positions changed (a drift) since the previous sub-flow of the same label, counted cyclically: the
+        closing evaluation of a step is reused by the next step's opening one when no drift separates them
+        (first same as last).  Kicks of other labels (force groups of a multiple-time-step sequence) do not
+        move the positions.  Every other kick runs on cached forces."""
+        out = set()
+        n = len(self.steps)
+        for label in dict.fromkeys(lab for lab in self.labels if lab != DRIFT):
+            kicks = [i for i, (lab, _) in enumerate(self.steps) if lab == label]
+            for k, i in enumerate(kicks):
+                previous = kicks[k - 1]  # cyclically: the last one of the previous step for the first
+                between = range(previous + 1, i) if previous < i else list(range(previous + 1, n)) + list(range(i))
+                if len(kicks) == 1 or any(self.steps[j][0] == DRIFT for j in between):
+                    out.add(i)
+        return frozenset(out)
+
     def force_evaluations(self, label: str = KICK) -> int:
-        """Evaluations of the ``label`` part per step in a long run.
-
-        A sub-flow of ``label`` needs an evaluation when the positions changed (a drift) since the previous
-        sub-flow of the same label, counted cyclically: the closing evaluation of a step is reused by the next
-        step's opening one when no drift separates them (first same as last).  Kicks of other labels (force
-        groups of a multiple-time-step sequence) do not move the positions."""
-        kicks = [i for i, (lab, _) in enumerate(self.steps) if lab == label]
-        if not kicks:
-            return 0
-        n, count = len(self.steps), 0
-        for k, i in enumerate(kicks):
-            previous = kicks[k - 1]  # cyclically: the last one of the previous step for the first
-            between = range(previous + 1, i) if previous < i else list(range(previous + 1, n)) + list(range(i))
-            if len(kicks) == 1 or any(self.steps[j][0] == DRIFT for j in between):
-                count += 1
-        return count
-
-    def projected_drifts(self) -> list:
-        """Indices (into ``steps``) of the drifts before which a constrained step projects the velocities.
-
-        Under constraints a drift x += c h v is followed by SHAKE and v += (x - x_u)/(c h): a constraint
-        solver that stops at its tolerance leaves a residual delta in x and so delta/(c h) in v along the
-        bonds, which the next drift c' turns into a position error (c'/c) delta.  Where |c'| > |c| (pefrl:
-        0.775 after -0.066, a factor 11.7) that grows from drift to drift faster than the solver, which does
-        nothing below its tolerance, removes it.  A velocity projection at the current (constrained)
-        positions just before such a drift removes the along-bond velocity; in exact arithmetic it changes
-        nothing, since the drift's own position projection acts along the same bond vectors and absorbs it.
-        So: every drift whose |coefficient| exceeds the previous drift's within the step."""
-        out, previous = [], None
-        for i, (label, c) in enumerate(self.steps):
-            if label == DRIFT:
-                if previous is not None and abs(c) > abs(previous):
-                    out.append(i)
-                previous = c
-        return out
+        """Evaluations of the ``label`` part per step in a long run (see :attr:`evaluating_kicks`)."""
+        return sum(1 for i in self.evaluating_kicks if self.steps[i][0] == label)
 
     def __len__(self):
         return len(self.steps)

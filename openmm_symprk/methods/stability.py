@@ -11,7 +11,7 @@ import math
 
 import numpy as np
 
-from .splitting import Splitting
+from .resolved import resolve
 from .tableau import PRKTableau
 
 
@@ -77,14 +77,12 @@ def stability_interval(method, x_max: float = 20.0, resolution: float = 1e-3, to
     1 - spectral radius that come close to zero; each such minimum is refined by a bounded scalar
     minimisation.  The first unstable point found is then bisected against the last stable one to
     ``tol``.  Returns inf if the method is stable on the whole scan range."""
-    from scipy.optimize import minimize_scalar
+    from ..support import require
 
-    from .catalogue import Method, get_method
+    minimize_scalar = require("scipy.optimize", "analysis", "openmm_symprk.methods.stability.stability_interval"
+                              ).minimize_scalar
 
-    if isinstance(method, str):
-        method = get_method(method)
-    tab = method.tableau() if isinstance(method, Method) else (
-        PRKTableau.from_splitting(method) if isinstance(method, Splitting) else method)
+    tab = resolve(method).tableau_in(np.float64)  # the method's own PRK pair (a name, Method, Splitting, ...)
     grid = np.arange(resolution, x_max + resolution, resolution)
     g = _margin(tab, grid)
     first_bad = None

@@ -12,6 +12,7 @@ gives symplecticity and conservation of angular momentum (docs/theory.md, sectio
 from __future__ import annotations
 
 from fractions import Fraction
+from functools import cached_property
 from typing import Sequence
 
 import numpy as np
@@ -56,16 +57,40 @@ class PRKTableau:
     precision the arrays are stored in.  Construction checks shapes, finiteness and consistency
     (sum b = sum b_hat = 1); symplecticity is *reported* (:attr:`residual_6`, :attr:`residual_7`)
     and enforced by the integrators, which refuse a non-symplectic pair unless told otherwise.
+
+    A tableau is immutable (read-only arrays, no attribute can be set after construction), so its derived
+    facts (residuals, explicit order, splitting form) are computed once, on first use, and kept; two
+    tableaux with the same arrays and precision are equal and hash alike, whatever their names.
     """
 
     def __init__(self, A, b, A_hat, b_hat, name: str | None = None, dtype=np.float64):
-        self.name = name or "user tableau"
-        self.dtype = np.dtype(dtype)
-        self.A = _as_array("A", A, dtype)
-        self.b = _as_array("b", b, dtype)
-        self.A_hat = _as_array("A_hat", A_hat, dtype)
-        self.b_hat = _as_array("b_hat", b_hat, dtype)
+        init = object.__setattr__
+        init(self, "name", name or "user tableau")
+        init(self, "dtype", np.dtype(dtype))
+        for label, value in (("A", A), ("b", b), ("A_hat", A_hat), ("b_hat", b_hat)):
+            arr = _as_array(label, value, dtype)
+            arr = np.array(arr, dtype=arr.dtype, copy=True)  # never a view of the caller's array
+            arr.setflags(write=False)
+            init(self, label, arr)
         self._validate()
+
+    def __setattr__(self, name, value):
+        raise AttributeError(f"a PRKTableau is immutable: cannot set {name!r} (build a new PRKTableau instead)")
+
+    def __delattr__(self, name):
+        raise AttributeError(f"a PRKTableau is immutable: cannot delete {name!r}")
+
+    def __eq__(self, other):
+        if not isinstance(other, PRKTableau):
+            return NotImplemented
+        return self.dtype == other.dtype and all(
+            np.array_equal(getattr(self, k), getattr(other, k)) for k in ("A", "b", "A_hat", "b_hat"))
+
+    def __hash__(self):
+        return hash((str(self.dtype),) + tuple(getattr(self, k).tobytes() for k in ("A", "b", "A_hat", "b_hat")))
+
+    def __reduce__(self):
+        return (PRKTableau, (self.A, self.b, self.A_hat, self.b_hat, self.name, self.dtype))
 
     # -- validation ---------------------------------------------------------------------
     def _validate(self):
@@ -94,39 +119,43 @@ class PRKTableau:
     def stages(self) -> int:
         return self.b.size
 
-    @property
+    @cached_property
     def c(self):
-        return self.A.sum(axis=1)
+        c = self.A.sum(axis=1)
+        c.setflags(write=False)
+        return c
 
-    @property
+    @cached_property
     def c_hat(self):
-        return self.A_hat.sum(axis=1)
+        c = self.A_hat.sum(axis=1)
+        c.setflags(write=False)
+        return c
 
     def symplectic_residual_matrix(self):
         """B A_hat + A^T B_hat - b b_hat^T (Reich's condition (6))."""
         return np.diag(self.b) @ self.A_hat + self.A.T @ np.diag(self.b_hat) - np.outer(self.b, self.b_hat)
 
-    @property
+    @cached_property
     def residual_6(self) -> float:
         """max |B A_hat + A^T B_hat - b b_hat^T|: zero for a symplectic PRK method."""
         return float(np.max(np.abs(self.symplectic_residual_matrix())))
 
-    @property
+    @cached_property
     def residual_7(self) -> float:
         """max |b - b_hat|: zero is also needed for non-separable H (not for MD)."""
         return float(np.max(np.abs(self.b - self.b_hat)))
 
-    @property
+    @cached_property
     def is_symplectic(self) -> bool:
         """Symplectic (and angular-momentum conserving) for separable H: condition (6)."""
         return self.residual_6 <= SYMPLECTIC_TOL
 
-    @property
+    @cached_property
     def is_symplectic_general(self) -> bool:
         """Conditions (6) and (7): symplectic for any H."""
         return self.is_symplectic and self.residual_7 <= SYMPLECTIC_TOL
 
-    @property
+    @cached_property
     def explicit_order(self):
         """'q-first' if Q_i needs only P_j, j < i (A strictly lower, A_hat lower); 'p-first' for the
         mirror case; None for an implicit pair."""
@@ -181,6 +210,14 @@ class PRKTableau:
         A = [[alphas[j] if j < i else Fraction(0) for j in range(s)] for i in range(s)]
         Ah = [[betas[j] if j <= i else Fraction(0) for j in range(s)] for i in range(s)]
         return cls(A, alphas, Ah, betas, name=name, dtype=dtype)
+
+    @cached_property
+    def splitting(self) -> Splitting | None:
+        """The kick/drift sequence of a tableau in splitting form, None for any other pair (computed once)."""
+        try:
+            return self.to_splitting()
+        except TableauError:
+            return None
 
     def to_splitting(self, tol: float = 1e-14) -> Splitting:
         """The kick/drift sequence of a tableau in splitting form; TableauError otherwise."""

@@ -26,6 +26,7 @@ import openmm as mm
 import openmm.unit as unit
 
 from ..methods.catalogue import methods as catalogue_methods
+from ..methods.resolved import resolve
 from ..methods.splitting import DRIFT, KICK, Splitting
 from ..physics.momenta import molecule_frames
 from .lie_poisson import splitting_of
@@ -60,12 +61,12 @@ class RigidBodies:
                  platform="CPU", properties=None):
         if not step_ps > 0:
             raise ValueError(f"step_ps must be positive, got {step_ps!r}")
-        entry = catalogue_methods[method]
-        if entry.splitting is None or set(entry.splitting.labels) - {KICK, DRIFT}:
+        resolved = resolve(method)  # rigidity is exact: no constraint steps
+        if not resolved.is_splitting or set(resolved.splitting.labels) - {KICK, DRIFT}:
             raise ValueError(f"method {method!r} is not a kick/drift splitting; use one of "
                              f"{', '.join(m.name for m in catalogue_methods.by_family('splitting'))}")
-        self.method, self.h = entry.name, float(step_ps)
-        self.splitting: Splitting = entry.splitting
+        self.method, self.h = resolved.name, float(step_ps)
+        self.splitting: Splitting = resolved.splitting
         self.rotor = [(int(label[1]) - 1, float(c)) for label, c in splitting_of("splitting-2").coefficients()]
         self.m = np.array([system.getParticleMass(i).value_in_unit(unit.dalton) for i in range(system.getNumParticles())])
         self.idx = np.asarray(molecules, dtype=int)

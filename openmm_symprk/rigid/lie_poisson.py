@@ -39,10 +39,12 @@ from dataclasses import dataclass
 from functools import lru_cache
 
 import numpy as np
-from scipy.special import ellipj, ellipk, ellipkinc
 
+from ..methods.catalogue import UnknownMethodError
 from ..methods.catalogue import methods as catalogue_methods
+from ..methods.resolved import resolve
 from ..methods.splitting import Splitting, compose
+from ..support import require
 
 __all__ = [
     "METHODS", "RigidBodyMethod", "euler_rhs", "energy", "casimir", "integrate", "step",
@@ -94,13 +96,18 @@ METHODS: dict = _build_methods()
 def _resolve(method) -> RigidBodyMethod:
     if isinstance(method, RigidBodyMethod):
         return method
-    if not isinstance(method, str):
-        raise ValueError(f"method must be a name (one of {', '.join(METHODS)}), got {method!r}")
-    key = method.strip().lower().replace("_", "-").replace(" ", "-")
+    key = method.strip().lower().replace("_", "-").replace(" ", "-") if isinstance(method, str) else None
     if key in METHODS:
         return METHODS[key]
-    if key in catalogue_methods and catalogue_methods[key].family == "composition":  # catalogue aliases
-        return METHODS[catalogue_methods[key].name]
+    try:  # a catalogue composition by name or alias, as a Method or resolved: its weights over splitting-2
+        resolved = resolve(method)
+    except (UnknownMethodError, TypeError):
+        resolved = None
+    if resolved is not None and resolved.kind == "composition":
+        return METHODS[resolved.name]
+    if key is None:
+        raise ValueError(f"method must be a name (one of {', '.join(METHODS)}) or a catalogue composition, "
+                         f"got {method!r}")
     close = difflib.get_close_matches(key, list(METHODS), n=3, cutoff=0.5)
     hint = f" Did you mean {', '.join(repr(c) for c in close)}?" if close else ""
     raise ValueError(f"unknown rigid-body method {method!r}.{hint} Known methods: {', '.join(METHODS)}.")
@@ -353,6 +360,8 @@ def exact_solution(x0, moments, times) -> np.ndarray:
     (Landau-Lifshitz §37), with σ, s_c fixed by x0 and by the sense of rotation (the ODE).  On the
     separatrix (m = 1) cn = dn = sech and sn = tanh.  Symmetric tops rotate about the distinct axis in
     closed form; a spherical top (or x = 0) stays put."""
+    special = require("scipy.special", "analysis", "openmm_symprk.rigid.lie_poisson.exact_solution")
+    ellipj, ellipk, ellipkinc = special.ellipj, special.ellipk, special.ellipkinc
     x0 = _check_x(x0)
     M = _check_moments(moments)
     t = np.atleast_1d(np.asarray(times, dtype=float))

@@ -19,7 +19,6 @@ from __future__ import annotations
 import argparse
 
 import openmm as mm
-import openmm.app as app
 import openmm.unit as unit
 
 from .timing import interleaved
@@ -36,13 +35,10 @@ def water_cluster_system(n_waters: int):
 
 def water_box_system(box_nm: float):
     from ..systems.prepare import maxwell_boltzmann, minimise
+    from ..systems.scenes import water_box
 
-    ff = app.ForceField("amber14/tip3p.xml")
-    mod = app.Modeller(app.Topology(), [])
-    mod.addSolvent(ff, model="tip3p", boxSize=mm.Vec3(box_nm, box_nm, box_nm) * unit.nanometer)
-    system = ff.createSystem(mod.topology, nonbondedMethod=app.PME, nonbondedCutoff=1.0 * unit.nanometer,
-                             constraints=app.HBonds, rigidWater=True, removeCMMotion=False)
-    pos = minimise(system, mod.positions, "CPU", tolerance=10.0, max_iterations=200)
+    system, _, x = water_box("tip3p", box_nm=box_nm, cutoff_nm=1.0)
+    pos = minimise(system, x, "CPU", tolerance=10.0, max_iterations=200)
     vel = maxwell_boltzmann(system, pos, 300.0, seed=7)
     return f"rigid TIP3P water box, PME 1 nm, {system.getNumParticles()} atoms", system, pos, vel
 

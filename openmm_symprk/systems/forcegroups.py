@@ -92,8 +92,9 @@ def split_forces(system: mm.System, slow="reciprocal", substeps: int = 2, fast_g
                 raise ValueError(f"slow forces {bad} are not in the System (it has {', '.join(sorted(known))}; "
                                  f"or give indices 0-{len(forces) - 1})")
             is_slow = [i in names or type(f).__name__ in names for i, f in enumerate(forces)]
-        if not any(is_slow):
-            raise ValueError(f"no force of the System is slow under slow={slow!r}")
+        if not any(s and type(f).__name__ not in NOT_FORCES for f, s in zip(forces, is_slow)):
+            raise ValueError(f"no force of the System is slow under slow={slow!r} ({', '.join(NOT_FORCES[:2])} and "
+                             f"barostats are not forces on the dynamics and belong to no group)")
         for f, s in zip(forces, is_slow):
             f.setForceGroup(slow_group if s else fast_group)
             if isinstance(f, mm.NonbondedForce):

@@ -28,7 +28,8 @@ def _nm(positions) -> np.ndarray:
 def minimise(system: mm.System, positions, platform="Reference", tolerance: float = 10.0,
              max_iterations: int = 200, properties=None) -> np.ndarray:
     """Constrained, energy-minimised positions (nm): constraints applied to 1e-10, then OpenMM's
-    LocalEnergyMinimizer to ``tolerance`` kJ/mol/nm or ``max_iterations`` iterations."""
+    LocalEnergyMinimizer to ``tolerance`` kJ/mol/nm or ``max_iterations`` iterations (it keeps the constraints
+    to the Context's constraint tolerance, OpenMM's default 1e-5 relative)."""
     ctx = _context(system, platform, properties)
     try:
         ctx.setPositions(_nm(positions))
@@ -65,12 +66,14 @@ def maxwell_boltzmann(system: mm.System, positions, temperature: float, seed: in
     x = _nm(positions)
     kT = R_KJ * temperature
     v = rng.normal(size=(len(m), 3)) * np.sqrt(kT / np.where(m > 0, m, 1.0))[:, None]
-    v[m == 0] = 0.0
     v -= (m[:, None] * v).sum(0) / m.sum()
+    v[m == 0] = 0.0  # after the net momentum is taken out (it would give them the centre-of-mass velocity)
     if angular_velocity is not None:
         spin = np.cross(np.asarray(angular_velocity, dtype=float), x - centre_of_mass(x, m))
         v += np.where(m[:, None] > 0, spin, 0.0)
-    return constrain_velocities(system, x, v)
+    v = constrain_velocities(system, x, v)
+    v[m == 0] = 0.0  # the momentum correction above moved them too
+    return v
 
 
 def equilibrate(system: mm.System, positions, temperature: float, picoseconds: float, seed: int,

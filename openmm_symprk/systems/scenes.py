@@ -7,12 +7,12 @@
 * :func:`morse_molecule` -- a small flexible molecule with Morse bonds and a cosine angle term: nonlinear
   forces in a handful of atoms, the smallest OpenMM system that measures convergence orders.
 
-Every scene returns a :class:`Scene` (system, topology, positions, velocities) built from a seed, so
+* :func:`water_box` -- the periodic box of rigid water (PME) that the studies and the bench measure on.
+
+Every scene returns a :class:`~.scene.Scene` (system, positions, velocities, topology) built from a seed, so
 all runs of a study start from one shared state.
 """
 from __future__ import annotations
-
-from dataclasses import dataclass
 
 import numpy as np
 import openmm as mm
@@ -20,36 +20,11 @@ import openmm.app as app
 import openmm.unit as unit
 
 from .prepare import constrain_velocities, maxwell_boltzmann, minimise
-from .properties import masses
+from .scene import Scene
 
 #: TIP3P geometry (nm, radians)
 _R_OH = 0.09572
 _THETA = np.deg2rad(104.52)
-
-
-@dataclass
-class Scene:
-    name: str
-    system: mm.System
-    topology: app.Topology
-    positions: np.ndarray  # nm, (N, 3)
-    velocities: np.ndarray  # nm/ps, (N, 3)
-    description: str = ""
-
-    @property
-    def n_atoms(self) -> int:
-        return self.system.getNumParticles()
-
-    def masses(self) -> np.ndarray:
-        return masses(self.system)
-
-    def context(self, integrator, platform="Reference", properties=None):
-        """A Context at the scene's initial state on the named platform."""
-        plat = mm.Platform.getPlatformByName(platform) if isinstance(platform, str) else platform
-        ctx = mm.Context(self.system, integrator, plat, properties or {})
-        ctx.setPositions(self.positions)
-        ctx.setVelocities(self.velocities)
-        return ctx
 
 
 def _water_topology(n):
@@ -106,8 +81,8 @@ def water_cluster(n_waters: int = 27, rigid: bool = True, temperature: float = 1
         pos = minimise(system, pos, tolerance=1.0)
     vel = maxwell_boltzmann(system, pos, temperature, rng, angular_velocity)
     kind = "rigid (SETTLE)" if rigid else "flexible"
-    return Scene(f"water-cluster-{n_waters}{'' if rigid else '-flexible'}", system, top, np.array(pos), vel,
-                 f"{n_waters} {kind} TIP3P waters in vacuum, spinning at {tuple(angular_velocity)} rad/ps")
+    return Scene(f"water-cluster-{n_waters}{'' if rigid else '-flexible'}", system, np.array(pos), vel,
+                 f"{n_waters} {kind} TIP3P waters in vacuum, spinning at {tuple(angular_velocity)} rad/ps", top)
 
 
 def _add_flexible_water_terms(system, n_waters):
@@ -156,7 +131,7 @@ def morse_molecule(seed: int = 3, temperature: float = 300.0, angular_velocity=(
     pos = np.array([[0.0, 0.0, 0.0], [0.15, 0.0, 0.0], [0.2, 0.14, 0.0], [0.35, 0.16, 0.05]])
     pos += rng.normal(scale=0.005, size=pos.shape)
     vel = maxwell_boltzmann(system, pos, temperature, rng, angular_velocity)
-    return Scene("morse-molecule", system, top, pos, vel, "4-atom Morse chain in vacuum (nonlinear, unconstrained)")
+    return Scene("morse-molecule", system, pos, vel, "4-atom Morse chain in vacuum (nonlinear, unconstrained)", top)
 
 
 def constrained_molecule(seed: int = 3) -> Scene:
@@ -168,8 +143,8 @@ def constrained_molecule(seed: int = 3) -> Scene:
         d = float(np.linalg.norm(sc.positions[i + 1] - sc.positions[i]))
         system.addConstraint(i, i + 1, d)
     vel = constrain_velocities(system, sc.positions, sc.velocities)
-    return Scene("constrained-molecule", system, sc.topology, sc.positions, vel,
-                 "4-atom chain with 3 distance constraints, angle and 1-4 terms (nonlinear, constrained)")
+    return Scene("constrained-molecule", system, sc.positions, vel,
+                 "4-atom chain with 3 distance constraints, angle and 1-4 terms (nonlinear, constrained)", sc.topology)
 
 
 def _openmm_data(name):
@@ -194,31 +169,43 @@ def protein_vacuum(constraints=app.HBonds, temperature: float = 300.0, angular_v
     if minimize:
         pos = minimise(system, pos, tolerance=10.0)
     vel = maxwell_boltzmann(system, pos, temperature, seed, angular_velocity)
-    return Scene("villin-vacuum", system, mod.topology, np.array(pos), vel,
+    return Scene("villin-vacuum", system, np.array(pos), vel,
                  f"villin headpiece (test.pdb, {system.getNumParticles()} atoms) in vacuum, amber14, "
-                 f"{system.getNumConstraints()} constraints")
+                 f"{system.getNumConstraints()} constraints", mod.topology)
 
 
 #: Rigid water models for :func:`water_box`: name -> (force field file, Modeller model name).
 WATER_MODELS = {"spce": ("amber14/spce.xml", "spce"), "tip3p": ("amber14/tip3p.xml", "tip3p")}
 
 
-def water_box(model: str = "spce", n_waters: int = 216, cutoff_nm: float = 0.9):
-    """A periodic box of ``n_waters`` rigid waters (SETTLE), PME with ``cutoff_nm``, no CMMotionRemover (so
-    an NVE run conserves the total momentum and the translational degrees of freedom are 3 N - 3).
+def water_box(model: str = "spce", n_waters: int | None = None, cutoff_nm: float = 0.9, box_nm: float | None = None,
+              ewald_tolerance: float | None = None, forcefields=None):
+    """A periodic box of rigid waters (SETTLE), PME with ``cutoff_nm``, no CMMotionRemover (so an NVE run conserves
+    the total momentum and the translational degrees of freedom are 3 N - 3): ``n_waters`` molecules (default 216),
+    or a cubic box of side ``box_nm``.  ``ewald_tolerance``: OpenMM's ewaldErrorTolerance (default 5e-4);
+    ``forcefields``: the force-field files (default the model's own).  The one place a water box is built.
     Returns (system, topology, positions in nm); positions are Modeller's, not minimised."""
     if model not in WATER_MODELS:
         raise ValueError(f"unknown water model {model!r}; known: {', '.join(WATER_MODELS)}")
-    if int(n_waters) < 2:
+    if box_nm is not None and n_waters is not None:
+        raise ValueError("give n_waters or box_nm, not both")
+    if box_nm is None and n_waters is None:
+        n_waters = 216
+    if n_waters is not None and (isinstance(n_waters, bool) or int(n_waters) < 2):
         raise ValueError(f"n_waters must be >= 2, got {n_waters!r}")
     ffname, name = WATER_MODELS[model]
-    ff = app.ForceField(ffname)
+    ff = app.ForceField(*(forcefields or (ffname,)))
     mod = app.Modeller(app.Topology(), [])
-    mod.addSolvent(ff, model=name, numAdded=int(n_waters))
+    if box_nm is not None:
+        mod.addSolvent(ff, model=name, boxSize=mm.Vec3(box_nm, box_nm, box_nm) * unit.nanometer)
+    else:
+        mod.addSolvent(ff, model=name, numAdded=int(n_waters))
     box = min(mod.topology.getUnitCellDimensions().value_in_unit(unit.nanometer))
-    if not 2 * cutoff_nm < box:
-        raise ValueError(f"cutoff {cutoff_nm} nm needs a box wider than {2 * cutoff_nm} nm; {n_waters} waters "
-                         f"give {box:.3f} nm: use more waters or a shorter cutoff")
+    if not 2 * cutoff_nm <= box:
+        raise ValueError(f"cutoff {cutoff_nm} nm needs a box at least {2 * cutoff_nm} nm wide; "
+                         f"{f'{n_waters} waters give' if box_nm is None else 'the box is'} {box:.3f} nm: "
+                         f"use more waters or a shorter cutoff")
+    extra = {} if ewald_tolerance is None else {"ewaldErrorTolerance": ewald_tolerance}
     system = ff.createSystem(mod.topology, nonbondedMethod=app.PME, nonbondedCutoff=cutoff_nm * unit.nanometer,
-                             constraints=app.HBonds, rigidWater=True, removeCMMotion=False)
+                             constraints=app.HBonds, rigidWater=True, removeCMMotion=False, **extra)
     return system, mod.topology, np.array(mod.positions.value_in_unit(unit.nanometer))

@@ -69,18 +69,25 @@ namespace OpenMM {
 
 class SymPRKIntegrator : public Integrator {
 public:
+    /* the same names and numbers as openmm_symprk.methods.resolved.SubstepKind and SubstepFlag */
     enum SubstepKind {
         Kick = 0,
         Drift = 1
     };
+    enum SubstepFlag {
+        ProjectVelocitiesBefore = 1,
+        ForcesCached = 2
+    };
     explicit SymPRKIntegrator(double stepSize);
-    SymPRKIntegrator(double stepSize, const std::vector<int>& kinds, const std::vector<double>& coefficients);
-    void setSubsteps(const std::vector<int>& kinds, const std::vector<double>& coefficients);
-    void setSubsteps(const std::vector<int>& kinds, const std::vector<double>& coefficients, const std::vector<int>& groups);
+    SymPRKIntegrator(double stepSize, const std::vector<int>& kinds, const std::vector<double>& coefficients,
+                     const std::vector<int>& groups, const std::vector<int>& flags);
+    void setSubsteps(const std::vector<int>& kinds, const std::vector<double>& coefficients, const std::vector<int>& groups,
+                     const std::vector<int>& flags);
     int getSubstepForceGroups(int index) const;
     int getNumSubsteps() const;
     int getSubstepKind(int index) const;
     double getSubstepCoefficient(int index) const;
+    int getSubstepFlags(int index) const;
     int getForceEvaluationsPerStep() const;
     bool getExactMomentum() const;
     void setExactMomentum(bool exact);

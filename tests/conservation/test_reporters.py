@@ -4,6 +4,7 @@ import io
 import numpy as np
 import openmm as mm
 import openmm.app as app
+import openmm.unit as unit
 import pytest
 
 import openmm_symprk.conservation.reporters as reporters
@@ -141,3 +142,104 @@ def test_trr_is_readable_by_another_process_after_every_report(water8, tmp_path)
         frames, step, drift = res.stdout.split()
         assert int(frames) == n and int(step) == 10 * n
         assert float(drift) < 1e-5  # the float32 floor of a stored trajectory, not a broken frame
+
+
+@pytest.mark.parametrize("interval", [2.5, 0, -3, True, "10", 2.0])
+def test_report_intervals_must_be_positive_whole_numbers(interval, tmp_path):
+    """2.5 used to be truncated to 2 in silence; now every reporter says what it takes."""
+    for make in (lambda: ConservationReporter(io.StringIO(), interval),
+                 lambda: VelocityTRRReporter(str(tmp_path / "i.trr"), interval)):
+        with pytest.raises(ValueError, match=f"positive whole number of steps.*got {interval!r}"):
+            make()
+    assert ConservationReporter(io.StringIO(), np.int64(5))._interval == 5
+
+
+def test_drift_column_is_the_least_squares_slope_of_every_report(water8):
+    """The running fit (constant work per report) gives what a fit of the whole history gives."""
+    from openmm_symprk.stats import drift
+
+    sim = _simulation(water8)
+    rep = ConservationReporter(io.StringIO(), 5)
+    sim.reporters.append(rep)
+    sim.step(100)
+    t = np.array([r["time"] for r in rep.records])
+    e = np.array([r["total_energy"] for r in rep.records])
+    dof = water8.n_dof
+    for k in (3, 10, 20):
+        assert rep.records[k - 1]["energy_drift"] == pytest.approx(drift(t[:k], e[:k]).slope * 1000 / dof, rel=1e-6)
+
+
+def _tip4p_waters(n=3, seed=4):
+    """``n`` rigid TIP4P-Ew waters in vacuum (each with a ThreeParticleAverageSite M), spun up."""
+    from openmm_symprk.systems.prepare import maxwell_boltzmann
+    from openmm_symprk.systems.scenes import water_cluster
+
+    base = water_cluster(n, rigid=True, minimize=False)
+    ff = app.ForceField("tip4pew.xml")
+    mod = app.Modeller(base.topology, base.positions * unit.nanometer)
+    mod.addExtraParticles(ff)
+    system = ff.createSystem(mod.topology, nonbondedMethod=app.NoCutoff, rigidWater=True, removeCMMotion=False)
+    x = np.array(mod.positions.value_in_unit(unit.nanometer))
+    v = maxwell_boltzmann(system, x, 300.0, seed, (0.0, 0.0, 3.0))
+    return system, mod.topology, x, v
+
+
+def test_trr_has_the_velocities_virtual_sites_move_with(tmp_path):
+    """TIP4P-Ew: OpenMM's State gives the M site zero velocity; the trajectory has w1 v_O + w2 v_H1 + w3 v_H2, and
+    it is the site's actual motion (a central difference of its written positions over two steps)."""
+    from MDAnalysis.lib.formats.libmdaxdr import TRRFile
+
+    system, top, x, v = _tip4p_waters()
+    sites = [i for i in range(system.getNumParticles()) if system.isVirtualSite(i)]
+    assert len(sites) == 3
+    dt = 0.0002
+    sim = app.Simulation(top, system, mm.VerletIntegrator(dt), mm.Platform.getPlatformByName("Reference"))
+    sim.context.setPositions(x)
+    sim.context.setVelocities(v)
+    sim.context.computeVirtualSites()
+    path = tmp_path / "tip4p.trr"
+    rep = VelocityTRRReporter(str(path), 1)
+    sim.reporters.append(rep)
+    sim.step(3)
+    rep.close()
+    assert not np.any(sim.context.getState(getVelocities=True).getVelocities(asNumpy=True)[sites[0]]._value)
+    with TRRFile(str(path), "r") as f:
+        frames = [(fr.x.astype(float), fr.v.astype(float)) for fr in f]  # the XDR library: nm and nm/ps, as written
+    for s in sites:
+        vs = system.getVirtualSite(s)
+        xs, vv = frames[1]
+        expected = sum(vs.getWeight(k) * vv[vs.getParticle(k)] for k in range(3))
+        assert np.linalg.norm(vv[s]) > 0.1
+        assert np.allclose(vv[s], expected, rtol=1e-5, atol=1e-5)
+        moved = (frames[2][0][s] - frames[0][0][s]) / (2 * dt)
+        assert np.allclose(vv[s], moved, rtol=2e-2, atol=2e-2), (vv[s], moved)
+
+
+@pytest.mark.parametrize("kind", ["out-of-plane", "local-coordinates"])
+def test_nonlinear_virtual_sites_move_as_their_position_function_says(kind):
+    """OutOfPlaneSite (bilinear cross term) and LocalCoordinatesSite (a rotated offset): the computed velocity is
+    the derivative of OpenMM's own site placement along the parents' velocities."""
+    from openmm_symprk.systems.virtual_sites import VirtualSiteVelocities
+
+    system = mm.System()
+    for m in (16.0, 1.0, 1.0, 0.0):
+        system.addParticle(m)
+    if kind == "out-of-plane":
+        system.setVirtualSite(3, mm.OutOfPlaneSite(0, 1, 2, 0.3, 0.4, 6.0))
+    else:
+        system.setVirtualSite(3, mm.LocalCoordinatesSite([0, 1, 2], [0.6, 0.2, 0.2], [-1.0, 1.0, 0.0],
+                                                         [-1.0, 0.0, 1.0], mm.Vec3(0.03, 0.05, -0.04)))
+    rng = np.random.default_rng(9)
+    x = np.array([[0.0, 0.0, 0.0], [0.0957, 0.0, 0.0], [-0.024, 0.0927, 0.0], [0.0, 0.0, 0.0]])
+    v = np.vstack([rng.normal(size=(3, 3)), np.zeros((1, 3))])
+    ctx = mm.Context(system, mm.VerletIntegrator(0.001), mm.Platform.getPlatformByName("Reference"))
+
+    def placed(xp):
+        ctx.setPositions(np.vstack([xp, np.zeros((1, 3))]))
+        ctx.computeVirtualSites()
+        return np.array(ctx.getState(getPositions=True).getPositions(asNumpy=True)._value[3])
+
+    h = 1e-7
+    expected = (placed(x[:3] + h * v[:3]) - placed(x[:3] - h * v[:3])) / (2 * h)
+    got = VirtualSiteVelocities(system)(np.vstack([x[:3], placed(x[:3])]), v)[3]
+    assert np.linalg.norm(expected) > 0.1 and np.allclose(got, expected, rtol=1e-5, atol=1e-6), (got, expected)

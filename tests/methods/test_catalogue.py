@@ -8,12 +8,12 @@ from fractions import Fraction
 import numpy as np
 import pytest
 
-from openmm_symprk import Splitting, UnknownMethodError, get_method, methods
+from openmm_symprk import Splitting, UnknownMethodError, get_method, catalogue
 from openmm_symprk.methods.catalogue import format_table
 from openmm_symprk.methods.reference import measure_order
 from openmm_symprk.methods.stability import stability_interval
 
-ALL = list(methods)
+ALL = list(catalogue)
 
 
 def _steps(order):
@@ -23,7 +23,7 @@ def _steps(order):
 
 @pytest.mark.parametrize("name", ALL)
 def test_measured_order_matches_catalogue(name):
-    m = methods[name]
+    m = catalogue[name]
     orders, diffs = measure_order(m, steps=_steps(m.order))
     assert diffs[-1] > 1e-17, "differences reached round-off: the measurement is meaningless"
     assert abs(orders[-1] - m.order) < 0.3, f"{name}: measured order {orders} != catalogue {m.order}"
@@ -31,7 +31,7 @@ def test_measured_order_matches_catalogue(name):
 
 @pytest.mark.parametrize("name", ALL)
 def test_stability_interval_matches_catalogue(name):
-    m = methods[name]
+    m = catalogue[name]
     measured = stability_interval(m)
     if m.stability is None:
         pytest.fail(f"{name} has no stability interval in the catalogue (measured {measured:.4f})")
@@ -41,7 +41,7 @@ def test_stability_interval_matches_catalogue(name):
         assert measured == pytest.approx(m.stability, rel=1e-3), f"{name}: measured {measured:.5f}"
 
 
-@pytest.mark.parametrize("m", methods.splittings(), ids=lambda m: m.name)
+@pytest.mark.parametrize("m", catalogue.splittings(), ids=lambda m: m.name)
 def test_splitting_consistency_and_cost(m):
     s = m.splitting
     # consistency: kicks and drifts each sum to 1 (exact up to the 22 published digits)
@@ -55,14 +55,14 @@ def test_splitting_consistency_and_cost(m):
 
 def test_swapped_orientation_is_caught():
     """ODE.jl's McAte4 swaps kick and drift: on a nonlinear problem it is only third order."""
-    m = methods["mclachlan-atela-4"]
+    m = catalogue["mclachlan-atela-4"]
     swapped = Splitting(("drift" if lab == "kick" else "kick", c) for lab, c in m.splitting)
     orders, _ = measure_order(swapped, steps=(8, 16, 32, 64))
     assert orders[-1] < 3.3
 
 
 def test_wrong_digit_is_caught():
-    m = methods["yoshida-6"]
+    m = catalogue["yoshida-6"]
     steps = list(m.splitting.steps)
     # a single wrong digit breaks consistency, which the exact sums catch ...
     label, c = steps[2]
@@ -81,8 +81,8 @@ def test_wrong_digit_is_caught():
 def test_aliases_and_case():
     assert get_method("Velocity-Verlet").name == "verlet"
     assert get_method("forest_ruth").name == "forest-ruth-4-position"
-    assert methods["McAte8"].name == "mclachlan-ss15-8"
-    assert "leapfrog" in methods and "nonsense" not in methods
+    assert catalogue["McAte8"].name == "mclachlan-ss15-8"
+    assert "leapfrog" in catalogue and "nonsense" not in catalogue
 
 
 def test_unknown_name_suggests_close_names():
@@ -93,12 +93,12 @@ def test_unknown_name_suggests_close_names():
 
 
 def test_families_and_table():
-    fams = {m.family for m in methods.values()}
+    fams = {m.family for m in catalogue.values()}
     assert fams == {"splitting", "composition", "implicit", "reference"}
     table = format_table()
     for name in ALL:
         assert name in table
-    assert not methods["rk4"].symplectic and methods["gauss-2"].symplectic
+    assert not catalogue["rk4"].symplectic and catalogue["gauss-2"].symplectic
 
 
 def test_narrow_instability_band_is_found():
@@ -106,7 +106,7 @@ def test_narrow_instability_band_is_found():
     grid; the interval ends at the band, not at the next wide instability (~5.97)."""
     from openmm_symprk.methods.stability import _stable
 
-    tab = methods["sofroniou-spaletta-10"].tableau()
+    tab = catalogue["sofroniou-spaletta-10"].tableau()
     assert not _stable(tab, np.array([3.1415]))[0]
     assert _stable(tab, np.array([3.1405, 3.1425])).all()  # stable on both sides of the band
     assert stability_interval("sofroniou-spaletta-10") == pytest.approx(3.14108, abs=1e-4)

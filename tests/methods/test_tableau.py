@@ -4,7 +4,7 @@ from fractions import Fraction
 import numpy as np
 import pytest
 
-from openmm_symprk import PRKTableau, Splitting, TableauError, compose, methods
+from openmm_symprk import PRKTableau, Splitting, TableauError, compose, catalogue
 from openmm_symprk.methods.reference import henon_heiles_force, prk_step, splitting_step
 
 LOBATTO_IIIA = [["0", "0", "0"], ["5/24", "1/3", "-1/24"], ["1/6", "2/3", "1/6"]]
@@ -31,25 +31,25 @@ def test_inconsistent_weights_rejected_with_value():
 
 
 def test_reich_residuals_exact_values():
-    iiia_iiib = methods["lobatto-iiia-iiib-3"].tableau()
+    iiia_iiib = catalogue["lobatto-iiia-iiib-3"].tableau()
     assert iiia_iiib.residual_6 < 1e-15 and iiia_iiib.residual_7 == 0.0
     assert iiia_iiib.is_symplectic_general
     # Lobatto IIIA paired with itself: the residual of (6) is 1/36 (the catalogue's reference value)
     bad = PRKTableau(LOBATTO_IIIA, B3, LOBATTO_IIIA, B3)
     assert bad.residual_6 == pytest.approx(1 / 36, rel=1e-14)
     assert not bad.is_symplectic
-    rk4 = methods["rk4"].tableau()
+    rk4 = catalogue["rk4"].tableau()
     assert rk4.residual_6 > 0.1 and rk4.residual_7 == 0.0
-    gauss = methods["gauss-2"].tableau()
+    gauss = catalogue["gauss-2"].tableau()
     assert gauss.residual_6 < 1e-15
 
 
 def test_splittings_satisfy_6_but_not_7():
-    for m in methods.splittings():
+    for m in catalogue.splittings():
         tab = m.tableau()
         assert tab.residual_6 == 0.0, m.name
         assert tab.is_explicit
-    assert methods["yoshida-4"].tableau().residual_7 > 1.0  # b != b_hat is allowed for separable H
+    assert catalogue["yoshida-4"].tableau().residual_7 > 1.0  # b != b_hat is allowed for separable H
 
 
 def test_check_symplectic_message_names_residual():
@@ -60,34 +60,34 @@ def test_check_symplectic_message_names_residual():
 
 
 def test_explicitness():
-    assert methods["rk4"].tableau().explicit_order == "q-first"
-    assert methods["gauss-2"].tableau().explicit_order is None
-    assert methods["lobatto-iiia-iiib-3"].tableau().explicit_order is None
+    assert catalogue["rk4"].tableau().explicit_order == "q-first"
+    assert catalogue["gauss-2"].tableau().explicit_order is None
+    assert catalogue["lobatto-iiia-iiib-3"].tableau().explicit_order is None
     mirror = PRKTableau([[0.5, 0], [0.5, 0.5]], [0.5, 0.5], [[0, 0], [1, 0]], [0.5, 0.5])
     assert mirror.explicit_order == "p-first"
 
 
 def test_splitting_tableau_round_trip():
-    for m in methods.splittings():
+    for m in catalogue.splittings():
         back = m.tableau().to_splitting()
         assert back.labels == m.splitting.labels, m.name
         assert max(abs(float(a[1] - b[1])) for a, b in zip(back, m.splitting)) < 1e-16
     with pytest.raises(TableauError, match="not a kick/drift splitting"):
-        methods["rk4"].tableau().to_splitting()
+        catalogue["rk4"].tableau().to_splitting()
 
 
 def test_tableau_form_gives_same_step_as_sequence():
     q0, p0 = np.array([0.1, 0.3]), np.array([0.35, -0.1])
     for name in ("verlet", "position-verlet", "pefrl", "mclachlan-atela-4", "yoshida-6"):
-        m = methods[name]
+        m = catalogue[name]
         qa, pa = splitting_step(m.splitting, henon_heiles_force, q0, p0, 0.1)
         qb, pb = prk_step(m.tableau(), henon_heiles_force, q0, p0, 0.1)
         assert np.max(np.abs(np.r_[qa - qb, pa - pb])) < 1e-15, name
 
 
 def test_tableau_composition_matches_splitting_composition():
-    w = methods["yoshida-4"].weights
-    verlet = methods["verlet"]
+    w = catalogue["yoshida-4"].weights
+    verlet = catalogue["verlet"]
     comp_tab = verlet.tableau().compose(w)
     comp_split = compose(verlet.splitting, w)
     assert comp_tab.residual_6 < 1e-15  # composition of symplectic steps is symplectic

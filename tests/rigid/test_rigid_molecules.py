@@ -7,7 +7,7 @@ import openmm as mm
 import openmm.unit as unit
 import pytest
 
-from openmm_symprk import SymplecticIntegrator, methods
+from openmm_symprk import SymplecticIntegrator, catalogue
 from openmm_symprk.rigid import molecules as rm
 from openmm_symprk.rigid.molecules import RigidGroupError, RigidGroupWarning, make_rigid
 
@@ -120,7 +120,7 @@ def _interacting_scene():
     return s, pos, vel, masses, groups
 
 
-SPLITTINGS = [m.name for m in methods.splittings()]
+SPLITTINGS = [m.name for m in catalogue.splittings()]
 
 
 @pytest.fixture(scope="module")

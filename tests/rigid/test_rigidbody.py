@@ -8,6 +8,7 @@ from scipy.integrate import solve_ivp
 
 from openmm_symprk.rigid import lie_poisson as rb
 from openmm_symprk.methods.catalogue import methods as catalogue
+from openmm_symprk.methods.resolved import resolve
 from openmm_symprk.methods.splitting import Splitting, compose
 
 EPS = np.finfo(float).eps
@@ -56,8 +57,14 @@ def test_compositions_go_through_the_catalogue_compose_path():
         assert all(abs(float(s.total(lab)) - 1) < 1e-15 for lab in ("X1", "X2", "X3"))
         assert s.is_symmetric()
         assert len(s) == 4 * len(catalogue[comp].weights) + 1
-    # catalogue aliases resolve to the same composition
+    # catalogue aliases, Method objects and resolved methods give the same composition
     assert rb.splitting_of("yoshida4") == rb.splitting_of("splitting-4")
+    assert rb.splitting_of(catalogue["kahan-li-8"]) == rb.splitting_of(resolve("kahan-li-8")) == \
+        rb.splitting_of("kahan-li-8")
+    with pytest.raises(ValueError, match="unknown rigid-body method 'yoshida-5'.*Did you mean"):
+        rb.splitting_of("yoshida-5")
+    with pytest.raises(ValueError, match="a catalogue composition, got 42"):
+        rb.splitting_of(42)
 
 
 # -- the sub-flows: exact, and in the right direction ---------------------------------------------

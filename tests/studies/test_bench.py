@@ -146,8 +146,8 @@ def test_dask_scheduler(tmp_path):
                                   dashboard_address=None) as cluster:
         res = run_sweep(cfg, str(tmp_path / "dask"), scheduler=cluster.scheduler_address, charts=False,
                         progress=False, log=lambda *a: None)
-    assert res.stats["computed"] == 4
-    assert all(r["status"] == "ok" for r in res.runs if r["step_fs"] == 1.0)
+    assert res["stats"]["computed"] == 4
+    assert all(r["status"] == "ok" for r in res["runs"] if r["step_fs"] == 1.0)
 
 
 def test_records_are_typed_and_versioned(tmp_path):
@@ -205,3 +205,39 @@ def test_production_scene_measures_drift_fluctuation_and_speed_against_a_baselin
             assert r[k] == old[k], k
     with pytest.raises(ValueError, match="no finished runs"):
         retime_sweep(cfg, str(tmp_path / "empty"), progress=False, log=lambda *a: None)
+
+
+def test_run_keys_of_stored_sweeps_do_not_change():
+    """``--resume`` finds a sweep's stored runs by their keys (spec and scene fingerprint): this is the key the
+    bench has used since schema 3, so a stored sweep can be summarised again with the current estimators."""
+    from openmm_symprk.studies.bench.store import run_key
+
+    spec = RunSpec("villin-pme", "verlet", 2.0, 12000, 240, "run", timing_s=4.0, threads=2)
+    assert run_key(spec.to_dict(), "0123456789abcdef") == "2fb18ad1d6637b608fd2"
+
+
+def test_stored_production_runs_are_summarised_with_the_current_estimator():
+    """A stored record keeps the drift its run computed; the summary takes the drift and its error again from the
+    record's energy trace with openmm_symprk.stats.drift, so an old sweep re-summarised gets the current figures."""
+    import numpy as np
+
+    from openmm_symprk.physics.temperature import R_KJ
+    from openmm_symprk.stats import drift
+    from openmm_symprk.studies.bench.aggregate import production_summary
+
+    rng = np.random.default_rng(3)
+    t = list(np.arange(241) * 0.1)
+
+    def run(method, slope):
+        de = list(slope * np.asarray(t) + rng.normal(scale=1e-4, size=len(t)))
+        return {"method": method, "step_fs": 2.0, "status": "ok", "failed": False, "wall_per_ps": 1.0,
+                "energy_std_per_dof": 1e-4, "drift_kT_per_ns_per_dof": 123.0, "drift_kT_stderr": 9.0,
+                "trace_t": t, "trace_de_per_dof": de}
+
+    runs = [run("openmm-verlet", 0.0), run("verlet", 2e-5)]
+    rows = production_summary({"baseline": ["openmm-verlet", 2.0]}, runs, temperature=300.0)["rows"]
+    kT = R_KJ * 300.0
+    for r, row in zip(runs, rows):
+        d = drift(r["trace_t"], r["trace_de_per_dof"])
+        assert row["drift"] == pytest.approx(d.slope * 1e3 / kT) and row["drift_err"] == pytest.approx(d.se * 1e3 / kT)
+    assert rows[0]["matches"] and not rows[1]["matches"]  # 2e-5 kJ/mol/ps/DOF = 8e-3 kT/ns/DOF, many SE

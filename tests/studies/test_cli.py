@@ -104,11 +104,11 @@ def test_bench_out_must_be_a_writable_folder(tmp_path, capsys):
 
 def test_two_sweeps_on_one_folder_are_refused(tmp_path):
     from openmm_symprk.studies.bench.sweep import SweepLockedError
-    from openmm_symprk.studies.folders import FolderLock
+    from openmm_symprk.studies.core import FolderLock
 
     lock = FolderLock(str(tmp_path), "symprk bench", SweepLockedError)
     code = ("import sys; from openmm_symprk.studies.bench.sweep import SweepLockedError\n"
-            "from openmm_symprk.studies.folders import FolderLock\n"
+            "from openmm_symprk.studies.core import FolderLock\n"
             "try:\n    FolderLock(sys.argv[1], 'symprk bench', SweepLockedError)\nexcept SweepLockedError as e:\n    print(e); sys.exit(3)\n")
     res = subprocess.run([sys.executable, "-c", code, str(tmp_path)], capture_output=True, text=True)
     assert res.returncode == 3 and "another symprk bench is running" in res.stdout

@@ -104,3 +104,25 @@ def test_bad_settings_are_refused(tmp_path, capsys):
     out = tmp_path / "rk4"
     assert main(["--quick", "--rows", "rk4:2", "--out", str(out)]) == 2  # refused before anything is built
     assert "rk4 is a reference method" in capsys.readouterr().err and not out.exists()
+
+
+def test_runs_on_a_dask_cluster(tmp_path):
+    """The same study through the --scheduler path (an in-process Dask cluster): every run stored, a summary."""
+    distributed = pytest.importorskip("dask.distributed")
+    cfg = copy.deepcopy(presets.quick())
+    cfg.update(replicas=1, length_ps=0.05)
+    cfg["models"] = {"spce": [["verlet", 0.5], ["omelyan-2", 4.0]]}
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=False,
+                                  dashboard_address=None) as cluster:
+        summary = run_study(cfg, str(tmp_path / "dask"), timing=False, progress=False, log=lambda *a: None,
+                            scheduler=cluster.scheduler_address)
+    rows = summary["models"]["spce"]["rows"]
+    assert [r["replicas"] for r in rows] == [1, 1] and all("dT" in r for r in rows)
+
+
+def test_run_keys_of_stored_studies_do_not_change():
+    """A study's stored runs are found by their keys: a change of the key (or of what it hashes) orphans every
+    stored run, so a re-summary would rerun them all.  This is the key the study has used since run version 2."""
+    from openmm_symprk.studies.equipartition.study import run_key
+
+    assert run_key(presets.full(), "spce", "omelyan-2", 4.0, 3) == "6ad2710190f9cc83"

@@ -1,10 +1,13 @@
 """``symprk bench``: speed against accuracy, and where each method stops being stable.
 
-Modules: :mod:`.toys` (analytic oscillators with exact solutions), :mod:`.scenes` (the scene registry
+Modules: :mod:`.toys` (analytic oscillators with exact solutions), :mod:`.registry` (the scene registry
 and user systems), :mod:`.measure` (observables), :mod:`.runs` (one run), :mod:`.stability` (largest
-stable step by bisection), :mod:`.store` (finished runs on disk), :mod:`.presets` (quick and full
-sweeps), :mod:`.sweep` (scenes x methods x steps in parallel, resumable), :mod:`.charts` (figures) and
-:mod:`.cli` (the command line).  Python use::
+stable step by bisection), :mod:`.records` and :mod:`.store` (typed records of finished runs on disk),
+:mod:`.presets` (quick and full sweeps), :mod:`.sweep` (scenes x methods x steps in parallel, resumable),
+:mod:`.aggregate` (results and tables), :mod:`.charts` (figures) and :mod:`.cli` (the command line).  The
+folder lock, atomic files, run keys, executors and job loop are the studies' shared skeleton
+(:mod:`openmm_symprk.studies.core`); drifts and their errors come from :mod:`openmm_symprk.stats`.  Python
+use::
 
     from openmm_symprk.studies.bench import run_sweep, presets
     results = run_sweep(presets.quick(), out="bench-results/quick", workers=2)

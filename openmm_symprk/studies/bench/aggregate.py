@@ -19,6 +19,8 @@ from statistics import median
 
 import numpy as np
 
+from ...physics.temperature import R_KJ
+from ...stats import Estimate, drift, no_larger
 from .measure import rms_deviation
 from .records import SCHEMA_VERSION
 from .runs import label
@@ -70,7 +72,8 @@ def aggregate(config, scenes, jobs, store) -> dict:
             "scenes": scene_info, "runs": runs, "references": list(refs.values()), "stability": stab,
             "best": best_at_accuracy(accurate),
             "best_energy": best_at_accuracy(accurate, ENERGY_TARGETS, "energy_error_per_dof"),
-            "production": {name: production_summary(config["scenes"][name], [r for r in runs if r["scene"] == name])
+            "production": {name: production_summary(config["scenes"][name], [r for r in runs if r["scene"] == name],
+                                                       scenes[name].temperature)
                            for name, sc in scenes.items() if sc.purpose == "production"}}
 
 
@@ -173,7 +176,21 @@ def _speed(r):
     return None
 
 
-def production_summary(scene_config: dict, runs: list) -> dict:
+def drift_kT(r: dict, temperature: float = 300.0) -> tuple:
+    """(energy drift in kT/ns/DOF, its standard error) of a production run, from its stored energy trace with the
+    package's one estimator (:func:`openmm_symprk.stats.drift`), so that summarising stored runs again uses the
+    current estimator; the record's own figures when it has no trace (or None, None for a failed run)."""
+    if r.get("drift_kT_per_ns_per_dof") is None:
+        return None, None
+    t, de = r.get("trace_t") or [], r.get("trace_de_per_dof") or []
+    if len(t) < 3:
+        return r["drift_kT_per_ns_per_dof"], r.get("drift_kT_stderr")
+    d = drift(t, de)  # kJ/mol per ps per DOF
+    kT = R_KJ * temperature
+    return d.slope * 1e3 / kT, d.se * 1e3 / kT
+
+
+def production_summary(scene_config: dict, runs: list, temperature: float = 300.0) -> dict:
     """Per production scene: every row's ns/day, its speed against the baseline (OpenMM's VerletIntegrator at 2 fs,
     or at its largest good step) measured in the same run, its energy drift and fluctuation, whether it matches
     the baseline's accuracy, and the fastest row that does."""
@@ -184,17 +201,18 @@ def production_summary(scene_config: dict, runs: list) -> dict:
         base = max(verlets, key=lambda r: r["step_fs"]) if verlets else None
     else:
         base = next((r for r in good if r["method"] == spec[0] and r["step_fs"] == float(spec[1])), None)
+    base_drift = Estimate(*drift_kT(base, temperature)) if base is not None else None
     rows = []
     for r in runs:
+        d, d_err = drift_kT(r, temperature)
         row = {"method": r["method"], "step_fs": r["step_fs"], "status": r["status"] if not r.get("failed") else
                f"failed: {r.get('failure')}", "ns_per_day": 86.4 / r["wall_per_ps"] if r.get("wall_per_ps") else None,
-               "drift": r.get("drift_kT_per_ns_per_dof"), "drift_err": r.get("drift_kT_stderr"),
+               "drift": d, "drift_err": d_err,
                "fluctuation": r.get("energy_std_per_dof"), "speedup": None, "matches": None}
         if base is not None and _speed(base) and _speed(r):
             row["speedup"] = _speed(base) / _speed(r)
         if base is not None and r in good:
-            tol = 2 * float(np.hypot(base["drift_kT_stderr"] or 0.0, r["drift_kT_stderr"] or 0.0))
-            row["matches"] = bool(abs(r["drift_kT_per_ns_per_dof"]) <= abs(base["drift_kT_per_ns_per_dof"]) + tol
+            row["matches"] = bool(no_larger(Estimate(d, d_err or 0.0), Estimate(base_drift.mean, base_drift.se or 0.0))
                                   and r["energy_std_per_dof"] <= FLUCTUATION_SLACK * base["energy_std_per_dof"])
         rows.append(row)
     winners = sorted((row for row in rows if row["matches"] and row["speedup"]), key=lambda row: -row["speedup"])

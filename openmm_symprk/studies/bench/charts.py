@@ -14,18 +14,19 @@ from __future__ import annotations
 import math
 import os
 
-import matplotlib
+import numpy as np
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
+from ...support import require
+from .aggregate import usable
+from .runs import label
 
-from .aggregate import usable  # noqa: E402
-from .runs import label  # noqa: E402
+require("matplotlib", "studies", "openmm_symprk.studies.bench.charts").use("Agg")
+plt = require("matplotlib.pyplot", "studies", "openmm_symprk.studies.bench.charts")
 
 
 def _log_axes(ax):
-    from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
+    ticker = require("matplotlib.ticker", "studies", "openmm_symprk.studies.bench.charts")
+    FuncFormatter, LogLocator, NullFormatter = ticker.FuncFormatter, ticker.LogLocator, ticker.NullFormatter
 
     ax.set_xscale("log")
     ax.set_yscale("log")
@@ -245,7 +246,7 @@ def speed_chart(results, path) -> str | None:
     ax.set_xlabel("force evaluations per step")
     ax.set_ylabel("wall time per step / OpenMM VerletIntegrator's")
     ax.grid(True, which="both", alpha=0.25)
-    from matplotlib.lines import Line2D
+    Line2D = require("matplotlib.lines", "studies", "openmm_symprk.studies.bench.charts").Line2D
 
     h1 = [Line2D([], [], ls="none", marker=markers[i % len(markers)], color="0.3", label=sc) for i, sc in enumerate(scenes)]
     h2 = [Line2D([], [], ls="none", marker="o", color=sty[m]["color"], label=label(m)) for m in methods

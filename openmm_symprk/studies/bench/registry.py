@@ -1,21 +1,20 @@
 """The bench's scene registry: each scene models no more than the question it answers.
 
-A :class:`BenchScene` is a System plus one shared initial state (positions and velocities, nm and
-nm/ps) and what the bench may measure on it: which quantities are invariants, whether an exact solution
-exists, whether it is for accuracy or for speed only.  Scenes are built once per sweep, saved in the
-output folder and shipped to the workers as a :meth:`BenchScene.payload`, so every run of a sweep (and
-of a resumed sweep) starts from bit-identical coordinates.
+A scene (:class:`openmm_symprk.systems.scene.Scene`, the package's one scene type) is a System plus one shared
+initial state (positions and velocities, nm and nm/ps) and what the bench may measure on it: which quantities
+are invariants, whether an exact solution exists, whether it is for accuracy or for speed only.  Scenes are
+built once per sweep, saved in the output folder (:func:`save_scene`) and shipped to the workers as a
+:meth:`~openmm_symprk.systems.scene.Scene.payload`, so every run of a sweep (and of a resumed sweep) starts
+from bit-identical coordinates.
 
 ``SCENES`` maps the registry names to their builders; each builder's docstring says why its model is
 enough for its question and no more.  :func:`user_scene` wraps a System of your own.
 """
 from __future__ import annotations
 
-import hashlib
 import json
 import os
 import warnings
-from dataclasses import dataclass, field
 
 import numpy as np
 import openmm as mm
@@ -24,114 +23,31 @@ import openmm.unit as unit
 
 from ...systems.forcegroups import split_forces
 from ...systems.prepare import equilibrate, maxwell_boltzmann, minimise
-from ...systems.properties import constraint_arrays, degrees_of_freedom, masses
+from ...systems.scene import Scene
+from ...systems.scenes import water_box
+from ..core.folders import write_json, write_npz, write_text
 from . import toys
 
-#: Every invariant an isolated system has.
-ALL_INVARIANTS = ("energy", "momentum", "angular_momentum")
+def save_scene(scene: Scene, folder: str) -> str:
+    """Write the scene's payload as <folder>/<name>.xml + .npz + .json (atomically); returns the JSON path."""
+    os.makedirs(folder, exist_ok=True)
+    p = scene.payload()
+    base = os.path.join(folder, scene.name)
+    write_text(base + ".xml", p["xml"])
+    write_npz(base + ".npz", {"positions": p["positions"], "velocities": p["velocities"]})
+    write_json(base + ".json", {"info": p["info"], "fingerprint": p["fingerprint"]})
+    return base + ".json"
 
 
-@dataclass
-class BenchScene:
-    name: str
-    system: mm.System
-    positions: np.ndarray
-    velocities: np.ndarray
-    description: str
-    purpose: str = "accuracy"  # "accuracy": errors and stability; "speed": wall time only; "production": NVE drift,
-    #                            fluctuation and ns/day of a periodic system (no trajectory reference)
-    platform: str = "Reference"
-    invariants: tuple = ALL_INVARIANTS
-    temperature: float = 300.0  # K, for the Langevin comparison row
-    exact: dict | None = None  # toy metadata: errors are taken against toys.exact_state
-    linear: dict | None = None  # {"omega_max": w}: the harmonic toy, stability decided exactly
-    why: str = ""
-    meta: dict = field(default_factory=dict)
-
-    # -- derived ---------------------------------------------------------------------------
-    @property
-    def n_atoms(self) -> int:
-        return self.system.getNumParticles()
-
-    @property
-    def n_dof(self) -> int:
-        return degrees_of_freedom(self.system)
-
-    def masses(self) -> np.ndarray:
-        if "_masses" not in self.__dict__:
-            self.__dict__["_masses"] = masses(self.system)
-        return self.__dict__["_masses"]
-
-    def constraints(self):
-        """(i, j, d) arrays of the distance constraints."""
-        return constraint_arrays(self.system)
-
-    # -- transport -------------------------------------------------------------------------
-    def payload(self) -> dict:
-        """Everything a worker needs, as picklable plain data (the System as XML)."""
-        xml = mm.XmlSerializer.serialize(self.system)
-        info = {k: getattr(self, k) for k in ("name", "description", "purpose", "platform", "temperature",
-                                              "exact", "linear", "why", "meta")}
-        info["invariants"] = list(self.invariants)
-        pos = np.ascontiguousarray(self.positions, dtype=np.float64)
-        vel = np.ascontiguousarray(self.velocities, dtype=np.float64)
-        h = hashlib.sha1(xml.encode())
-        h.update(pos.tobytes())
-        h.update(vel.tobytes())
-        h.update(json.dumps(_plain(info), sort_keys=True).encode())
-        return {"xml": xml, "positions": pos, "velocities": vel, "info": info, "fingerprint": h.hexdigest()[:16]}
-
-    @classmethod
-    def from_payload(cls, payload: dict) -> "BenchScene":
-        info = dict(payload["info"])
-        info["invariants"] = tuple(info["invariants"])
-        system = mm.XmlSerializer.deserialize(payload["xml"])
-        return cls(system=system, positions=np.asarray(payload["positions"]),
-                   velocities=np.asarray(payload["velocities"]), **info)
-
-    def save(self, folder: str) -> str:
-        """Write the payload as <folder>/<name>.xml + .npz + .json; returns the JSON path."""
-        os.makedirs(folder, exist_ok=True)
-        p = self.payload()
-        base = os.path.join(folder, self.name)
-        _atomic_write(base + ".xml", p["xml"])
-        tmp = f"{base}.tmp{os.getpid()}.npz"
-        np.savez(tmp, positions=p["positions"], velocities=p["velocities"])
-        os.replace(tmp, base + ".npz")
-        _atomic_write(base + ".json", json.dumps({"info": _plain(p["info"]), "fingerprint": p["fingerprint"]},
-                                                 indent=1))
-        return base + ".json"
-
-    @classmethod
-    def load(cls, folder: str, name: str) -> "BenchScene":
-        base = os.path.join(folder, name)
-        with open(base + ".json") as fh:
-            meta = json.load(fh)
-        with open(base + ".xml") as fh:
-            xml = fh.read()
-        arrays = np.load(base + ".npz")
-        return cls.from_payload({"xml": xml, "positions": arrays["positions"], "velocities": arrays["velocities"],
-                                 "info": meta["info"]})
-
-
-def _plain(obj):
-    """JSON-ready copy (numpy arrays to lists)."""
-    if isinstance(obj, dict):
-        return {k: _plain(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [_plain(v) for v in obj]
-    if isinstance(obj, np.ndarray):
-        return obj.tolist()
-    if isinstance(obj, np.generic):
-        return obj.item()
-    return obj
-
-
-def _atomic_write(path: str, text: str):
-    tmp = f"{path}.tmp{os.getpid()}"
-    with open(tmp, "w") as fh:
-        fh.write(text)
-    os.replace(tmp, path)
+def load_scene(folder: str, name: str) -> Scene:
+    base = os.path.join(folder, name)
+    with open(base + ".json") as fh:
+        meta = json.load(fh)
+    with open(base + ".xml") as fh:
+        xml = fh.read()
+    with np.load(base + ".npz") as arrays:
+        return Scene.from_payload({"xml": xml, "positions": arrays["positions"], "velocities": arrays["velocities"],
+                                   "info": meta["info"]})
 
 
 def _why(fn) -> str:
@@ -139,7 +55,7 @@ def _why(fn) -> str:
 
 
 # -- the analytic toys ---------------------------------------------------------------------------
-def harmonic(n: int = 256, omega_max: float = toys.OMEGA_OH, seed: int = 11) -> BenchScene:
+def harmonic(n: int = 256, omega_max: float = toys.OMEGA_OH, seed: int = 11) -> Scene:
     """Independent harmonic oscillators, frequencies spread evenly up to an O-H stretch (700/ps).
 
     Linear forces have an exact solution, so every error is the integrator's own; a spectrum reaching
@@ -148,14 +64,14 @@ def harmonic(n: int = 256, omega_max: float = toys.OMEGA_OH, seed: int = 11) -> 
     energy and angular momentum about the origin are invariants, linear momentum is not."""
     omega = toys.harmonic_frequencies(n, omega_max)
     x0, v0 = toys.harmonic_initial_state(omega, seed)
-    return BenchScene("harmonic", toys.harmonic_system(omega), x0, v0,
+    return Scene("harmonic", toys.harmonic_system(omega), x0, v0,
                       f"{n} harmonic oscillators, omega up to {omega_max:g}/ps (exact solution)",
                       invariants=("energy", "angular_momentum"),
                       exact={"toy": "harmonic", "omega": omega, "x0": x0, "v0": v0},
                       linear={"omega_max": float(omega_max)}, why=_why(harmonic))
 
 
-def anharmonic(n: int = 64, seed: int = 13) -> BenchScene:
+def anharmonic(n: int = 64, seed: int = 13) -> Scene:
     """Independent hardening Duffing oscillators (quartic term as large as the quadratic one).
 
     Nonlinear forces reach the order conditions that a harmonic force cannot see (on q'' = -q every
@@ -163,19 +79,19 @@ def anharmonic(n: int = 64, seed: int = 13) -> BenchScene:
     the answer exact.  Separable quartic wells: energy is the only invariant."""
     a, b, amp = toys.duffing_parameters(n)
     x0, v0, u0 = toys.duffing_initial_state(a, b, amp, seed)
-    return BenchScene("anharmonic", toys.duffing_system(a, b), x0, v0,
+    return Scene("anharmonic", toys.duffing_system(a, b), x0, v0,
                       f"{n} Duffing oscillators (x 3 axes), frequencies up to ~700/ps (exact solution)",
                       invariants=("energy",), exact={"toy": "duffing", "a": a, "b": b, "amp": amp, "u0": u0},
                       why=_why(anharmonic))
 
 
 # -- molecular scenes (built from the core scenes) -----------------------------------------------
-def _from_core(scene, name, why, **kw) -> BenchScene:
-    return BenchScene(name, scene.system, np.array(scene.positions), np.array(scene.velocities), scene.description,
+def _from_core(scene, name, why, **kw) -> Scene:
+    return Scene(name, scene.system, np.array(scene.positions), np.array(scene.velocities), scene.description,
                       why=why, **kw)
 
 
-def water_rigid(n_waters: int = 64) -> BenchScene:
+def water_rigid(n_waters: int = 64) -> Scene:
     """A spinning cluster of rigid TIP3P waters in vacuum (SETTLE, no cutoff, no CMMotionRemover).
 
     Rigid water is the common production model; with SETTLE the fastest motion left is libration, so
@@ -187,7 +103,7 @@ def water_rigid(n_waters: int = 64) -> BenchScene:
     return _from_core(water_cluster(n_waters, rigid=True), "water-rigid", _why(water_rigid))
 
 
-def water_flexible(n_waters: int = 64) -> BenchScene:
+def water_flexible(n_waters: int = 64) -> Scene:
     """The same cluster with flexible waters (harmonic O-H bonds and H-O-H angle, no constraints).
 
     The O-H stretch (period about 9 fs) is the fastest motion in biomolecular MD: this is where large
@@ -197,7 +113,7 @@ def water_flexible(n_waters: int = 64) -> BenchScene:
     return _from_core(water_cluster(n_waters, rigid=False), "water-flexible", _why(water_flexible))
 
 
-def villin() -> BenchScene:
+def villin() -> Scene:
     """The villin headpiece (OpenMM's bundled test.pdb) in vacuum, amber14, HBonds constraints (CCMA).
 
     A real protein: torsions, 1-4 terms and a few hundred constraints solved iteratively (CCMA at
@@ -209,20 +125,16 @@ def villin() -> BenchScene:
     return _from_core(protein_vacuum(), "villin", _why(villin))
 
 
-def water_box_pme(box_nm: float = 3.9, seed: int = 17) -> BenchScene:
+def water_box_pme(box_nm: float = 3.9, seed: int = 17) -> Scene:
     """A periodic box of rigid TIP3P water (~5800 atoms), PME, 0.9 nm cutoff: speed only.
 
     This is the shape of a production run, so it is what the wall-time ratios to VerletIntegrator are
     measured on (CPU platform).  Periodic boxes break rotational symmetry and the PME grid makes the
     energy approximate, so no accuracy or stability figure is taken here: the other scenes answer those."""
-    ff = app.ForceField("amber14-all.xml", "amber14/tip3p.xml")
-    mod = app.Modeller(app.Topology(), [])
-    mod.addSolvent(ff, model="tip3p", boxSize=mm.Vec3(box_nm, box_nm, box_nm) * unit.nanometer)
-    system = ff.createSystem(mod.topology, nonbondedMethod=app.PME, nonbondedCutoff=0.9 * unit.nanometer,
-                             constraints=app.HBonds, rigidWater=True, removeCMMotion=False)
-    pos = minimise(system, mod.positions, "CPU", tolerance=10.0, max_iterations=100)
+    system, _, x = water_box("tip3p", box_nm=box_nm, cutoff_nm=0.9, forcefields=("amber14-all.xml", "amber14/tip3p.xml"))
+    pos = minimise(system, x, "CPU", tolerance=10.0, max_iterations=100)
     vel = maxwell_boltzmann(system, pos, 300.0, seed)
-    return BenchScene("water-box-pme", system, pos, vel,
+    return Scene("water-box-pme", system, pos, vel,
                       f"periodic TIP3P box, {system.getNumParticles()} atoms, PME (speed only)",
                       purpose="speed", platform="CPU", invariants=("energy", "momentum"), why=_why(water_box_pme))
 
@@ -231,7 +143,7 @@ def _openmm_data(name: str) -> str:
     return os.path.join(os.path.dirname(app.__file__), "data", name)
 
 
-def villin_pme(hmr: bool = False, equilibrate_ps: float = 10.0, seed: int = 29) -> BenchScene:
+def villin_pme(hmr: bool = False, equilibrate_ps: float = 10.0, seed: int = 29) -> Scene:
     """OpenMM's test.pdb as shipped: the villin headpiece in 2,761 TIP3P waters (8,867 atoms), amber14, PME with a
     0.9 nm cutoff, HBonds and rigid water, no CMMotionRemover; with ``hmr`` the hydrogen masses are repartitioned
     to 1.5 Da (ForceField hydrogenMass).  NVE from one Langevin-equilibrated state at 300 K.
@@ -248,28 +160,23 @@ def villin_pme(hmr: bool = False, equilibrate_ps: float = 10.0, seed: int = 29) 
     split_forces(system, slow="reciprocal")
     pos = minimise(system, pdb.positions, "CPU", tolerance=10.0, max_iterations=200)
     pos, vel = equilibrate(system, pos, 300.0, equilibrate_ps, seed)
-    return BenchScene("villin-pme-hmr" if hmr else "villin-pme", system, pos, vel,
+    return Scene("villin-pme-hmr" if hmr else "villin-pme", system, pos, vel,
                       f"villin in water (test.pdb, {system.getNumParticles()} atoms), PME 0.9 nm, HBonds, rigid water"
                       + (", HMR 1.5 Da" if hmr else "") + f", equilibrated {equilibrate_ps:g} ps at 300 K",
                       purpose="production", platform="CPU", invariants=("energy",), why=_why(villin_pme))
 
 
 def water_pme_accurate(box_nm: float = 3.0, ewald_tolerance: float = 1e-6, equilibrate_ps: float = 5.0,
-                       seed: int = 31) -> BenchScene:
+                       seed: int = 31) -> Scene:
     """A rigid TIP3P box (about 2,700 atoms) with PME tuned for accuracy (ewaldErrorTolerance 1e-6: a 128^3 grid
     on 3 nm): the reciprocal space costs about twice the rest on the CPU platform, so it models the expensive,
     smooth long-range force a user puts on the outer step of multiple time stepping (accurate electrostatics,
     or a machine-learned or polarizable term).  It is where multiple time stepping pays."""
-    ff = app.ForceField("amber14/tip3p.xml")
-    mod = app.Modeller(app.Topology(), [])
-    mod.addSolvent(ff, model="tip3p", boxSize=mm.Vec3(box_nm, box_nm, box_nm) * unit.nanometer)
-    system = ff.createSystem(mod.topology, nonbondedMethod=app.PME, nonbondedCutoff=0.9 * unit.nanometer,
-                             constraints=app.HBonds, rigidWater=True, removeCMMotion=False,
-                             ewaldErrorTolerance=ewald_tolerance)
+    system, _, x = water_box("tip3p", box_nm=box_nm, cutoff_nm=0.9, ewald_tolerance=ewald_tolerance)
     split_forces(system, slow="reciprocal")
-    pos = minimise(system, mod.positions, "CPU", tolerance=10.0, max_iterations=200)
+    pos = minimise(system, x, "CPU", tolerance=10.0, max_iterations=200)
     pos, vel = equilibrate(system, pos, 300.0, equilibrate_ps, seed)
-    return BenchScene("water-pme-accurate", system, pos, vel,
+    return Scene("water-pme-accurate", system, pos, vel,
                       f"rigid TIP3P box, {system.getNumParticles()} atoms, PME with ewaldErrorTolerance "
                       f"{ewald_tolerance:g} (reciprocal space in group 1)", purpose="production", platform="CPU",
                       invariants=("energy",), why=_why(water_pme_accurate))
@@ -289,7 +196,7 @@ SCENES = {
 }
 
 
-def build(name: str, **params) -> BenchScene:
+def build(name: str, **params) -> Scene:
     try:
         builder = SCENES[name]
     except KeyError:
@@ -317,7 +224,7 @@ def _invariants_of(system) -> tuple:
 
 def user_scene(name: str = "user", system_xml: str | None = None, state: str | None = None,
                pdb: str | None = None, forcefields=(), temperature: float = 300.0, seed: int = 23,
-               platform: str | None = None, minimize: bool = True, equilibrate_ps: float = 2.0) -> BenchScene:
+               platform: str | None = None, minimize: bool = True, equilibrate_ps: float = 2.0) -> Scene:
     """Your own system: a serialized System XML with positions (PDB or serialized State XML), or a PDB
     plus force-field file names (e.g. ``amber14-all.xml amber14/tip3pfb.xml``).
 
@@ -373,7 +280,7 @@ def user_scene(name: str = "user", system_xml: str | None = None, state: str | N
             split_forces(system, slow="reciprocal")  # for the multiple-time-step rows
         except ValueError:
             pass  # no reciprocal space: the MTS rows report an error, the others run
-    return BenchScene(name, system, positions, velocities,
+    return Scene(name, system, positions, velocities,
                       f"user system ({system.getNumParticles()} atoms, {system.getNumConstraints()} constraints"
                       f"{', periodic' if periodic else ''})", platform=platform, invariants=_invariants_of(system),
                       temperature=temperature, purpose="production" if periodic else "accuracy",

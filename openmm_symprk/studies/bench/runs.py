@@ -42,9 +42,10 @@ from ...physics import angular_momentum, linear_momentum
 from ...systems.prepare import R_KJ
 from ..timing import interleaved
 from ...systems.properties import constraint_violation
+from ...stats import drift
 from . import measure
 from .records import RunRecord
-from .registry import BenchScene
+from ...systems.scene import Scene
 
 #: The comparison rows: OpenMM's own integrators.
 OPENMM_ROWS = ("openmm-verlet", "openmm-langevin")
@@ -130,7 +131,7 @@ def canonical_row(name: str) -> str:
                          f"MTSIntegrator) or <method>[/<inner>]@mts<n> (multiple time stepping)") from None
 
 
-def make_integrator(method: str, h_ps: float, scene: BenchScene, seed: int = 1, temperature=None):
+def make_integrator(method: str, h_ps: float, scene: Scene, seed: int = 1, temperature=None):
     """(integrator, force evaluations per step, leapfrog?) for a row name."""
     tolerance = PRODUCTION_CONSTRAINT_TOLERANCE if scene.purpose == "production" else CONSTRAINT_TOLERANCE
     if method == "openmm-verlet":
@@ -165,12 +166,12 @@ def make_integrator(method: str, h_ps: float, scene: BenchScene, seed: int = 1, 
     return ig, evals, leapfrog
 
 
-def make_context(scene: BenchScene, integrator, platform: str, threads: int = 1):
+def make_context(scene: Scene, integrator, platform: str, threads: int = 1):
     plat = mm.Platform.getPlatformByName(platform)
     return mm.Context(scene.system, integrator, plat, platform_properties(platform, threads))
 
 
-def set_initial_state(ctx, scene: BenchScene, x0, v0, h_ps: float, leapfrog: bool):
+def set_initial_state(ctx, scene: Scene, x0, v0, h_ps: float, leapfrog: bool):
     ctx.setPositions(x0)
     if leapfrog:
         f = ctx.getState(getForces=True).getForces(asNumpy=True).value_in_unit(
@@ -183,7 +184,7 @@ def set_initial_state(ctx, scene: BenchScene, x0, v0, h_ps: float, leapfrog: boo
         ctx.applyVelocityConstraints(CONSTRAINT_TOLERANCE)
 
 
-def base_record(spec: RunSpec, scene: BenchScene, platform: str) -> RunRecord:
+def base_record(spec: RunSpec, scene: Scene, platform: str) -> RunRecord:
     return RunRecord(**dict(spec.to_dict(), platform=platform), label=label(spec.method), length_ps=spec.length_ps,
                      n_atoms=scene.n_atoms, n_dof=scene.n_dof)
 
@@ -196,7 +197,7 @@ def _failure(rec, reason, t):
         rec.failure += f"; then {reason} at {t:.4g} ps"
 
 
-def execute(spec: RunSpec, scene: BenchScene) -> tuple[RunRecord, dict]:
+def execute(spec: RunSpec, scene: Scene) -> tuple[RunRecord, dict]:
     """Run ``spec`` on ``scene``; returns (record, arrays).  ``arrays`` holds the final positions of
     molecular accuracy runs (for the trajectory error against the reference), else it is empty."""
     if spec.role == "linear-probe":
@@ -298,17 +299,17 @@ def _measure(spec, scene, ctx, ig, rec, arrays):
         if rec.failed and stop_early:
             break
     loop_s = time.perf_counter() - t_loop
+    fit = drift(ts, des) if len(ts) >= 3 else None  # kJ/mol per ps per DOF
     rec.update(energy_error=worst_e, energy_error_per_dof=worst_e / n_dof,
-               drift_per_ns_per_dof=measure.drift_rate(ts, des) * 1e3,
+               drift_per_ns_per_dof=fit.slope * 1e3 if fit else None,
                dP=worst_p if "momentum" in inv else None,
                dL_rel=worst_l if "angular_momentum" in inv else None,
                constraint_error=worst_c, trace_t=ts, trace_de_per_dof=des)
     if scene.purpose == "production" and len(ts) > 3:
         # production figures: energy fluctuation and drift per DOF, the drift in kT/ns with its standard error
         kT = R_KJ * scene.temperature
-        slope, stderr = measure.drift_with_error(ts, des)  # kJ/mol per ps per DOF
-        rec.update(energy_std_per_dof=float(np.std(des)), drift_kT_per_ns_per_dof=slope * 1e3 / kT,
-                   drift_kT_stderr=stderr * 1e3 / kT)
+        rec.update(energy_std_per_dof=float(np.std(des)), drift_kT_per_ns_per_dof=fit.slope * 1e3 / kT,
+                   drift_kT_stderr=fit.se * 1e3 / kT)
     if rec.blew_up:
         # the measured maxima only cover the samples before the blow-up: do not report them as errors
         rec.update(energy_error=None, energy_error_per_dof=None, drift_per_ns_per_dof=None, dP=None, dL_rel=None,
@@ -363,7 +364,7 @@ def _time(spec, scene, ig, rec, per_step_estimate, rounds=TIMING_ROUNDS):
                verlet_wall_per_step=verlet, wall_vs_verlet_paired=best / verlet)
 
 
-def retime(spec: RunSpec, scene: BenchScene, rec: RunRecord, rounds: int = TIMING_ROUNDS) -> RunRecord:
+def retime(spec: RunSpec, scene: Scene, rec: RunRecord, rounds: int = TIMING_ROUNDS) -> RunRecord:
     """Measure the timing of a finished run again, from the scene's initial state, leaving what the run
     measured untouched: for a sweep whose machine was busy while it ran (``symprk bench --retime``).  The
     paired VerletIntegrator is timed in turns with it, as in the run itself."""

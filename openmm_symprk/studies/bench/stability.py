@@ -55,11 +55,11 @@ def _dense_harmonic(omega_max: float):
 
 def linear_probe(spec: RunSpec, scene):
     """One step of ``spec.method`` on the dense harmonic spectrum; fails if the one-step map grows."""
-    from .registry import BenchScene
+    from ...systems.scene import Scene
 
     omega_max = scene.linear["omega_max"]
     omega, system = _dense_harmonic(omega_max)
-    probe_scene = BenchScene(scene.name, system, np.zeros((len(omega), 3)), np.zeros((len(omega), 3)), "",
+    probe_scene = Scene(scene.name, system, np.zeros((len(omega), 3)), np.zeros((len(omega), 3)), "",
                              invariants=())
     platform = spec.platform or scene.platform
     rec = base_record(spec, probe_scene, platform)

@@ -4,8 +4,9 @@
     from openmm_symprk.studies.bench.sweep import run_sweep
     results = run_sweep(presets.quick(), "bench-results/quick", workers=2)
 
-Jobs are generators that yield :class:`~.runs.RunSpec` s and receive their records: a plain run is one
-spec; a stability search (:func:`~.stability.driver`) yields probe after probe.  Every record is stored
+Jobs (:mod:`openmm_symprk.studies.core.jobs`, the machinery every study shares) are generators that yield
+:class:`~.runs.RunSpec` s and receive their records: a plain run is one spec; a stability search
+(:func:`~.stability.driver`) yields probe after probe.  Every record is stored
 (:class:`~.store.Store`) the moment it arrives, before anything else happens, so an interrupted sweep
 (Ctrl-C, a crash, a killed job) keeps every finished run; ``resume=True`` replays the jobs, takes every
 stored record from disk instead of recomputing it (a stability search replays its probes in the same
@@ -21,16 +22,15 @@ steps x force evaluations x the scene's cost per evaluation), so that long runs 
 """
 from __future__ import annotations
 
-import heapq
-import itertools
 import json
 import os
 import time
 import warnings
 
-from ..folders import FolderLock, FolderLockedError, write_json
+from ..core import FolderLock, FolderLockedError, progress_bar, write_json, write_text
+from ..core.executors import make_executor
+from ..core.jobs import Job, run_jobs, single
 from . import presets
-from .executors import make_executor
 from .records import RunRecord
 from .runs import OPENMM_ROWS, RunSpec, label
 from .store import Store, run_key
@@ -42,22 +42,6 @@ class SweepExistsError(RuntimeError):
 
 class SweepLockedError(FolderLockedError):
     """Another sweep is running on the same output folder."""
-
-
-class _Job:
-    def __init__(self, kind, gen, scene, method, estimate=1, cost=1.0):
-        self.kind, self.gen, self.scene, self.method = kind, gen, scene, method
-        self.estimate, self.cost = estimate, cost
-        self.count, self.done, self.result = 0, False, None
-
-    @property
-    def remaining(self):
-        return 0 if self.done else max(1, self.estimate - self.count)
-
-
-def _single(spec):
-    rec = yield spec
-    return rec
 
 
 def _evals(method):
@@ -76,7 +60,7 @@ def _evals(method):
 # -- scenes --------------------------------------------------------------------------------------
 def prepare_scenes(config: dict, out: str, reuse: bool = True, log=print) -> dict:
     """Build (or, with ``reuse``, load the saved copy of) every scene of ``config``."""
-    from .registry import BenchScene, build, user_scene
+    from .registry import build, load_scene, save_scene, user_scene
 
     folder = os.path.join(out, "scenes")
     result = {}
@@ -88,7 +72,7 @@ def prepare_scenes(config: dict, out: str, reuse: bool = True, log=print) -> dic
             with open(path) as fh:
                 saved = json.load(fh)["info"].get("meta", {}).get("params")
             if saved == json.loads(json.dumps(params)):
-                scene = BenchScene.load(folder, name)
+                scene = load_scene(folder, name)
         if scene is None:
             t = time.perf_counter()
             with warnings.catch_warnings():
@@ -96,7 +80,7 @@ def prepare_scenes(config: dict, out: str, reuse: bool = True, log=print) -> dic
                 scene = user_scene(name=name, **params) if sc.get("builder") == "user" else build(name, **params)
             scene.name = name
             scene.meta = dict(scene.meta, params=params)
-            scene.save(folder)
+            save_scene(scene, folder)
             log(f"built scene {name}: {scene.description} ({time.perf_counter() - t:.1f} s)")
         if sc.get("platform"):
             scene.platform = sc["platform"]
@@ -123,15 +107,15 @@ def plan(config: dict, scenes: dict) -> list:
         for m, h in presets.rows_of(config, name):
             n = round(length * 1e3 / h)
             spec = RunSpec(name, m, float(h), n, sc.get("samples", 50), "run", timing_s=timing, threads=threads)
-            jobs.append(_Job("run", _single(spec), name, m, cost=n * _evals(m) * eval_s))
+            jobs.append(Job(single(spec), n * _evals(m) * eval_s, kind="run", scene=name, method=m))
         if scene.purpose == "accuracy" and scene.exact is None and not sc.get("rows"):
             ref = config.get("reference", presets.REFERENCE)
             h_min = min(sc["steps_fs"])
             n = round(length * 1e3 / h_min) * int(ref["factor"])
             spec = RunSpec(name, ref["method"], length * 1e3 / n, n, sc.get("samples", 50), "reference",
                            threads=threads)
-            jobs.append(_Job("reference", _single(spec), name, ref["method"],
-                             cost=n * _evals(ref["method"]) * eval_s * 2))
+            jobs.append(Job(single(spec), n * _evals(ref["method"]) * eval_s * 2, kind="reference", scene=name,
+                            method=ref["method"]))
         st = sc.get("stability")
         if st and scene.purpose == "accuracy":
             from .stability import driver
@@ -139,74 +123,48 @@ def plan(config: dict, scenes: dict) -> list:
             for m in sc.get("methods", methods):
                 est = 20 if st.get("linear") else 11
                 steps = 1 if st.get("linear") else st["probe_steps"]
-                jobs.append(_Job("stability", driver(name, m, st, threads=threads), name, m, estimate=est,
-                                 cost=steps * _evals(m) * (eval_s if not st.get("linear") else 4096 * 3e-7)))
+                jobs.append(Job(driver(name, m, st, threads=threads),
+                                steps * _evals(m) * (eval_s if not st.get("linear") else 4096 * 3e-7), est,
+                                kind="stability", scene=name, method=m))
     return jobs
 
 
 # -- execution -----------------------------------------------------------------------------------
+_scenes: dict = {}
+
+
+def work(payload: dict, spec_dict: dict):
+    """One spec in whatever process executes it (each scene is rebuilt from its payload once per process);
+    returns (record, arrays)."""
+    from ...systems.scene import Scene
+    from .stability import run_spec
+
+    key = (payload["info"]["name"], payload["fingerprint"])
+    if key not in _scenes:
+        _scenes[key] = Scene.from_payload(payload)
+    return run_spec(RunSpec(**spec_dict), _scenes[key])
+
+
 def _run_jobs(jobs, store, executor, fingerprints, progress=True, on_result=None):
-    from tqdm import tqdm
+    def key_of(spec):
+        return run_key(spec.to_dict(), fingerprints[spec.scene])
 
-    counter = itertools.count()
-    ready, inflight = [], {}
-    stats = {"computed": 0, "reused": 0}
-    bar = tqdm(total=sum(j.remaining for j in jobs), desc="bench", unit="run", disable=not progress,
-               dynamic_ncols=True)
+    def stored(spec):
+        rec = store.get(key_of(spec))
+        return None if rec is None or rec.status == "error" else rec
 
-    def tick():
-        bar.total = bar.n + sum(j.remaining for j in jobs)
-        bar.update(1)
+    def finish(spec, fut):
+        key = key_of(spec)
+        rec, arrays = _result(fut, spec)
+        store.put(key, rec, arrays)
+        return store.get(key)
 
-    def advance(job, rec):
-        while True:
-            try:
-                spec = next(job.gen) if rec is None else job.gen.send(rec)
-            except StopIteration as stop:
-                job.done, job.result = True, stop.value
-                return
-            key = run_key(spec.to_dict(), fingerprints[spec.scene])
-            stored = store.get(key)
-            if stored is None or stored.status == "error":
-                heapq.heappush(ready, (-job.cost, next(counter), job, spec, key))
-                return
-            stats["reused"] += 1
-            job.count += 1
-            tick()
-            rec = stored
-
-    for job in jobs:
-        advance(job, None)
+    bar = progress_bar(sum(j.remaining for j in jobs), "bench", progress)
     try:
-        while ready or inflight:
-            while ready and len(inflight) < executor.workers + 1:
-                _, _, job, spec, key = heapq.heappop(ready)
-                inflight[executor.submit(spec.to_dict(), spec.scene)] = (job, spec, key)
-            for fut in executor.wait(set(inflight)):
-                job, spec, key = inflight.pop(fut)
-                rec = _result(fut, spec)
-                store.put(key, rec[0], rec[1])
-                stats["computed"] += 1
-                job.count += 1
-                tick()
-                if on_result is not None:
-                    on_result(store.get(key))
-                advance(job, store.get(key))
-    except BaseException:
-        executor.shutdown(cancel=True, inflight=list(inflight))
-        for fut, (job, spec, key) in inflight.items():  # keep what finished while stopping
-            if fut.done() and not fut.cancelled():
-                try:
-                    rec, arrays = fut.result()
-                except BaseException:  # noqa: BLE001
-                    continue
-                if store.get(key) is None:
-                    store.put(key, rec, arrays)
-                    stats["computed"] += 1
+        return run_jobs(jobs, executor, stored, lambda ex, spec: ex.submit(spec.scene, spec.to_dict()), finish, bar,
+                        on_result)
+    finally:
         bar.close()
-        raise
-    bar.close()
-    return stats
 
 
 def _result(fut, spec):
@@ -241,8 +199,6 @@ def retime_sweep(config: dict, out: str, rounds: int = 3, workers: int = 1, char
     VerletIntegrator, in turns, ``rounds`` rounds), one at a time in this process, keeping everything else
     each run measured; then continue the sweep as ``resume=True`` does and rewrite its results.  For a sweep
     that shared its machine with other work: the ratios are taken in turns, but heavy load still blurs them."""
-    from tqdm import tqdm
-
     from .runs import retime
 
     if not os.path.isdir(os.path.join(out, "runs")) or not len(Store(out)):
@@ -261,9 +217,12 @@ def retime_sweep(config: dict, out: str, rounds: int = 3, workers: int = 1, char
             rec = store.get(key)
             if rec is not None and rec.wall_per_step and spec.timing_s > 0:
                 todo.append((spec, key, rec))
-        for spec, key, rec in tqdm(todo, desc="retime", unit="run", disable=not progress, dynamic_ncols=True):
+        bar = progress_bar(len(todo), "retime", progress)
+        for spec, key, rec in todo:
             retime(spec, scenes[spec.scene], rec, rounds)
             store.put(key, rec, store.arrays(key) if rec.has_arrays else None)
+            bar.update(1)
+        bar.close()
         log(f"timed {len(todo)} runs again")
     finally:
         lock.release()
@@ -281,21 +240,19 @@ def _sweep(config, out, workers, scheduler, resume, charts, progress, on_result,
     payloads = {name: sc.payload() for name, sc in scenes.items()}
     fingerprints = {name: p["fingerprint"] for name, p in payloads.items()}
     jobs = plan(config, scenes)
-    executor = make_executor(payloads, workers, scheduler)
+    executor = make_executor(work, payloads, workers, scheduler)
     t0 = time.perf_counter()
     try:
         stats = _run_jobs(jobs, store, executor, fingerprints, progress, on_result)
     except KeyboardInterrupt:
         log(f"interrupted: {len(store)} finished runs are kept in {out}; rerun with --resume to continue")
         raise
-    executor.shutdown()
     stats["seconds"] = time.perf_counter() - t0
     results = aggregate(config, scenes, jobs, store)
     results["stats"] = stats
     results["out"] = out
     write_json(os.path.join(out, "results.json"), results)
-    with open(os.path.join(out, "summary.txt"), "w") as fh:
-        fh.write(format_summary(results) + "\n")
+    write_text(os.path.join(out, "summary.txt"), format_summary(results) + "\n")
     if charts:
         from .charts import make_charts
 

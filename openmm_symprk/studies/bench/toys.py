@@ -19,7 +19,11 @@ from __future__ import annotations
 
 import numpy as np
 import openmm as mm
-from scipy.special import ellipj, ellipkinc
+
+from ...support import require
+
+special = require("scipy.special", "studies", "openmm_symprk.studies.bench.toys")
+ellipj, ellipkinc = special.ellipj, special.ellipkinc
 
 #: kT at 300 K in kJ/mol: the toys hold about this much energy per degree of freedom.
 KT300 = 0.0083144626 * 300.0

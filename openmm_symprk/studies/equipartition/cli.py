@@ -30,6 +30,9 @@ def build_parser():
     ap.add_argument("--quick", action="store_true", help="64 waters, short runs: seconds, large error bars")
     ap.add_argument("--out", default="equipartition-results", help="output folder (finished runs are reused)")
     ap.add_argument("--workers", type=int, default=2, help="worker processes (each runs one NVE run at a time)")
+    ap.add_argument("--scheduler", metavar="ADDRESS",
+                    help="Dask distributed scheduler address (e.g. tcp://host:8786) instead of local workers; "
+                         "needs the 'cluster' extra")
     ap.add_argument("--models", default=None, help="comma-separated water models (spce, tip3p); default: all (--quick: spce)")
     ap.add_argument("--rows", type=_rows, default=None,
                     help="METHOD:STEP_FS,... for every model (rigid:METHOD for the rigid-body engine); "
@@ -69,11 +72,11 @@ def main(argv=None) -> int:
         from .study import run_study
 
         summary = run_study(cfg, args.out, workers=args.workers, timing=not args.no_timing,
-                            progress=not args.no_progress)
+                            progress=not args.no_progress, scheduler=args.scheduler)
     except KeyboardInterrupt:
         print("symprk equipartition: interrupted (finished runs are kept; run again to continue)", file=sys.stderr)
         return 130
-    except (ValueError, KeyError, OSError, RuntimeError) as exc:
+    except (ValueError, KeyError, OSError, RuntimeError, ImportError) as exc:
         print(f"symprk equipartition: error: {exc}", file=sys.stderr)
         return 2
     print(format_summary(summary))

@@ -2,7 +2,7 @@
 
 Per model and row (method, step): T_rot - T_trans, T_trans, potential energy per molecule and the NVE energy
 drift (kT/ns per degree of freedom), each the mean over replicas with the larger of the within- and
-between-replica standard errors (:mod:`.stats`); the cost in force evaluations per ps and in wall seconds per
+between-replica standard errors (:mod:`openmm_symprk.stats`); the cost in force evaluations per ps and in wall seconds per
 simulated ps (measured in turns, relative to the reference row).  A row *matches* the reference (Verlet at
 0.5 fs) when its T_rot - T_trans and potential energy per molecule both lie within 2 combined standard errors
 of the reference's, compared replica by replica: every row runs from the same replica states, so each replica's
@@ -14,9 +14,10 @@ from __future__ import annotations
 import numpy as np
 
 from ...physics.temperature import R_KJ
+from ...support import require
 from .presets import RIGID_PREFIX
 from .runs import force_evals_per_step
-from .stats import Estimate, agrees, combine, drift, series_stats
+from ...stats import Estimate, agrees, combine, drift, paired, series_stats
 
 ZERO = Estimate(0.0, 0.0, 0, 0.0, 0.0)
 
@@ -28,7 +29,7 @@ def label(method: str, step_fs: float) -> str:
 
 
 def _estimate_dict(e: Estimate) -> dict:
-    return {"mean": e.mean, "se": e.se, "replicas": e.replicas, "se_within": e.se_within, "se_between": e.se_between}
+    return e.as_dict()
 
 
 #: Quantities compared with the reference replica by replica.
@@ -64,15 +65,6 @@ def _row_stats(reps, n_waters, temperature):
     return out
 
 
-def _paired(row_reps: dict, ref_reps: dict) -> Estimate | None:
-    """The row minus the reference over the replicas both have ({replica: (mean, se)})."""
-    common = sorted(set(row_reps) & set(ref_reps))
-    if not common:
-        return None
-    return combine([row_reps[r][0] - ref_reps[r][0] for r in common],
-                   [float(np.hypot(row_reps[r][1], ref_reps[r][1])) for r in common])
-
-
 def summarise(cfg: dict, runs: dict, timings: dict | None = None) -> dict:
     """The study's results from its finished runs ({(model, method, step): [(arrays, info)]}) and the optional
     timings ({(model, method, step): wall seconds per simulated ps})."""
@@ -99,7 +91,7 @@ def summarise(cfg: dict, runs: dict, timings: dict | None = None) -> dict:
             r["vs_ref"] = {}
             if ref is not None and "per_replica" in ref and "per_replica" in r:
                 for k in PAIRED:
-                    e = _paired(r["per_replica"][k], ref["per_replica"][k])
+                    e = paired(r["per_replica"][k], ref["per_replica"][k])
                     if e is not None:
                         r["vs_ref"][k] = _estimate_dict(e)
         for r in table:
@@ -203,10 +195,8 @@ def chart(summary: dict, path: str):
     """Three panels, error bars ± 2 SE: T_rot - T_trans against step size with the reference row as a band;
     T_rot - T_trans minus the reference's (replica by replica) against force evaluations per ps; the potential
     energy per molecule minus the reference's against step size."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    require("matplotlib", "studies", "openmm_symprk.studies.equipartition.report.chart").use("Agg")
+    plt = require("matplotlib.pyplot", "studies", "openmm_symprk.studies.equipartition.report.chart")
 
     fig, axes = plt.subplots(1, 3, figsize=(15, 4.6))
     markers = {"verlet": "o", "omelyan-2": "s", "pefrl": "D"}

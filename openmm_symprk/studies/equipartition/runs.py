@@ -18,29 +18,23 @@ from ...physics.momenta import kinetic_energy
 from ...physics.temperature import kinetic_temperatures
 from ...rigid.bodies import RigidBodies
 from ...systems.prepare import equilibrate, minimise
-from ...systems.properties import masses
+from ...systems.scene import Scene
 from ...systems.scenes import water_box
 from .presets import RIGID_PREFIX
 
-__all__ = ["WaterBox", "build_box", "replica_states", "run_nve", "steps_per_sample", "force_evals_per_step", "make_engine"]
+__all__ = ["build_box", "replica_states", "run_nve", "steps_per_sample", "force_evals_per_step", "make_engine"]
 
 
-class WaterBox:
-    """The study's System for one water model, with its molecules and masses."""
-
-    def __init__(self, model: str, n_waters: int, cutoff_nm: float):
-        self.model = model
-        self.system, self.topology, self.positions = water_box(model, n_waters, cutoff_nm)
-        self.molecules = [[a.index for a in r.atoms()] for r in self.topology.residues()]
-        self.masses = masses(self.system)
-        self.n_constraints = self.system.getNumConstraints()
+def build_box(cfg: dict, model: str) -> Scene:
+    """The study's water box for one model (:func:`openmm_symprk.systems.scenes.water_box`) as a Scene whose
+    ``meta["model"]`` names the model; its state is Modeller's (see :func:`replica_states`)."""
+    system, topology, x = water_box(model, cfg["n_waters"], cfg["cutoff_nm"])
+    return Scene(f"water-box-{model}", system, x, np.zeros_like(x), f"{cfg['n_waters']} rigid {model} waters, PME",
+                 topology, purpose="production", platform="CPU", invariants=("energy", "momentum"),
+                 temperature=float(cfg["temperature"]), meta={"model": model})
 
 
-def build_box(cfg: dict, model: str) -> WaterBox:
-    return WaterBox(model, cfg["n_waters"], cfg["cutoff_nm"])
-
-
-def replica_states(box: WaterBox, cfg: dict, log=print, start=None):
+def replica_states(box: Scene, cfg: dict, log=print, start=None):
     """(x, v) arrays of shape (replicas, N, 3): minimise, Langevin ``equilibrate_ps`` at ``temperature``,
     then one state every ``spacing_ps`` of further Langevin dynamics (replica r with seed ``seed + r``).
     ``start``: the (x, v) arrays of replicas already built, which the chain continues from."""
@@ -61,7 +55,7 @@ def replica_states(box: WaterBox, cfg: dict, log=print, start=None):
                            properties=props)
         xs.append(x)
         vs.append(v)
-    log(f"{box.model}: {len(box.molecules)} waters, {len(xs)} replica states ({cfg['equilibrate_ps']} + "
+    log(f"{box.meta['model']}: {len(box.molecules)} waters, {len(xs)} replica states ({cfg['equilibrate_ps']} + "
         f"{cfg['spacing_ps']} ps apart of Langevin dynamics; {len(xs) - n_old} new, "
         f"{time.perf_counter() - t0:.0f} s)")
     return np.array(xs), np.array(vs)
@@ -113,14 +107,14 @@ def make_engine(box, x, v, method, step_fs, threads):
     return _Constrained(box, x, v, method, step_fs, props)
 
 
-def run_nve(box: WaterBox, x, v, method: str, step_fs: float, cfg: dict):
+def run_nve(box: Scene, x, v, method: str, step_fs: float, cfg: dict):
     """One NVE run; returns (arrays, info).  arrays: t (ps, from the end of settling), T_trans, T_rot (K),
     pe and etot (kJ/mol).  info: wall_s, steps, force_evals, status ("ok", or "blew up at step S")."""
     every = steps_per_sample(step_fs, cfg["sample_fs"])
     dt_sample = every * step_fs * 1e-3
     settle = int(round(cfg["settle_ps"] / dt_sample))
     n_samples = int(round(cfg["length_ps"] / dt_sample)) + 1
-    m = box.masses
+    m, molecules, n_constraints = box.masses(), box.molecules, box.system.getNumConstraints()
     t0 = time.perf_counter()
     eng = make_engine(box, x, v, method, step_fs, cfg.get("threads", 1))
     out = {k: np.full(n_samples, np.nan) for k in ("t", "T_trans", "T_rot", "pe", "etot")}
@@ -132,7 +126,7 @@ def run_nve(box: WaterBox, x, v, method: str, step_fs: float, cfg: dict):
         if i < 0:
             continue
         xs, vs, pe = eng.sample()
-        kt = kinetic_temperatures(xs, vs, m, box.molecules, True, box.n_constraints)
+        kt = kinetic_temperatures(xs, vs, m, molecules, True, n_constraints)
         ke = kinetic_energy(vs, m)
         out["t"][i], out["T_trans"][i], out["T_rot"][i] = i * dt_sample, kt.translational, kt.rotational
         out["pe"][i], out["etot"][i] = pe, pe + ke

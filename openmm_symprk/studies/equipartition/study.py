@@ -11,44 +11,36 @@ setting never reuses a stale one.  Workers are spawned processes (scripts need t
 """
 from __future__ import annotations
 
-import concurrent.futures as cf
-import hashlib
-import json
-import multiprocessing as mp
 import os
 
 import numpy as np
 
-from ..folders import FolderLock, write_json
+from ..core import Run, Study, run_key as hash_key, write_json, write_npz, write_text
 from .report import summarise
 
-__all__ = ["run_study", "run_key", "load_runs"]
+__all__ = ["run_study", "run_key", "load_runs", "EquipartitionStudy"]
 
 #: What a replica state depends on.  Not the number of replicas: replica r is the same state whatever that number,
 #: so a study asked for more replicas later extends the chain and reuses every finished run.
 _STATE_KEYS = ("n_waters", "cutoff_nm", "temperature", "seed", "equilibrate_ps", "spacing_ps", "threads")
 _RUN_KEYS = _STATE_KEYS + ("settle_ps", "length_ps", "sample_fs")
 
-
-def _hash(obj) -> str:
-    return hashlib.sha1(json.dumps(obj, sort_keys=True).encode()).hexdigest()[:16]
-
-
 #: Version of what a run stores (2: T_trans without the kinetic energy of the box's centre of mass); a run
-#: stored by another version is never reused.
+#: stored by another version is never reused.  The error bars are computed at summary time from the stored
+#: series, so a change of estimator needs no new version: calling the study again re-summarises.
 RUN_VERSION = 2
 
 
 def run_key(cfg: dict, model: str, method: str, step_fs: float, replica: int) -> str:
-    return _hash({"cfg": {k: cfg[k] for k in _RUN_KEYS}, "model": model, "row": [method, float(step_fs)],
-                  "replica": int(replica), "version": RUN_VERSION})
+    return hash_key({"cfg": {k: cfg[k] for k in _RUN_KEYS}, "model": model, "row": [method, float(step_fs)],
+                     "replica": int(replica), "version": RUN_VERSION})
 
 
 def _states(cfg, model, out, log):
     """The model's replica states (at least ``cfg["replicas"]``), built or extended and kept in ``<out>/states``."""
     from .runs import build_box, replica_states
 
-    path = os.path.join(out, "states", f"{model}-{_hash({k: cfg[k] for k in _STATE_KEYS})}.npz")
+    path = os.path.join(out, "states", f"{model}-{hash_key({k: cfg[k] for k in _STATE_KEYS})}.npz")
     start = None
     if os.path.exists(path):
         with np.load(path) as d:
@@ -57,64 +49,48 @@ def _states(cfg, model, out, log):
             return start
     os.makedirs(os.path.dirname(path), exist_ok=True)
     x, v = replica_states(build_box(cfg, model), cfg, log, start=start)
-    tmp = f"{path}.tmp{os.getpid()}.npz"
-    np.savez(tmp, x=x, v=v)
-    os.replace(tmp, path)
+    write_npz(path, {"x": x, "v": v})
     return x, v
 
 
 _boxes: dict = {}
 
 
-def _work(cfg, model, method, step_fs, x, v):
-    """One run in a worker process (the box is built once per process and model)."""
-    import warnings
-
+def work(shared: dict, method: str, step_fs: float, replica: int):
+    """One NVE run in whatever process executes it (the box is built once per process and model)."""
     from .runs import build_box, run_nve
 
+    cfg, model = shared["cfg"], shared["model"]
     key = (model, cfg["n_waters"], cfg["cutoff_nm"])
     if key not in _boxes:
         _boxes[key] = build_box(cfg, model)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")  # the periodic-box conservation warning is expected here
-        return run_nve(_boxes[key], x, v, method, step_fs, cfg)
-
-
-def _paths(out, key):
-    return os.path.join(out, "runs", f"{key}.json"), os.path.join(out, "runs", f"{key}.npz")
+    return run_nve(_boxes[key], shared["x"][replica], shared["v"][replica], method, step_fs, cfg)
 
 
 def load_runs(cfg: dict, out: str) -> dict:
     """{(model, method, step_fs): [(arrays, info) per finished replica]}: every finished replica in ``out`` made
     with these settings, also those beyond ``cfg["replicas"]`` (from an earlier call that asked for more)."""
+    from ..core import RunStore
+
     wanted = {(model, method, float(h)) for model, rows in cfg["models"].items() for method, h in rows}
     found = {row: [] for row in wanted}
-    folder = os.path.join(out, "runs")
-    for name in sorted(os.listdir(folder)) if os.path.isdir(folder) else []:
-        if not name.endswith(".json"):
-            continue
-        jpath, npath = _paths(out, name[:-5])
+    if not os.path.isdir(os.path.join(out, "runs")):
+        return found
+    store = RunStore(out)
+    for key in sorted(store.keys()):
+        info = store.info(key)
         try:
-            with open(jpath) as fh:
-                info = json.load(fh)
             row = (info["model"], info["method"], float(info["step_fs"]))
-        except (OSError, ValueError, KeyError):
+        except (TypeError, ValueError, KeyError):
             continue
-        if row not in wanted or name[:-5] != run_key(cfg, *row, info["replica"]) or not os.path.exists(npath):
+        if row not in wanted or key != run_key(cfg, *row, info["replica"]):
             continue
-        with np.load(npath) as d:
-            found[row].append(({k: d[k] for k in d.files}, info))
+        arrays = store.arrays(key)
+        if arrays is not None:
+            found[row].append((arrays, info))
     for reps in found.values():
         reps.sort(key=lambda rep: rep[1]["replica"])
     return found
-
-
-def _save(out, key, arrays, info):
-    jpath, npath = _paths(out, key)
-    tmp = f"{npath}.tmp{os.getpid()}.npz"
-    np.savez(tmp, **arrays)
-    os.replace(tmp, npath)
-    write_json(jpath, info)
 
 
 def _check(cfg):
@@ -140,41 +116,58 @@ def _check(cfg):
             raise ValueError(f"{model}: the reference row {cfg['reference']} is not among its rows")
 
 
-def run_study(cfg: dict, out: str, workers: int = 2, timing: bool = True, progress: bool = True, log=print) -> dict:
-    """Run (or finish) the study in ``out``; returns the summary (see :func:`.report.summarise`) and writes
-    ``summary.txt``, ``results.json`` and ``equipartition.png`` there."""
-    _check(cfg)
-    os.makedirs(os.path.join(out, "runs"), exist_ok=True)
-    lock = FolderLock(out, "symprk equipartition")
-    try:
-        todo = []
-        states = {model: _states(cfg, model, out, log) for model in cfg["models"]}
+class EquipartitionStudy(Study):
+    """Replica states per water model, then one NVE run per (model, row, replica)."""
+
+    command = "symprk equipartition"
+    work = work
+
+    def __init__(self, cfg: dict, out: str, workers: int = 2, timing: bool = True, progress: bool = True,
+                 log=print, scheduler: str | None = None):
+        _check(cfg)
+        super().__init__(out, workers, scheduler, progress, log)
+        self.cfg, self.timing = cfg, timing
+        self.states = {}
+
+    def plan(self) -> list:
+        cfg = self.cfg
+        self.states = {model: _states(cfg, model, self.out, self.log) for model in cfg["models"]}
+        runs = []
         for model, rows in cfg["models"].items():
-            for method, h in sorted(rows, key=lambda r: -force_cost(r, cfg)):
+            for method, h in rows:
                 for r in range(int(cfg["replicas"])):
-                    key = run_key(cfg, model, method, h, r)
-                    if not os.path.exists(_paths(out, key)[0]):
-                        todo.append((key, model, method, float(h), r))
-        n_all = sum(len(rows) for rows in cfg["models"].values()) * int(cfg["replicas"])
-        if n_all - len(todo):
-            log(f"reusing {n_all - len(todo)} finished runs in {out}")
-        _execute(todo, cfg, states, out, workers, progress, log)
-        runs = load_runs(cfg, out)
-        timings = _timings(cfg, states, log) if timing else {}
-        summary = summarise(cfg, runs, timings)
+                    runs.append(Run(run_key(cfg, model, method, h, r), model, (method, float(h), r),
+                                    {"model": model, "method": method, "step_fs": float(h), "replica": r},
+                                    force_cost([method, h], cfg)))
+        return runs
+
+    def shared(self, runs) -> dict:
+        return {model: {"cfg": self.cfg, "model": model, "x": x, "v": v} for model, (x, v) in self.states.items()}
+
+    def stored(self, run, info):
+        if info["status"] != "ok":
+            self.log(f"{info['model']} {info['method']} {info['step_fs']} fs replica {info['replica']}: "
+                     f"{info['status']}")
+
+    def summarise(self, runs) -> dict:
         from .report import chart, format_summary
 
-        text = format_summary(summary)
-        with open(os.path.join(out, "summary.txt"), "w") as fh:
-            fh.write(text + "\n")
-        write_json(os.path.join(out, "results.json"), summary)
+        timings = _timings(self.cfg, self.states, self.log) if self.timing else {}
+        summary = summarise(self.cfg, load_runs(self.cfg, self.out), timings)
+        write_text(os.path.join(self.out, "summary.txt"), format_summary(summary) + "\n")
+        write_json(os.path.join(self.out, "results.json"), summary)
         try:
-            chart(summary, os.path.join(out, "equipartition.png"))
-        except ImportError:
-            log("matplotlib is not installed: no chart (pip install matplotlib)")
+            chart(summary, os.path.join(self.out, "equipartition.png"))
+        except ImportError as exc:  # MissingDependencyError says which extra installs matplotlib
+            self.log(f"no chart: {exc}")
         return summary
-    finally:
-        lock.release()
+
+
+def run_study(cfg: dict, out: str, workers: int = 2, timing: bool = True, progress: bool = True, log=print,
+              scheduler: str | None = None) -> dict:
+    """Run (or finish, or only re-summarise) the study in ``out``; returns the summary (see
+    :func:`.report.summarise`) and writes ``summary.txt``, ``results.json`` and ``equipartition.png`` there."""
+    return EquipartitionStudy(cfg, out, workers, timing, progress, log, scheduler).run()
 
 
 def force_cost(row, cfg) -> float:
@@ -183,45 +176,6 @@ def force_cost(row, cfg) -> float:
 
     method, h = row
     return force_evals_per_step(method) * (cfg["length_ps"] + cfg["settle_ps"]) * 1000.0 / float(h)
-
-
-def _execute(todo, cfg, states, out, workers, progress, log):
-    if not todo:
-        return
-    bar = None
-    if progress:
-        from tqdm import tqdm
-
-        bar = tqdm(total=len(todo), desc="equipartition runs", unit="run")
-
-    def done(key, model, method, h, r, result):
-        arrays, info = result
-        info.update(model=model, method=method, step_fs=h, replica=r)
-        _save(out, key, arrays, info)
-        if bar is not None:
-            bar.update(1)
-        if info["status"] != "ok":
-            log(f"{model} {method} {h} fs replica {r}: {info['status']}")
-
-    try:
-        if workers <= 1:
-            for key, model, method, h, r in todo:
-                x, v = states[model]
-                done(key, model, method, h, r, _work(cfg, model, method, h, x[r], v[r]))
-            return
-        with cf.ProcessPoolExecutor(max_workers=workers, mp_context=mp.get_context("spawn")) as pool:
-            futures = {pool.submit(_work, cfg, model, method, h, states[model][0][r], states[model][1][r]):
-                       (key, model, method, h, r) for key, model, method, h, r in todo}
-            try:
-                for fut in cf.as_completed(futures):
-                    done(*futures[fut], fut.result())
-            except BaseException:
-                for f in futures:
-                    f.cancel()
-                raise
-    finally:
-        if bar is not None:
-            bar.close()
 
 
 def _timings(cfg, states, log) -> dict:

@@ -162,17 +162,6 @@ void CommonIntegrateSymPRKStepKernel::execute(ContextImpl& context, const SymPRK
             lastVelocityStep = s;
     const int check = (int) min(stepIndex, (long long) INT_MAX);
 
-    // Velocity projections before every drift whose |coefficient| exceeds the previous drift's (the rule of
-    // openmm_symprk.methods.splitting.Splitting.projected_drifts; see the Reference kernel).
-    vector<bool> projectBefore(numSubsteps, false);
-    double previousDrift = 0.0;
-    for (int s = 0; s < numSubsteps; s++)
-        if (integrator.getSubstepKind(s) == SymPRKIntegrator::Drift) {
-            double c = integrator.getSubstepCoefficient(s);
-            projectBefore[s] = (hasConstraints && previousDrift != 0.0 && fabs(c) > fabs(previousDrift));
-            previousDrift = c;
-        }
-
     if (context.updateContextState())
         forcesAreValid = false;
     if (!forcesAreValid)
@@ -186,11 +175,12 @@ void CommonIntegrateSymPRKStepKernel::execute(ContextImpl& context, const SymPRK
             // method keeps a copy per group, so that a group is evaluated only where a drift came between two of
             // its kicks).
             const int mask = (integrator.getSubstepForceGroups(s) == -1 ? groups : integrator.getSubstepForceGroups(s));
+            const bool reuse = (integrator.getSubstepFlags(s) & SymPRKIntegrator::ForcesCached) != 0;
             ArrayInterface* kickForces = &cc.getLongForceBuffer();
-            if (multipleGroups && groupForcesValid[mask])
+            if (reuse && multipleGroups && groupForcesValid[mask])
                 kickForces = groupForces[mask].get();
             else {
-                if (!forcesAreValid || context.getLastForceGroups() != mask) {
+                if (!reuse || !forcesAreValid || context.getLastForceGroups() != mask) {
                     ContextDeselector deselector(cc);
                     context.calcForcesAndEnergy(true, false, mask);
                     forcesAreValid = true;
@@ -217,7 +207,8 @@ void CommonIntegrateSymPRKStepKernel::execute(ContextImpl& context, const SymPRK
             }
         }
         else {
-            if (projectBefore[s])
+            // a projection before a drift flagged for one (openmm_symprk.methods.resolved states the rule)
+            if (hasConstraints && (integrator.getSubstepFlags(s) & SymPRKIntegrator::ProjectVelocitiesBefore) != 0)
                 projectVelocities(tol, exact);
             if (hasConstraints) {
                 setMixedArg(driftDeltaKernel, 0, cdt);

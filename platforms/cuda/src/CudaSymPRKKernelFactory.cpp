@@ -1,8 +1,7 @@
 /* openmm_symprk native plugin: registers the Common SymPRKIntegrator kernel with the CUDA platform.
  *
- * Built only when SYMPRK_BUILD_CUDA=1 and both the CUDA toolkit headers and the wheel's libOpenMMCUDA.so are
- * present (the build driver, platforms/build_native.py, checks); nothing here has been compiled or run on a
- * machine of this project yet.  The kernel code is the same Common source as OpenCL's. */
+ * Compiled wherever CMake finds the CUDA headers (cuda/CMakeLists.txt); never run on a machine of this project
+ * yet (no GPU).  The kernel code is the same Common source as OpenCL's. */
 
 #include "CommonSymPRKKernels.h"
 #include "openmm/cuda/CudaContext.h"

@@ -17,73 +17,63 @@
 using namespace OpenMM;
 using namespace std;
 
-static const int64_t CHECKPOINT_MAGIC_V1 = 0x53796d50524b0001LL; // "SymPRK" + format version 1
-static const int64_t CHECKPOINT_MAGIC = 0x53796d50524b0002LL;    // version 2: + program signature and method
+// Checkpoint format: "SymPRK" + version.  Version 3 (sub-steps with flags in the program signature) refuses the
+// older versions 1 and 2, whose signatures were computed without the flags.
+static const int64_t CHECKPOINT_MAGIC_BASE = 0x53796d50524b0000LL;
+static const int64_t CHECKPOINT_MAGIC = CHECKPOINT_MAGIC_BASE + 3;
 
 SymPRKIntegrator::SymPRKIntegrator(double stepSize) : exactMomentum(false), forcesAreValid(false),
         methodName("verlet"), stepsTaken(0), blowUpStep(0), maxSpeed(0.0), expectedParticles(-1),
         expectedConstraints(false) {
     setStepSize(stepSize);
     setConstraintTolerance(1e-5);
-    setSubsteps({Kick, Drift, Kick}, {0.5, 1.0, 0.5});
+    setSubsteps({Kick, Drift, Kick}, {0.5, 1.0, 0.5}, {-1, -1, -1}, {ForcesCached, 0, 0});
 }
 
-SymPRKIntegrator::SymPRKIntegrator(double stepSize, const vector<int>& kinds, const vector<double>& coefficients) :
+SymPRKIntegrator::SymPRKIntegrator(double stepSize, const vector<int>& kinds, const vector<double>& coefficients,
+        const vector<int>& groups, const vector<int>& flags) :
         exactMomentum(false), forcesAreValid(false), methodName(""), stepsTaken(0), blowUpStep(0), maxSpeed(0.0),
         expectedParticles(-1), expectedConstraints(false) {
     setStepSize(stepSize);
     setConstraintTolerance(1e-5);
-    setSubsteps(kinds, coefficients);
+    setSubsteps(kinds, coefficients, groups, flags);
 }
 
-void SymPRKIntegrator::setSubsteps(const vector<int>& newKinds, const vector<double>& newCoefficients) {
-    setSubsteps(newKinds, newCoefficients, vector<int>(newKinds.size(), -1));
-}
-
-void SymPRKIntegrator::setSubsteps(const vector<int>& newKinds, const vector<double>& newCoefficients, const vector<int>& newGroups) {
+void SymPRKIntegrator::setSubsteps(const vector<int>& newKinds, const vector<double>& newCoefficients, const vector<int>& newGroups,
+        const vector<int>& newFlags) {
     if (owner != NULL)
         throw OpenMMException("SymPRKIntegrator: the sub-steps cannot be changed once the integrator is bound to a Context");
-    if (newKinds.size() != newCoefficients.size() || newKinds.size() != newGroups.size())
-        throw OpenMMException("SymPRKIntegrator: kinds, coefficients and force groups must have the same length");
-    vector<int> k, g;
-    vector<double> c;
-    for (size_t i = 0; i < newKinds.size(); i++) {
-        if (newKinds[i] != Kick && newKinds[i] != Drift) {
-            stringstream msg;
-            msg << "SymPRKIntegrator: sub-step " << i << " has kind " << newKinds[i] << "; expected 0 (kick) or 1 (drift)";
-            throw OpenMMException(msg.str());
-        }
-        if (!std::isfinite(newCoefficients[i])) {
-            stringstream msg;
-            msg << "SymPRKIntegrator: sub-step " << i << " has a non-finite coefficient";
-            throw OpenMMException(msg.str());
-        }
-        int group = (newKinds[i] == Kick ? newGroups[i] : -1);
-        if (group == 0 || group < -1) {
-            stringstream msg;
-            msg << "SymPRKIntegrator: sub-step " << i << " has force-group mask " << group << "; expected a non-zero bit mask or -1";
-            throw OpenMMException(msg.str());
-        }
-        if (newCoefficients[i] == 0.0)
+    const size_t n = newKinds.size();
+    if (newCoefficients.size() != n || newGroups.size() != n || newFlags.size() != n)
+        throw OpenMMException("SymPRKIntegrator: kinds, coefficients, force groups and flags must have the same length");
+    if (n == 0)
+        throw OpenMMException("SymPRKIntegrator: a step needs at least one sub-step");
+    for (size_t i = 0; i < n; i++) {
+        stringstream msg;
+        msg << "SymPRKIntegrator: sub-step " << i;
+        if (newKinds[i] != Kick && newKinds[i] != Drift)
+            msg << " has kind " << newKinds[i] << "; expected " << Kick << " (kick) or " << Drift << " (drift)";
+        else if (!std::isfinite(newCoefficients[i]) || newCoefficients[i] == 0.0)
+            msg << " has the coefficient " << newCoefficients[i] << "; expected a finite non-zero number (leave a zero sub-step out)";
+        else if (newKinds[i] == Kick && (newGroups[i] == 0 || newGroups[i] < -1))
+            msg << " has force-group mask " << newGroups[i] << "; expected a non-zero bit mask or -1";
+        else if (newKinds[i] == Drift && newGroups[i] != -1)
+            msg << " is a drift with force-group mask " << newGroups[i] << "; a drift takes -1";
+        else if ((newFlags[i] & ~(ProjectVelocitiesBefore | ForcesCached)) != 0)
+            msg << " has flags " << newFlags[i] << "; expected a combination of " << ProjectVelocitiesBefore
+                << " (project velocities before a drift) and " << ForcesCached << " (a kick on cached forces)";
+        else if (newKinds[i] == Kick && (newFlags[i] & ProjectVelocitiesBefore) != 0)
+            msg << " is a kick flagged ProjectVelocitiesBefore, which only a drift takes";
+        else if (newKinds[i] == Drift && (newFlags[i] & ForcesCached) != 0)
+            msg << " is a drift flagged ForcesCached, which only a kick takes";
+        else
             continue;
-        if (!k.empty() && k.back() == newKinds[i] && g.back() == group)
-            c.back() += newCoefficients[i];
-        else {
-            k.push_back(newKinds[i]);
-            c.push_back(newCoefficients[i]);
-            g.push_back(group);
-        }
-        if (c.back() == 0.0) {
-            k.pop_back();
-            c.pop_back();
-            g.pop_back();
-        }
+        throw OpenMMException(msg.str());
     }
-    if (k.empty())
-        throw OpenMMException("SymPRKIntegrator: a step needs at least one sub-step with a non-zero coefficient");
-    kinds = k;
-    coefficients = c;
-    groups = g;
+    kinds = newKinds;
+    coefficients = newCoefficients;
+    groups = newGroups;
+    flags = newFlags;
 }
 
 int SymPRKIntegrator::getSubstepForceGroups(int index) const {
@@ -104,24 +94,17 @@ double SymPRKIntegrator::getSubstepCoefficient(int index) const {
     return coefficients[index];
 }
 
+int SymPRKIntegrator::getSubstepFlags(int index) const {
+    if (index < 0 || index >= (int) kinds.size())
+        throw OpenMMException("SymPRKIntegrator: sub-step index out of range");
+    return flags[index];
+}
+
 int SymPRKIntegrator::getForceEvaluationsPerStep() const {
-    // A kick needs an evaluation when a drift came since the previous kick of the same force groups, counted
-    // cyclically (the same rule as openmm_symprk.methods.splitting.Splitting.force_evaluations).
-    const int n = kinds.size();
     int count = 0;
-    for (int i = 0; i < n; i++) {
-        if (kinds[i] != Kick)
-            continue;
-        bool drift = false;
-        for (int j = (i-1+n)%n; ; j = (j-1+n)%n) {
-            if (kinds[j] == Drift)
-                drift = true;
-            if ((kinds[j] == Kick && groups[j] == groups[i]) || j == i)
-                break;
-        }
-        if (drift)
+    for (size_t i = 0; i < kinds.size(); i++)
+        if (kinds[i] == Kick && (flags[i] & ForcesCached) == 0)
             count++;
-    }
     return count;
 }
 
@@ -159,7 +142,7 @@ void SymPRKIntegrator::setExpectedSystem(int numParticles, bool constraints) {
 }
 
 long long SymPRKIntegrator::getProgramSignature() const {
-    // FNV-1a over the sub-step kinds, the coefficients' bits and the exact-momentum flag.
+    // FNV-1a over the sub-step kinds, coefficients' bits, force groups and flags, and the exact-momentum option.
     uint64_t hash = 1469598103934665603ULL;
     auto mix = [&] (const void* data, size_t size) {
         const unsigned char* bytes = (const unsigned char*) data;
@@ -169,11 +152,11 @@ long long SymPRKIntegrator::getProgramSignature() const {
         }
     };
     for (size_t i = 0; i < kinds.size(); i++) {
-        int32_t kind = kinds[i], group = groups[i];
+        int32_t kind = kinds[i], group = groups[i], flag = flags[i];
         mix(&kind, sizeof(kind));
         mix(&coefficients[i], sizeof(double));
-        if (group != -1)
-            mix(&group, sizeof(group));  // absent for plain splittings: their signatures are unchanged
+        mix(&group, sizeof(group));
+        mix(&flag, sizeof(flag));
     }
     int32_t exact = exactMomentum ? 1 : 0;
     mix(&exact, sizeof(exact));
@@ -281,23 +264,29 @@ void SymPRKIntegrator::createCheckpoint(ostream& stream) const {
 void SymPRKIntegrator::loadCheckpoint(istream& stream) {
     int64_t values[3];
     stream.read((char*) values, sizeof(values));
-    if (!stream || (values[0] != CHECKPOINT_MAGIC && values[0] != CHECKPOINT_MAGIC_V1))
+    if (stream && values[0] > CHECKPOINT_MAGIC_BASE && values[0] < CHECKPOINT_MAGIC) {
+        stringstream msg;
+        msg << "SymPRKIntegrator: the checkpoint was written by an older openmm_symprk (checkpoint format "
+            << (values[0]-CHECKPOINT_MAGIC_BASE) << "; this one reads format " << (CHECKPOINT_MAGIC-CHECKPOINT_MAGIC_BASE)
+            << ", whose program signature covers the sub-step flags): it cannot be loaded. Load the positions and "
+               "velocities of the saved run (a State or a PDB/XML file) instead";
+        throw OpenMMException(msg.str());
+    }
+    if (!stream || values[0] != CHECKPOINT_MAGIC)
         throw OpenMMException("SymPRKIntegrator: the checkpoint was not written by a SymPRKIntegrator (a checkpoint "
                 "of openmm_symprk's CustomIntegrator backend? Load it into SymplecticIntegrator(..., backend='custom') "
                 "with the same method and options as when it was saved)");
-    if (values[0] == CHECKPOINT_MAGIC) {
-        int64_t more[2];
-        stream.read((char*) more, sizeof(more));
-        string name(more[1] > 0 && more[1] < 4096 ? more[1] : 0, ' ');
-        if (!name.empty())
-            stream.read(&name[0], name.size());
-        if (!stream)
-            throw OpenMMException("SymPRKIntegrator: the checkpoint is truncated");
-        if (more[0] != getProgramSignature())
-            throw OpenMMException("SymPRKIntegrator: the checkpoint was written by a SymPRKIntegrator running another program "
-                    "(method '"+name+"'; this one runs '"+methodName+"' with exact momentum "+(exactMomentum ? "on" : "off")+
-                    "): create the integrator with the same method and options as when the checkpoint was saved");
-    }
+    int64_t more[2];
+    stream.read((char*) more, sizeof(more));
+    string name(more[1] > 0 && more[1] < 4096 ? more[1] : 0, ' ');
+    if (!name.empty())
+        stream.read(&name[0], name.size());
+    if (!stream)
+        throw OpenMMException("SymPRKIntegrator: the checkpoint is truncated");
+    if (more[0] != getProgramSignature())
+        throw OpenMMException("SymPRKIntegrator: the checkpoint was written by a SymPRKIntegrator running another program "
+                "(method '"+name+"'; this one runs '"+methodName+"' with exact momentum "+(exactMomentum ? "on" : "off")+
+                "): create the integrator with the same method and options as when the checkpoint was saved");
     stepsTaken = values[1];
     blowUpStep = values[2];
     if (context != NULL)

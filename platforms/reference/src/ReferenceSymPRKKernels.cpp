@@ -283,18 +283,13 @@ void ReferenceIntegrateSymPRKStepKernel::execute(ContextImpl& context, const Sym
         forcesAreValid = false;
         groupForces.clear();
     };
-    // Velocity projections inside the step, before every drift whose |coefficient| exceeds the previous drift's
-    // (the rule of openmm_symprk.methods.splitting.Splitting.projected_drifts): a no-op in exact arithmetic that
-    // keeps the constraint solver's residual from being amplified from drift to drift.
+    // The sub-step flags come with the sequence (openmm_symprk.methods.resolved states the rules): a velocity
+    // projection before a drift flagged ProjectVelocitiesBefore (where the System has constraints), and forces
+    // reused by a kick flagged ForcesCached while they are still valid.
     const int numSubsteps = integrator.getNumSubsteps();
-    vector<bool> projectBefore(numSubsteps, false);
-    double previousDrift = 0.0;
-    for (int s = 0; s < numSubsteps; s++)
-        if (integrator.getSubstepKind(s) == SymPRKIntegrator::Drift) {
-            double c = integrator.getSubstepCoefficient(s);
-            projectBefore[s] = (hasConstraints && previousDrift != 0.0 && fabs(c) > fabs(previousDrift));
-            previousDrift = c;
-        }
+    auto projectBefore = [&] (int s) {
+        return hasConstraints && (integrator.getSubstepFlags(s) & SymPRKIntegrator::ProjectVelocitiesBefore) != 0;
+    };
     for (int s = 0; s < numSubsteps; ) {
         const double cdt = integrator.getSubstepCoefficient(s)*dt;
         if (integrator.getSubstepKind(s) == SymPRKIntegrator::Kick) {
@@ -302,23 +297,26 @@ void ReferenceIntegrateSymPRKStepKernel::execute(ContextImpl& context, const Sym
             // multiple-time-step method keeps a copy per group, so that a group is evaluated only where a
             // drift came between two of its kicks.
             const int mask = (integrator.getSubstepForceGroups(s) == -1 ? groups : integrator.getSubstepForceGroups(s));
+            const bool reuse = (integrator.getSubstepFlags(s) & SymPRKIntegrator::ForcesCached) != 0;
             const vector<Vec3>* kickForces = &force;
-            auto cached = groupForces.find(mask);
+            auto cached = (reuse ? groupForces.find(mask) : groupForces.end());
             if (cached != groupForces.end())
                 kickForces = &cached->second;
             else {
-                if (!forcesAreValid || context.getLastForceGroups() != mask) {
+                if (!reuse || !forcesAreValid || context.getLastForceGroups() != mask) {
                     context.calcForcesAndEnergy(true, false, mask);
                     forcesAreValid = true;
                 }
-                if (multipleGroups)
-                    kickForces = &groupForces.emplace(mask, force).first->second;
+                if (multipleGroups) {
+                    groupForces[mask] = force;
+                    kickForces = &groupForces[mask];
+                }
             }
             const vector<Vec3>& f = *kickForces;
             // a drift right after this kick shares its pass, unless it projects the velocities first (a kick of
             // another force group may follow too: multiple time stepping)
             const bool fuse = (s+1 < numSubsteps && integrator.getSubstepKind(s+1) == SymPRKIntegrator::Drift &&
-                               !projectBefore[s+1]);
+                               !projectBefore(s+1));
             const double cdtDrift = (fuse ? integrator.getSubstepCoefficient(s+1)*dt : 0.0);
             if (exact) {
                 computeProjection(pos, f);
@@ -352,7 +350,7 @@ void ReferenceIntegrateSymPRKStepKernel::execute(ContextImpl& context, const Sym
                 s += 1;
         }
         else {
-            if (projectBefore[s])
+            if (projectBefore(s))
                 projectVelocities(pos, vel, tol, exact);
             parallelFor([&] (int t, int start, int end) {
                 for (int i = start; i < end; i++)

@@ -4,6 +4,7 @@
 #include "openmm/serialization/SerializationNode.h"
 #include "openmm/SymPRKIntegrator.h"
 #include "openmm/OpenMMException.h"
+#include <string>
 #include <typeinfo>
 #include <vector>
 
@@ -15,7 +16,7 @@ SymPRKIntegratorProxy::SymPRKIntegratorProxy() : SerializationProxy("SymPRKInteg
 
 void SymPRKIntegratorProxy::serialize(const void* object, SerializationNode& node) const {
     const SymPRKIntegrator& integrator = *reinterpret_cast<const SymPRKIntegrator*>(object);
-    node.setIntProperty("version", 1);
+    node.setIntProperty("version", 2);  // 2: every sub-step carries its flags
     node.setDoubleProperty("stepSize", integrator.getStepSize());
     node.setDoubleProperty("constraintTolerance", integrator.getConstraintTolerance());
     node.setIntProperty("integrationForceGroups", integrator.getIntegrationForceGroups());
@@ -31,13 +32,19 @@ void SymPRKIntegratorProxy::serialize(const void* object, SerializationNode& nod
         s.setDoubleProperty("c", integrator.getSubstepCoefficient(i));
         if (integrator.getSubstepForceGroups(i) != -1)
             s.setIntProperty("groups", integrator.getSubstepForceGroups(i));
+        s.setIntProperty("flags", integrator.getSubstepFlags(i));
     }
 }
 
 void* SymPRKIntegratorProxy::deserialize(const SerializationNode& node) const {
-    if (node.getIntProperty("version") != 1)
-        throw OpenMMException("SymPRKIntegrator: unsupported serialization version");
-    vector<int> kinds, groups;
+    const int version = node.getIntProperty("version");
+    if (version == 1)
+        throw OpenMMException("SymPRKIntegrator: this XML was written by an older openmm_symprk (serialization version 1, "
+                "sub-steps without their projection and cached-force flags) and cannot be read: create the integrator "
+                "again (openmm_symprk.SymplecticIntegrator with the same method and options) and serialize it anew");
+    if (version != 2)
+        throw OpenMMException("SymPRKIntegrator: unsupported serialization version "+to_string(version)+" (this build reads 2)");
+    vector<int> kinds, groups, flags;
     vector<double> coefficients;
     for (const SerializationNode& s : node.getChildNode("Substeps").getChildren()) {
         string kind = s.getStringProperty("kind");
@@ -49,9 +56,9 @@ void* SymPRKIntegratorProxy::deserialize(const SerializationNode& node) const {
             throw OpenMMException("SymPRKIntegrator: unknown sub-step kind '"+kind+"' in XML");
         coefficients.push_back(s.getDoubleProperty("c"));
         groups.push_back(s.getIntProperty("groups", -1));
+        flags.push_back(s.getIntProperty("flags"));
     }
-    SymPRKIntegrator* integrator = new SymPRKIntegrator(node.getDoubleProperty("stepSize"), kinds, coefficients);
-    integrator->setSubsteps(kinds, coefficients, groups);
+    SymPRKIntegrator* integrator = new SymPRKIntegrator(node.getDoubleProperty("stepSize"), kinds, coefficients, groups, flags);
     integrator->setConstraintTolerance(node.getDoubleProperty("constraintTolerance"));
     integrator->setIntegrationForceGroups(node.getIntProperty("integrationForceGroups", 0xFFFFFFFF));
     integrator->setExactMomentum(node.getBoolProperty("exactMomentum", false));

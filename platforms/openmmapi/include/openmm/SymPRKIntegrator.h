@@ -3,18 +3,23 @@
 
 /* openmm_symprk native plugin: an Integrator that runs any explicit kick/drift splitting.
  *
- * One step is a sequence of sub-steps, each a kind and a coefficient c:
- *   kick  (Kick = 0):  v += c*dt*F/m               (F/m projected when exact momentum is on)
- *   drift (Drift = 1): x += c*dt*v                  (RATTLE when the System has constraints:
- *                      positions constrained with the pre-drift positions as reference, then
- *                      v += (x - x_unconstrained)/(c*dt))
+ * One step is a sequence of sub-steps, each a kind, a coefficient c, a force-group mask and flags:
+ *   kick  (Kick):   v += c*dt*F/m               (F/m projected when exact momentum is on)
+ *   drift (Drift):  x += c*dt*v                  (RATTLE when the System has constraints:
+ *                   positions constrained with the pre-drift positions as reference, then
+ *                   v += (x - x_unconstrained)/(c*dt))
  * and, with constraints, one velocity projection at the end of the step.  Massless particles are
  * never moved; virtual sites are placed before every force evaluation and at the end of the step.
- * The forces of a closing kick stay valid and serve the next step's opening kick, so a step costs
+ *
+ * The flags are decided by whoever builds the sequence (openmm_symprk.methods.resolved, the one place
+ * that states the rules), not here: ProjectVelocitiesBefore on a drift projects the velocities onto the
+ * constraints first (where the System has constraints); ForcesCached on a kick says that no drift came
+ * since the previous kick of its force groups (cyclically, so a closing kick's forces serve the next
+ * step's opening kick), so its forces are reused whenever they are still valid.  A step then costs
  * getForceEvaluationsPerStep() force evaluations in steady state.
  *
- * This is the same program openmm_symprk/program.py compiles into a CustomIntegrator, without the
- * per-degree-of-freedom interpreter.
+ * This is the same program openmm_symprk/integrators/program.py compiles into a CustomIntegrator,
+ * without the per-degree-of-freedom interpreter.
  */
 
 #include "openmm/Integrator.h"
@@ -27,12 +32,20 @@ namespace OpenMM {
 
 class OPENMM_EXPORT SymPRKIntegrator : public Integrator {
 public:
+    /** What a sub-step does (openmm_symprk.methods.resolved.SubstepKind has the same numbers). */
     enum SubstepKind {
         Kick = 0,
         Drift = 1
     };
+    /** Bits of a sub-step's flags (openmm_symprk.methods.resolved.SubstepFlag has the same numbers). */
+    enum SubstepFlag {
+        /** A drift: project the velocities onto the constraints first (only where the System has constraints). */
+        ProjectVelocitiesBefore = 1,
+        /** A kick: no drift since the previous kick of its force groups; its forces are reused when still valid. */
+        ForcesCached = 2
+    };
     /**
-     * Create an integrator.  Without coefficients it is velocity Verlet (kick 1/2, drift 1, kick 1/2).
+     * Create an integrator running velocity Verlet (kick 1/2, drift 1, kick 1/2; the first kick on cached forces).
      *
      * @param stepSize  the step size (ps)
      */
@@ -40,20 +53,18 @@ public:
     /**
      * Create an integrator running a given sub-step sequence (see setSubsteps()).
      */
-    SymPRKIntegrator(double stepSize, const std::vector<int>& kinds, const std::vector<double>& coefficients);
+    SymPRKIntegrator(double stepSize, const std::vector<int>& kinds, const std::vector<double>& coefficients,
+                     const std::vector<int>& groups, const std::vector<int>& flags);
     /**
-     * Set the sub-step sequence: kinds[i] is Kick (0) or Drift (1), coefficients[i] the fraction of the
-     * step size.  Adjacent sub-steps of the same kind (and, for kicks, the same force groups) are merged and
-     * zero coefficients dropped.  Cannot be called once the integrator is bound to a Context.
+     * Set the sub-step sequence, run as given: kinds[i] is a SubstepKind, coefficients[i] the fraction of the
+     * step size (finite, non-zero), groups[i] a kick's force groups as a bit mask (as in Context::getState), or
+     * -1 for the integrator's integration force groups (drifts: -1), flags[i] a combination of SubstepFlag bits
+     * (ProjectVelocitiesBefore on drifts only, ForcesCached on kicks only).  Kicks of different groups make a
+     * multiple-time-step method; the forces of every group are kept until the positions change.  Cannot be
+     * called once the integrator is bound to a Context.
      */
-    void setSubsteps(const std::vector<int>& kinds, const std::vector<double>& coefficients);
-    /**
-     * The same, with the force groups of every kick: groups[i] is a bit mask of force groups (as in
-     * Context::getState), or -1 for the integrator's integration force groups (drifts ignore it).  Kicks of
-     * different groups make a multiple-time-step method; the forces of every group are cached until the
-     * positions change, so each group is evaluated only where a drift came between two of its kicks.
-     */
-    void setSubsteps(const std::vector<int>& kinds, const std::vector<double>& coefficients, const std::vector<int>& groups);
+    void setSubsteps(const std::vector<int>& kinds, const std::vector<double>& coefficients, const std::vector<int>& groups,
+                     const std::vector<int>& flags);
     /** The force-group mask of sub-step index (-1: the integration force groups; drifts: -1). */
     int getSubstepForceGroups(int index) const;
     int getNumSubsteps() const {
@@ -61,10 +72,9 @@ public:
     }
     int getSubstepKind(int index) const;
     double getSubstepCoefficient(int index) const;
-    /**
-     * Force evaluations per step in a long run, all groups counted: a kick needs one when a drift came since
-     * the previous kick of its force groups (cyclically, so a closing kick's forces serve the next opening kick).
-     */
+    /** The SubstepFlag bits of sub-step index. */
+    int getSubstepFlags(int index) const;
+    /** Force evaluations per step in a long run, all groups counted: the kicks without ForcesCached. */
     int getForceEvaluationsPerStep() const;
     /**
      * Project the forces of every kick onto zero net force and zero net torque about the centre of mass
@@ -138,7 +148,7 @@ protected:
     void loadCheckpoint(std::istream& stream);
 
 private:
-    std::vector<int> kinds, groups;
+    std::vector<int> kinds, groups, flags;
     std::vector<double> coefficients;
     bool exactMomentum, forcesAreValid;
     std::string methodName;

@@ -1,4 +1,4 @@
-"""Study output folders: atomic JSON files and an exclusive lock for the life of a run."""
+"""Study output folders: atomic JSON, text and array files, and an exclusive lock for the life of a run."""
 from __future__ import annotations
 
 import json
@@ -6,7 +6,7 @@ import os
 
 import numpy as np
 
-__all__ = ["FolderLock", "FolderLockedError", "write_json", "jsonable"]
+__all__ = ["FolderLock", "FolderLockedError", "write_text", "write_json", "write_npz", "jsonable"]
 
 
 class FolderLockedError(RuntimeError):
@@ -53,9 +53,21 @@ def jsonable(obj):
     return obj
 
 
-def write_json(path: str, data):
-    """Write ``data`` as JSON to a temporary name, then rename (a reader sees the old file or the new one)."""
+def write_text(path: str, text: str):
+    """Write ``text`` to a temporary name, then rename (a reader sees the old file or the new one, never a part)."""
     tmp = f"{path}.tmp{os.getpid()}"
     with open(tmp, "w") as fh:
-        json.dump(jsonable(data), fh, indent=1, allow_nan=True)
+        fh.write(text)
+    os.replace(tmp, path)
+
+
+def write_json(path: str, data):
+    """Write ``data`` (made :func:`jsonable`) as JSON, atomically: the one JSON writer of the studies."""
+    write_text(path, json.dumps(jsonable(data), indent=1, allow_nan=True))
+
+
+def write_npz(path: str, arrays: dict):
+    """Write ``arrays`` to ``path`` (an .npz file), atomically."""
+    tmp = f"{path[:-4] if path.endswith('.npz') else path}.tmp{os.getpid()}.npz"
+    np.savez(tmp, **arrays)
     os.replace(tmp, path)

@@ -1,0 +1,291 @@
+"""A method sorted out once: what the user passed, made into the one description of the step that will run.
+
+Everything that runs a method (both OpenMM backends, multiple time stepping, the reference integrators, the
+stability scan, restore) takes a :class:`ResolvedMethod` from :func:`resolve` instead of normalising the
+user's input itself::
+
+    r = resolve("yoshida-4", constraints=True)            # or a Method, a Splitting, a PRKTableau
+    r.kind, r.order, r.force_evals, [s.label for s in r.substeps]
+
+``resolve`` takes the method (a catalogue name or alias, a catalogue :class:`~.catalogue.Method`, a
+:class:`~.splitting.Splitting` or a :class:`~.tableau.PRKTableau`), plain facts about the System (whether it
+has constraints; no OpenMM object, so this layer stays free of OpenMM) and the multiple-time-step groups, and
+derives, once: the kick/drift sequence as it will run (compositions taken over the RATTLE base under
+constraints, the r-RESPA sequence of the groups), every sub-step's kind (:class:`SubstepKind`, the same
+numbers as the plugin's ``SymPRKIntegrator::SubstepKind``), its velocity projection and cached-force flags
+(:class:`SubstepFlag`, the plugin's ``SymPRKIntegrator::SubstepFlag``), the force evaluations per step, and
+the catalogue's order, constrained order and stability interval.  The result is frozen and hashable.
+
+The projection rule (:func:`projected_drifts`) and the cached-force rule
+(:attr:`~.splitting.Splitting.evaluating_kicks`) are written here and in :mod:`.splitting` only: the
+CustomIntegrator compiler and the native kernels are sent the flags and do not derive them again.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from enum import IntEnum, IntFlag
+from fractions import Fraction
+
+import numpy as np
+
+from .catalogue import Method, get_method
+from .respa import MTSError, label_groups, levels, respa
+from .splitting import DRIFT, KICK, Splitting
+from .tableau import PRKTableau, TableauError
+
+__all__ = ["resolve", "ResolvedMethod", "Substep", "SubstepKind", "SubstepFlag", "ConstraintSupportError",
+           "projected_drifts", "KINDS"]
+
+#: What a method is: a kick/drift sequence (splitting, or a composition of one), or a general PRK pair.
+KINDS = ("splitting", "composition", "explicit", "implicit")
+
+
+class SubstepKind(IntEnum):
+    """The kind of one sub-step; the numbers are the plugin's ``SymPRKIntegrator::SubstepKind`` (a test checks
+    it).  A later operation (e.g. a thermostat half step) is one more member on both sides."""
+
+    KICK = 0  # v += c*dt*F/m
+    DRIFT = 1  # x += c*dt*v (RATTLE under constraints)
+
+
+class SubstepFlag(IntFlag):
+    """Per-sub-step flags, the plugin's ``SymPRKIntegrator::SubstepFlag`` bits (a test checks it)."""
+
+    NONE = 0
+    PROJECT_BEFORE = 1  # a drift: project the velocities onto the constraints first (see projected_drifts)
+    FORCES_CACHED = 2  # a kick: its force groups' forces are still those of the current positions
+
+
+class ConstraintSupportError(ValueError):
+    """The method cannot be used on a system with constraints."""
+
+
+@dataclass(frozen=True)
+class Substep:
+    """One sub-step of the step as it will run."""
+
+    kind: SubstepKind
+    coefficient: Fraction  # fraction of the step size (exact)
+    groups: tuple | None = None  # kicks: the force groups (None: all the integrator's forces)
+    project_before: bool = False  # drifts: project the velocities first
+    forces_cached: bool = False  # kicks: no force evaluation (no drift since the last kick of these groups)
+
+    @property
+    def label(self) -> str:
+        """"drift", "kick", or "kick:<groups>" (the labels of :class:`~.splitting.Splitting`)."""
+        if self.kind == SubstepKind.DRIFT:
+            return DRIFT
+        return KICK if self.groups is None else KICK + ":" + ",".join(map(str, self.groups))
+
+    @property
+    def flags(self) -> SubstepFlag:
+        return ((SubstepFlag.PROJECT_BEFORE if self.project_before else SubstepFlag.NONE)
+                | (SubstepFlag.FORCES_CACHED if self.forces_cached else SubstepFlag.NONE))
+
+    @property
+    def group_mask(self) -> int:
+        """The force groups as a bit mask, -1 for drifts and for kicks of all forces."""
+        return -1 if self.groups is None else sum(1 << g for g in self.groups)
+
+
+def projected_drifts(splitting: Splitting) -> list:
+    """Indices (into ``steps``) of the drifts before which a constrained step projects the velocities.
+
+    Under constraints a drift x += c h v is followed by SHAKE and v += (x - x_u)/(c h): a constraint solver that
+    stops at its tolerance leaves a residual delta in x and so delta/(c h) in v along the bonds, which the next
+    drift c' turns into a position error (c'/c) delta.  Where |c'| > |c| (pefrl: 0.775 after -0.066, a factor
+    11.7) that grows from drift to drift faster than the solver, which does nothing below its tolerance, removes
+    it.  A velocity projection at the current (constrained) positions just before such a drift removes the
+    along-bond velocity; in exact arithmetic it changes nothing, since the drift's own position projection acts
+    along the same bond vectors and absorbs it.  So: every drift whose |coefficient| exceeds the previous
+    drift's within the step.  (The one statement of the rule: the backends receive it as a flag.)"""
+    out, previous = [], None
+    for i, (label, c) in enumerate(splitting.steps):
+        if label == DRIFT:
+            if previous is not None and abs(c) > abs(previous):
+                out.append(i)
+            previous = c
+    return out
+
+
+def _substeps(splitting: Splitting, constraints: bool) -> tuple:
+    projected = set(projected_drifts(splitting)) if constraints else set()
+    evaluating = splitting.evaluating_kicks
+    out = []
+    for i, (label, c) in enumerate(splitting.steps):
+        if label == DRIFT:
+            out.append(Substep(SubstepKind.DRIFT, c, project_before=i in projected))
+        else:
+            try:
+                groups = label_groups(label)
+            except ValueError:
+                raise TableauError(f"a kick/drift splitting cannot contain a {label!r} sub-flow") from None
+            out.append(Substep(SubstepKind.KICK, c, groups, forces_cached=i not in evaluating))
+    return tuple(out)
+
+
+@dataclass(frozen=True)
+class ResolvedMethod:
+    """One method as it will run (see the module docstring).  Build it with :func:`resolve`."""
+
+    name: str
+    kind: str  # one of KINDS
+    constraints: bool  # RATTLE steps (kick/drift methods only)
+    stages: int | None  # PRK stages of the method's tableau (None: multiple time stepping)
+    order: int | None  # catalogue order (None: not a catalogue method)
+    constrained_order: int | None  # catalogue order under RATTLE constraints
+    stability: float | None  # catalogue: largest stable h*omega (multiple time stepping: the outer method's)
+    splitting: Splitting | None  # the kick/drift sequence as it runs (None: a general PRK pair)
+    tableau: PRKTableau | None  # the method's own PRK pair (None: multiple time stepping)
+    substeps: tuple = ()  # Substep, in order (empty for a general PRK pair)
+    force_evals: int | None = None  # per step in a long run (implicit: per fixed-point iteration)
+    evals_per_group: tuple = ()  # multiple time stepping: ((force groups, evaluations per step), ...)
+    levels: tuple = ()  # multiple time stepping: Level, slowest first
+    groups: tuple | None = None  # multiple time stepping: ((force group, substeps), ...) as given
+    inner_name: str | None = None  # multiple time stepping: the inner levels' method
+    entry: Method | None = field(default=None, repr=False)  # the catalogue entry, when there is one
+
+    # -- views ----------------------------------------------------------------------------------------------
+    @property
+    def family(self) -> str | None:
+        """The catalogue family (splitting, composition, implicit, reference), None for user methods."""
+        return self.entry.family if self.entry is not None else None
+
+    @property
+    def is_splitting(self) -> bool:
+        """A kick/drift sequence: runs on both backends and keeps constraints (RATTLE)."""
+        return self.splitting is not None
+
+    @property
+    def is_mts(self) -> bool:
+        return bool(self.levels)
+
+    @property
+    def program(self) -> str:
+        """What the backends compile: "splitting", "explicit" or "implicit"."""
+        return "splitting" if self.is_splitting else self.kind
+
+    @property
+    def evaluations(self) -> dict:
+        """{force groups (tuple, or None for all forces): evaluations per step} of a kick/drift method."""
+        return dict(self.evals_per_group)
+
+    def tableau_in(self, dtype=np.float64) -> PRKTableau:
+        """The method's PRK pair in ``dtype`` (float64 or long double), from the exact data where there is some."""
+        if self.tableau is None:
+            raise TableauError(f"{self.name}: a multiple-time-step method has no single PRK tableau")
+        if np.dtype(dtype) == self.tableau.dtype:
+            return self.tableau
+        if self.entry is not None:
+            return self.entry.tableau(dtype)
+        if self.kind in ("splitting", "composition") and set(self.splitting.labels) <= {KICK, DRIFT}:
+            return PRKTableau.from_splitting(self.splitting, name=self.name, dtype=dtype)
+        t = self.tableau
+        return PRKTableau(t.A, t.b, t.A_hat, t.b_hat, name=t.name, dtype=dtype)
+
+    def check_symplectic(self, allow_nonsymplectic: bool = False):
+        """TableauError naming Reich's residuals unless the method is symplectic (kick/drift sequences are)."""
+        if self.tableau is not None:
+            self.tableau.check_symplectic(allow_nonsymplectic)
+
+    def describe_levels(self) -> str:
+        """One line: each level's groups, substeps and evaluations per step ("" without multiple time stepping)."""
+        if not self.levels:
+            return ""
+        evals = self.evaluations
+        parts = [f"groups {','.join(map(str, lv.groups))} x{lv.substeps}"
+                 + (f" ({evals[tuple(lv.groups)]} evaluations per step)" if tuple(lv.groups) in evals else "")
+                 for lv in self.levels]
+        return "multiple time stepping, slowest first: " + "; ".join(parts)
+
+
+def _normalise(method):
+    """(catalogue entry or None, splitting or None, tableau or None) of what the user passed."""
+    if isinstance(method, ResolvedMethod):
+        method = method.entry if method.entry is not None else (
+            method.tableau if method.tableau is not None else method.splitting)
+    if isinstance(method, str):
+        method = get_method(method)
+    if isinstance(method, Method):
+        return method, method.splitting, method.tableau()
+    if isinstance(method, Splitting):
+        return None, method, None  # its tableau is built once the name is known
+    if isinstance(method, PRKTableau):
+        return None, method.splitting, method
+    raise TypeError(f"expected a method name, a catalogue Method, a Splitting or a PRKTableau, got {method!r}")
+
+
+def _kind(entry, splitting, tableau) -> str:
+    if entry is not None and entry.family in ("splitting", "composition"):
+        return entry.family
+    if splitting is not None:
+        return "splitting"
+    return "explicit" if tableau.is_explicit else "implicit"
+
+
+def _tableau_evals(tab: PRKTableau) -> int:
+    """Force evaluations per step of a general PRK pair (implicit: per fixed-point iteration)."""
+    if not tab.is_explicit:
+        return tab.stages
+    Ah, bh = np.asarray(tab.A_hat, dtype=np.float64), np.asarray(tab.b_hat, dtype=np.float64)
+    return int(sum(bool(np.any(Ah[:, i]) or bh[i]) for i in range(tab.stages)))
+
+
+def resolve(method, constraints: bool | None = False, groups=None, inner_method=None,
+            name: str | None = None) -> ResolvedMethod:
+    """The one description of ``method`` as it will run (see the module docstring).
+
+    ``constraints``: the System has constraints (True), has none (False, the default: model problems), or is
+    not known (None: kick/drift methods then get RATTLE steps, which are correct, and cheap, without
+    constraints too).  ``groups``/``inner_method``: multiple time stepping in the form of OpenMM's
+    ``MTSIntegrator`` (:mod:`.respa`).  ``name`` overrides the method's name.  Raises UnknownMethodError (with
+    close names), TypeError for something that is not a method, ConstraintSupportError for a general PRK pair
+    under constraints and MTSError for a malformed ``groups``."""
+    entry, splitting, tableau = _normalise(method)
+    kind = _kind(entry, splitting, tableau)
+    name = name or (entry.name if entry is not None else None) or (
+        tableau.name if tableau is not None else "user splitting")
+    if tableau is None and set(splitting.labels) <= {KICK, DRIFT}:
+        tableau = PRKTableau.from_splitting(splitting, name=name)
+    if inner_method is not None and groups is None:
+        raise ValueError("inner_method= needs groups= (the force groups of the levels of multiple time stepping)")
+    constrained = splitting is not None if constraints is None else bool(constraints)
+    if constrained and splitting is None:
+        raise ConstraintSupportError(
+            f"method {name!r} is a general (non-splitting) PRK tableau and cannot keep constraints: the "
+            f"system has constraints (rigid water, HBonds, ...). Use a kick/drift method instead, e.g. "
+            f"'verlet' (RATTLE), 'yoshida-4' or 'blanes-moan-srkn6b-4', or create the system with "
+            f"constraints=None and rigidWater=False.")
+    common = dict(name=name, kind=kind, constraints=constrained,
+                  order=entry.order if entry is not None else None,
+                  constrained_order=entry.constrained_order if entry is not None else None,
+                  stability=entry.stability if entry is not None else None, entry=entry)
+    if splitting is None:
+        if groups is not None:
+            raise MTSError(f"multiple time stepping needs kick/drift methods at every level; {name!r} is a general "
+                           f"({entry.family if entry is not None else kind}) PRK tableau")
+        return ResolvedMethod(stages=tableau.stages, splitting=None, tableau=tableau,
+                              force_evals=_tableau_evals(tableau), **common)
+    run = entry.constrained_splitting if (entry is not None and constrained) else splitting
+    lv, inner_name, given = (), None, None
+    if groups is not None:
+        inner_given = method if inner_method is None else inner_method
+        inner = resolve(inner_given)
+        if not inner.is_splitting:
+            raise MTSError(f"multiple time stepping needs kick/drift methods at every level; {inner.name!r} is a "
+                           f"general ({inner.family or inner.kind}) PRK tableau")
+        if constrained:
+            inner = resolve(inner_given, constraints=True)
+        lv = tuple(levels(groups, run, inner.splitting))
+        given = tuple((int(g), int(n)) for g, n in groups)
+        inner_name = inner.name
+        run = respa(list(lv))
+        tableau = None
+    substeps = _substeps(run, constrained)  # (refuses labels that are neither kicks nor drifts)
+    evals = {}
+    for label in dict.fromkeys(lab for lab in run.labels if lab != DRIFT):
+        evals[label_groups(label)] = run.force_evaluations(label)
+    return ResolvedMethod(stages=tableau.stages if tableau is not None else None, splitting=run, tableau=tableau,
+                          substeps=substeps, force_evals=sum(evals.values()),
+                          evals_per_group=tuple(evals.items()) if list(evals) != [None] else (),
+                          levels=lv, groups=given, inner_name=inner_name, **common)

@@ -1,0 +1,63 @@
+"""Finished runs on disk: ``<out>/runs/<key>.json`` (what the run measured, plain data) and, when it has arrays,
+``<key>.npz``; both written atomically, the arrays first, so a JSON file on disk means a complete run.
+
+A run's key hashes everything the run depends on (its settings and the fingerprint of its starting state), so a
+study called again finds exactly the runs it already did, and a changed setting never reuses a stale run.
+"""
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+
+import numpy as np
+
+from .folders import write_json, write_npz
+
+__all__ = ["run_key", "RunStore"]
+
+
+def run_key(obj, length: int = 16) -> str:
+    """The key of a run: the SHA-1 of ``obj`` as sorted JSON, cut to ``length`` hex digits."""
+    return hashlib.sha1(json.dumps(obj, sort_keys=True).encode()).hexdigest()[:length]
+
+
+class RunStore:
+    """``<out>/<folder>/<key>.json`` (+ ``<key>.npz``)."""
+
+    def __init__(self, out: str, folder: str = "runs"):
+        self.out = out
+        self.folder = os.path.join(out, folder)
+        os.makedirs(self.folder, exist_ok=True)
+
+    def path(self, key: str, ext: str) -> str:
+        return os.path.join(self.folder, f"{key}.{ext}")
+
+    def info(self, key: str) -> dict | None:
+        """The stored JSON of a run, or None (missing or unreadable)."""
+        try:
+            with open(self.path(key, "json")) as fh:
+                return json.load(fh)
+        except (FileNotFoundError, json.JSONDecodeError):
+            return None
+
+    def arrays(self, key: str) -> dict | None:
+        try:
+            with np.load(self.path(key, "npz")) as data:
+                return {k: data[k] for k in data.files}
+        except FileNotFoundError:
+            return None
+
+    def put(self, key: str, info: dict, arrays: dict | None = None):
+        if arrays:
+            write_npz(self.path(key, "npz"), arrays)
+        write_json(self.path(key, "json"), info)
+
+    def __contains__(self, key: str) -> bool:
+        return os.path.exists(self.path(key, "json"))
+
+    def keys(self) -> set:
+        return {f[:-5] for f in os.listdir(self.folder) if f.endswith(".json")}
+
+    def __len__(self):
+        return len(self.keys())

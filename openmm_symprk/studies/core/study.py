@@ -1,0 +1,125 @@
+"""The skeleton of a study: plan the runs, run one, store it under its key, summarise.
+
+A study subclasses :class:`Study` and gives
+
+* :meth:`Study.plan` -- every run the study needs, each a :class:`Run` (its key, what it needs, its cost);
+* :attr:`Study.work` -- a module-level function ``work(shared, *args) -> (arrays, info)`` that does one run in
+  whatever process executes it (``shared``: the data :meth:`Study.shared` gives under the run's ``name``);
+* :meth:`Study.summarise` -- the results from the stored runs.
+
+:meth:`Study.run` takes the folder's lock, skips every run already stored, executes the rest (in this process,
+spawned worker processes or on a Dask cluster, the most expensive first) with a progress bar, stores each run
+the moment it finishes (``runs/<key>.json`` with the run's ``meta`` and ``info``, ``runs/<key>.npz`` with its
+arrays), and summarises.  An interrupted study keeps every finished run; calling it again continues.  A study
+with per-run trajectory observables keeps them in the arrays, its replicas as runs of one row, and compares
+rows replica by replica in :meth:`Study.summarise` (:func:`openmm_symprk.stats.paired`).
+"""
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass, field
+
+from ...support import require
+from .executors import make_executor
+from .folders import FolderLock
+from .jobs import Job, run_jobs, single
+from .store import RunStore
+
+__all__ = ["Run", "Study", "progress_bar"]
+
+
+def progress_bar(total: int, desc: str, enabled: bool = True):
+    """A tqdm progress bar (disabled: a silent one with the same methods)."""
+    tqdm = require("tqdm", "studies", "openmm_symprk.studies (progress bar)").tqdm
+
+    return tqdm(total=total, desc=desc, unit="run", disable=not enabled, dynamic_ncols=True)
+
+
+@dataclass
+class Run:
+    key: str
+    name: str  # which entry of Study.shared() the run needs
+    args: tuple = ()  # passed to Study.work after the shared data (picklable)
+    meta: dict = field(default_factory=dict)  # stored with the run: what identifies it (row, replica, ...)
+    cost: float = 1.0  # relative cost, to start the longest runs first
+
+
+class Study:
+    """Base class of a study in the folder ``out`` (see the module's docstring)."""
+
+    #: The command named in the lock's error and the progress bar.
+    command = "symprk study"
+    #: ``work(shared, *args) -> (arrays, info)``: one run (a module-level function, set by the subclass).
+    work = None
+
+    def __init__(self, out: str, workers: int = 1, scheduler: str | None = None, progress: bool = True,
+                 log=print):
+        if int(workers) < 1:
+            raise ValueError(f"workers must be >= 1, got {workers!r}")
+        self.out, self.workers, self.scheduler, self.progress, self.log = out, int(workers), scheduler, progress, log
+        self.store: RunStore | None = None
+
+    # -- to be given by a study -----------------------------------------------------------------------------------
+    def plan(self) -> list:
+        raise NotImplementedError
+
+    def shared(self, runs: list) -> dict:
+        """{name: data} that the given (missing) runs need, shipped to each worker once."""
+        return {}
+
+    def summarise(self, runs: list):
+        raise NotImplementedError
+
+    def stored(self, run: Run, info: dict):
+        """Called in this process after each run is stored (e.g. to log a failed run)."""
+
+    # -- the skeleton ---------------------------------------------------------------------------------------------
+    def run(self):
+        """Run what is missing and return :meth:`summarise` of every planned run."""
+        os.makedirs(self.out, exist_ok=True)
+        lock = FolderLock(self.out, self.command)
+        try:
+            self.store = RunStore(self.out)
+            runs = self.plan()
+            todo = [r for r in runs if r.key not in self.store]
+            if len(runs) - len(todo):
+                self.log(f"reusing {len(runs) - len(todo)} finished runs in {self.out}")
+            if todo:
+                self.execute(todo)
+            return self.summarise(runs)
+        finally:
+            lock.release()
+
+    def execute(self, todo: list) -> dict:
+        """Run ``todo``, storing each run as it finishes; on an interruption keep what finished."""
+        executor = make_executor(type(self).work, self.shared(todo), self.workers, self.scheduler)
+        bar = progress_bar(len(todo), self.command.split()[-1] + " runs", self.progress)
+        try:
+            return run_jobs([Job(single(r), r.cost) for r in todo], executor,
+                            lambda run: self.store.info(run.key) if run.key in self.store else None,
+                            lambda ex, run: ex.submit(run.name, *run.args),
+                            lambda run, fut: self._keep(run, fut.result()), bar)
+        finally:
+            bar.close()
+
+    def results(self, runs: list, by: tuple) -> dict:
+        """The stored runs among ``runs`` grouped by the ``meta`` fields ``by`` (e.g. a row: model, method, step):
+        {(values...): [(arrays, info) sorted by the "replica" field when there is one]}; runs not stored are left
+        out.  The replicas of a row are what :func:`openmm_symprk.stats.paired` compares with a reference row."""
+        out = {}
+        for run in runs:
+            info = self.store.info(run.key)
+            if info is None:
+                continue
+            arrays = self.store.arrays(run.key) or {}
+            out.setdefault(tuple(run.meta[k] for k in by), []).append((arrays, info))
+        for reps in out.values():
+            reps.sort(key=lambda rep: rep[1].get("replica", 0))
+        return out
+
+    def _keep(self, run: Run, result) -> dict:
+        arrays, info = result
+        info = dict(info, **run.meta)
+        self.store.put(run.key, info, arrays)
+        self.stored(run, info)
+        return info

@@ -1,0 +1,99 @@
+"""The study skeleton (studies/core) on a toy study: plan, run one, store atomically under its key, summarise;
+a second call reuses every run, an interrupted one keeps what finished, replicas are paired with a reference."""
+import json
+import os
+
+import numpy as np
+import pytest
+
+from openmm_symprk.stats import paired, series_stats
+from openmm_symprk.studies.core import FolderLock, FolderLockedError, Run, RunStore, Study, run_key, write_json
+
+
+def toy_work(shared, row, replica):
+    """A 'run': a noisy series whose mean is the row's offset plus the replica's own offset (shared by rows)."""
+    if row == "broken":
+        raise RuntimeError("this row always fails")
+    rng = np.random.default_rng(1000 * replica + len(row))
+    x = shared["offsets"][replica] + shared["shift"][row] + rng.normal(scale=0.1, size=200)
+    return {"x": x}, {"status": "ok"}
+
+
+class ToyStudy(Study):
+    command = "symprk toy"
+    work = toy_work
+
+    def __init__(self, out, rows, replicas=4, **kw):
+        super().__init__(out, progress=False, log=lambda *a: None, **kw)
+        self.rows, self.replicas, self.calls = rows, replicas, 0
+
+    def plan(self):
+        return [Run(run_key({"row": row, "replica": r}), "toy", (row, r), {"row": row, "replica": r}, cost=r)
+                for row in self.rows for r in range(self.replicas)]
+
+    def shared(self, runs):
+        self.calls += len(runs)
+        return {"toy": {"offsets": [0.0, 5.0, -3.0, 2.0, 1.0, 7.0], "shift": {"ref": 0.0, "a": 0.0, "b": 0.05,
+                                                                                 "broken": 0.0}}}
+
+    def summarise(self, runs):
+        res = self.results(runs, ("row",))
+        per = {row: {i["replica"]: (series_stats(a["x"]).mean, series_stats(a["x"]).se) for a, i in reps}
+               for (row,), reps in res.items()}
+        return {row: paired(per[row], per["ref"]) for row in per if row != "ref"}
+
+
+def test_a_study_runs_stores_reuses_and_pairs(tmp_path):
+    out = str(tmp_path / "toy")
+    study = ToyStudy(out, ["ref", "a", "b"])
+    res = study.run()
+    assert study.calls == 12 and len(RunStore(out)) == 12
+    # the replicas' offsets (5 units apart) cancel in the paired difference: 0.05 resolved, "a" matches
+    assert res["b"].mean == pytest.approx(0.05, abs=0.02) and res["b"].se < 0.02
+    assert abs(res["a"].mean) < 3 * res["a"].se
+    key = run_key({"row": "b", "replica": 2})
+    with open(os.path.join(out, "runs", key + ".json")) as fh:
+        assert json.load(fh) == {"status": "ok", "row": "b", "replica": 2}
+    again = ToyStudy(out, ["ref", "a", "b"], replicas=5)  # one more replica per row: only those run
+    res5 = again.run()
+    assert again.calls == 3 and res5["b"].replicas == 5
+
+
+def test_an_exception_in_a_run_stops_the_study_and_keeps_what_finished(tmp_path):
+    """(A run that fails as a run, e.g. blows up, returns its status instead: an exception is a bug.)"""
+    out = str(tmp_path / "toy")
+    with pytest.raises(RuntimeError, match="always fails"):
+        ToyStudy(out, ["ref", "broken"], replicas=2).run()
+    kept = RunStore(out).keys()
+    assert run_key({"row": "ref", "replica": 1}) in kept  # in flight beside the broken run, finished
+    assert not any(run_key({"row": "broken", "replica": r}) in kept for r in range(2))
+    res = ToyStudy(out, ["ref", "a"], replicas=2).run()  # the next call continues from what was kept
+    assert res["a"].replicas == 2
+
+
+def test_the_folder_is_locked_while_a_study_runs(tmp_path):
+    lock = FolderLock(str(tmp_path), "symprk toy")
+    try:
+        with pytest.raises(FolderLockedError, match="another symprk toy is running"):
+            ToyStudy(str(tmp_path), ["ref"]).run()
+    finally:
+        lock.release()
+    with pytest.raises(ValueError, match="workers must be >= 1"):
+        ToyStudy(str(tmp_path), ["ref"], workers=0)
+
+
+def test_json_is_written_atomically_and_plainly(tmp_path):
+    path = str(tmp_path / "x.json")
+    write_json(path, {"a": np.arange(3), "b": np.float32(0.5), "c": float("nan"), "d": (1, 2)})
+    with open(path) as fh:
+        assert json.load(fh) == {"a": [0, 1, 2], "b": 0.5, "c": None, "d": [1, 2]}
+    assert os.listdir(tmp_path) == ["x.json"]
+
+
+def test_a_study_on_a_dask_cluster(tmp_path):
+    distributed = pytest.importorskip("dask.distributed")
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=False,
+                                  dashboard_address=None) as cluster:
+        study = ToyStudy(str(tmp_path / "dask"), ["ref", "b"], replicas=3, scheduler=cluster.scheduler_address)
+        res = study.run()
+    assert res["b"].replicas == 3 and len(RunStore(str(tmp_path / "dask"))) == 6
