@@ -286,7 +286,7 @@ if __name__ == "__main__":
         python_requires=">=3.11",
         packages=find_packages(include=["openmm_symprk", "openmm_symprk.*"]),
         package_data={"openmm_symprk.methods": ["data/*.toml"]},
-        install_requires=["openmm>=8.6,<8.7", "numpy>=1.24", "scipy>=1.10"],
+        install_requires=["openmm>=8.6,<8.7", "numpy>=1.24"],
         extras_require=EXTRAS,
         entry_points={"console_scripts": ["symprk=openmm_symprk.cli:main"]},
         cmdclass={"build_ext": BuildNative},

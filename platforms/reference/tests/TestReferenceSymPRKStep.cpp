@@ -105,7 +105,7 @@ int main() {
         failed |= checkStep("velocity Verlet", verlet, {{'k', 0.5}, {'d', 1.0}, {'k', 0.5}}, x, v);
 
         SymPRKIntegrator positionVerlet(DT, {SymPRKIntegrator::Drift, SymPRKIntegrator::Kick, SymPRKIntegrator::Drift},
-                                        {0.5, 1.0, 0.5});
+                                        {0.5, 1.0, 0.5}, {-1, -1, -1}, {0, 0, 0});
         failed |= checkStep("position Verlet", positionVerlet, {{'d', 0.5}, {'k', 1.0}, {'d', 0.5}}, x, v);
         if (failed)
             return 1;

@@ -28,8 +28,8 @@ int main() {
                              SymPRKIntegrator::Drift, SymPRKIntegrator::Kick};
         vector<double> coefficients = {0.1931833275037836, 0.5, 0.6136333449924328, 0.5, 0.1931833275037836};
         vector<int> groups = {-1, -1, 2, -1, -1};
-        SymPRKIntegrator original(0.0015, kinds, coefficients);
-        original.setSubsteps(kinds, coefficients, groups);
+        vector<int> flags = {SymPRKIntegrator::ForcesCached, 0, 0, SymPRKIntegrator::ProjectVelocitiesBefore, 0};
+        SymPRKIntegrator original(0.0015, kinds, coefficients, groups, flags);
         original.setConstraintTolerance(3e-7);
         original.setIntegrationForceGroups(5);
         original.setExactMomentum(true);
@@ -60,6 +60,7 @@ int main() {
             CHECK_EQUAL(original.getSubstepKind(i), restored->getSubstepKind(i));
             CHECK_EQUAL(original.getSubstepCoefficient(i), restored->getSubstepCoefficient(i));  // bit for bit
             CHECK_EQUAL(original.getSubstepForceGroups(i), restored->getSubstepForceGroups(i));
+            CHECK_EQUAL(original.getSubstepFlags(i), restored->getSubstepFlags(i));
         }
         CHECK_EQUAL(5, restored->getNumSubsteps());
         CHECK_EQUAL(2, restored->getSubstepForceGroups(2));
