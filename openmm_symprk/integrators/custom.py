@@ -94,7 +94,8 @@ class PRKIntegrator(IntegratorBase, mm.CustomIntegrator):
     def __init__(self, stepSize, tableau, system: mm.System | None = None, constraints: bool | None = None,
                  allow_nonsymplectic: bool = False, exact_momentum: bool = False, check_finite: bool = True,
                  max_speed=None, groups=None, inner_method=None, tolerance: float = 1e-12, max_iterations: int = 60,
-                 name: str | None = None, **unknown):
+                 name: str | None = None, temperature=None, collision_time=None, thermostat_interval=None,
+                 random_seed=None, **unknown):
         check_option_names(unknown, _PRK_ARGS, type(self).__name__)
         if constraints is not None and not isinstance(constraints, bool):
             raise TypeError(f"constraints must be True, False or None (from system=), got {constraints!r}")
@@ -105,7 +106,10 @@ class PRKIntegrator(IntegratorBase, mm.CustomIntegrator):
             raise ValueError(f"max_iterations must be at least 1, got {max_iterations!r}")
         p = prepare(type(self).__name__, stepSize, tableau, system, exact_momentum=exact_momentum,
                     check_finite=check_finite, max_speed=max_speed, groups=groups, inner_method=inner_method,
-                    constraints=constraints, name=name)
+                    constraints=constraints, name=name, temperature=temperature, collision_time=collision_time,
+                    thermostat_interval=thermostat_interval, random_seed=random_seed)
+        if p.thermostat is not None:
+            raise NotImplementedError("the thermostat of the CustomIntegrator backend is being written")
         r = p.method
         r.check_symplectic(allow_nonsymplectic)
         has_sites = p.system.virtual_sites if p.system is not None else True
