@@ -133,18 +133,52 @@ Vec3 ReferenceIntegrateSymPRKStepKernel::solveInertia(Vec3 d, Vec3 o, Vec3 tau) 
     // d = (sum m x^2, sum m y^2, sum m z^2), o = (sum m xy, sum m xz, sum m yz) about the centre of mass.
     // The inertia tensor is regularised by 1e-12 of its trace (a linear molecule or a single particle then
     // gives a finite result; the shift changes a round-off-sized torque by 1e-12 of itself).
-    double Ixx = d[1]+d[2], Iyy = d[0]+d[2], Izz = d[0]+d[1];
-    double Ixy = -o[0], Ixz = -o[1], Iyz = -o[2];
-    double shift = 1e-12*(Ixx+Iyy+Izz);
-    Ixx += shift;
-    Iyy += shift;
-    Izz += shift;
-    double axx = Iyy*Izz-Iyz*Iyz, ayy = Ixx*Izz-Ixz*Ixz, azz = Ixx*Iyy-Ixy*Ixy;
-    double axy = Ixz*Iyz-Izz*Ixy, axz = Ixy*Iyz-Iyy*Ixz, ayz = Ixy*Ixz-Ixx*Iyz;
-    double det = Ixx*axx+Ixy*axy+Ixz*axz;
-    if (det == 0.0 || !std::isfinite(det))
-        return Vec3();
-    return Vec3(axx*tau[0]+axy*tau[1]+axz*tau[2], axy*tau[0]+ayy*tau[1]+ayz*tau[2], axz*tau[0]+ayz*tau[1]+azz*tau[2])/det;
+    return SymPRKThermostat::solveInertia(d, o, tau);
+}
+
+void ReferenceIntegrateSymPRKStepKernel::thermostatEvent(const SymPRKIntegrator& integrator) {
+    // The sums in double, serially in particle order (deterministic, whatever the thread count); the host
+    // computes the kept field and the factor (SymPRKThermostat), then every particle with mass is rescaled.
+    const vector<Vec3>& pos = *data.positions;
+    vector<Vec3>& vel = *data.velocities;
+    const bool rotation = integrator.getThermostatKeepsRotation();
+    double sums[SymPRKThermostat::NumSums] = {0};
+    for (int i = 0; i < numParticles; i++) {
+        const double m = masses[i];
+        if (m == 0.0)
+            continue;
+        const Vec3& v = vel[i];
+        sums[SymPRKThermostat::SumMass] += m;
+        for (int j = 0; j < 3; j++)
+            sums[SymPRKThermostat::SumMomentum+j] += m*v[j];
+        sums[SymPRKThermostat::SumTwiceKinetic] += m*v.dot(v);
+        if (rotation) {
+            const Vec3& x = pos[i];
+            const Vec3 l = x.cross(v)*m;
+            double* S = sums+SymPRKThermostat::SumSecond;
+            for (int j = 0; j < 3; j++) {
+                sums[SymPRKThermostat::SumMomentX+j] += m*x[j];
+                sums[SymPRKThermostat::SumAngular+j] += l[j];
+            }
+            S[0] += m*x[0]*x[0];
+            S[1] += m*x[0]*x[1];
+            S[2] += m*x[0]*x[2];
+            S[3] += m*x[1]*x[1];
+            S[4] += m*x[1]*x[2];
+            S[5] += m*x[2]*x[2];
+        }
+    }
+    const SymPRKThermostat::Event e = thermostat.event(sums, integrator, thermostatDecay(integrator));
+    if (!e.apply)
+        return;
+    parallelFor([&] (int t, int start, int end) {
+        for (int i = start; i < end; i++)
+            if (masses[i] != 0.0) {
+                const Vec3 u = e.velocity + e.omega.cross(pos[i]-e.centre);
+                for (int j = 0; j < 3; j++)
+                    vel[i][j] = u[j] + e.alpha*(vel[i][j]-u[j]);
+            }
+    });
 }
 
 void ReferenceIntegrateSymPRKStepKernel::removeRigidChange(const vector<Vec3>& pos, vector<Vec3>& vel, Vec3 dP, Vec3 dL) {
@@ -235,6 +269,10 @@ void ReferenceIntegrateSymPRKStepKernel::execute(ContextImpl& context, const Sym
         forcesAreValid = false;
     if (!forcesAreValid)
         groupForces.clear();  // the cached forces of a multiple-time-step method belong to old positions
+    // Thermostat: a half event before the first step of every interval (after the Context's state updates, a
+    // barostat's move included), and one after its last step (below).
+    if (thermostatBefore(integrator, stepIndex))
+        thermostatEvent(integrator);
 
     // One pass over the atoms per kick and per drift; a kick directly followed by a drift (every kick but a
     // step's last) shares its pass with it.  The per-atom arithmetic is the same either way.
@@ -362,6 +400,8 @@ void ReferenceIntegrateSymPRKStepKernel::execute(ContextImpl& context, const Sym
     }
     if (hasConstraints)
         projectVelocities(pos, vel, tol, exact);
+    if (thermostatAfter(integrator, stepIndex))
+        thermostatEvent(integrator);
 
     // Record the first step that leaves a velocity NaN, infinite or beyond the blow-up speed (NaN fails every <=).
     if (blowUpStep == 0) {
