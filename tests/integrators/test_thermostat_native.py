@@ -258,14 +258,14 @@ def test_water_box_mean_temperature(tmp_path):
     ctx.setVelocitiesToTemperature(320, 2)
     ig.step(300)
     temps = []
-    for _ in range(400):
-        ig.step(5)
+    for _ in range(600):
+        ig.step(10)
         _, v = _xv(ctx)
         pec = v - (m[:, None] * v).sum(axis=0) / m.sum()
         temps.append(float(np.sum(m[:, None] * pec ** 2)) / (dof * R_KJ))
     s = series_stats(temps)
     assert abs(s.mean - 320) <= 3 * s.se, (s.mean, s.se)
-    assert s.se < 3.0  # the test has power
+    assert s.se < 3.0  # the test has power: 1 % of the target (sd of T for these 381 DOF: 23 K)
 
 
 # -- checkpoints, XML, the NVE program ----------------------------------------------------------------------------
