@@ -143,41 +143,73 @@ void ReferenceIntegrateSymPRKStepKernel::thermostatEvent(const SymPRKIntegrator&
     vector<Vec3>& vel = *data.velocities;
     const bool rotation = integrator.getThermostatKeepsRotation();
     double sums[SymPRKThermostat::NumSums] = {0};
+    double M = 0, px = 0, py = 0, pz = 0, twiceK = 0;
     for (int i = 0; i < numParticles; i++) {
         const double m = masses[i];
         if (m == 0.0)
             continue;
         const Vec3& v = vel[i];
-        sums[SymPRKThermostat::SumMass] += m;
-        for (int j = 0; j < 3; j++)
-            sums[SymPRKThermostat::SumMomentum+j] += m*v[j];
-        sums[SymPRKThermostat::SumTwiceKinetic] += m*v.dot(v);
-        if (rotation) {
+        M += m;
+        px += m*v[0];
+        py += m*v[1];
+        pz += m*v[2];
+        twiceK += m*(v[0]*v[0]+v[1]*v[1]+v[2]*v[2]);
+    }
+    sums[SymPRKThermostat::SumMass] = M;
+    sums[SymPRKThermostat::SumMomentum] = px;
+    sums[SymPRKThermostat::SumMomentum+1] = py;
+    sums[SymPRKThermostat::SumMomentum+2] = pz;
+    sums[SymPRKThermostat::SumTwiceKinetic] = twiceK;
+    if (rotation) {
+        // the positions' moments and the angular momentum about the origin
+        double mx = 0, my = 0, mz = 0, xx = 0, xy = 0, xz = 0, yy = 0, yz = 0, zz = 0, lx = 0, ly = 0, lz = 0;
+        for (int i = 0; i < numParticles; i++) {
+            const double m = masses[i];
+            if (m == 0.0)
+                continue;
             const Vec3& x = pos[i];
-            const Vec3 l = x.cross(v)*m;
-            double* S = sums+SymPRKThermostat::SumSecond;
-            for (int j = 0; j < 3; j++) {
-                sums[SymPRKThermostat::SumMomentX+j] += m*x[j];
-                sums[SymPRKThermostat::SumAngular+j] += l[j];
-            }
-            S[0] += m*x[0]*x[0];
-            S[1] += m*x[0]*x[1];
-            S[2] += m*x[0]*x[2];
-            S[3] += m*x[1]*x[1];
-            S[4] += m*x[1]*x[2];
-            S[5] += m*x[2]*x[2];
+            const Vec3& v = vel[i];
+            mx += m*x[0];
+            my += m*x[1];
+            mz += m*x[2];
+            xx += m*x[0]*x[0];
+            xy += m*x[0]*x[1];
+            xz += m*x[0]*x[2];
+            yy += m*x[1]*x[1];
+            yz += m*x[1]*x[2];
+            zz += m*x[2]*x[2];
+            lx += m*(x[1]*v[2]-x[2]*v[1]);
+            ly += m*(x[2]*v[0]-x[0]*v[2]);
+            lz += m*(x[0]*v[1]-x[1]*v[0]);
         }
+        const double moments[12] = {mx, my, mz, xx, xy, xz, yy, yz, zz, lx, ly, lz};
+        for (int j = 0; j < 3; j++) {
+            sums[SymPRKThermostat::SumMomentX+j] = moments[j];
+            sums[SymPRKThermostat::SumAngular+j] = moments[9+j];
+        }
+        for (int j = 0; j < 6; j++)
+            sums[SymPRKThermostat::SumSecond+j] = moments[3+j];
     }
     const SymPRKThermostat::Event e = thermostat.event(sums, integrator, thermostatDecay(integrator));
     if (!e.apply)
         return;
+    const double alpha = e.alpha;
+    const Vec3 V = e.velocity, R = e.centre, w = e.omega;
     parallelFor([&] (int t, int start, int end) {
-        for (int i = start; i < end; i++)
-            if (masses[i] != 0.0) {
-                const Vec3 u = e.velocity + e.omega.cross(pos[i]-e.centre);
-                for (int j = 0; j < 3; j++)
-                    vel[i][j] = u[j] + e.alpha*(vel[i][j]-u[j]);
-            }
+        if (rotation) {
+            for (int i = start; i < end; i++)
+                if (masses[i] != 0.0) {
+                    const Vec3 u = V + w.cross(pos[i]-R);
+                    for (int j = 0; j < 3; j++)
+                        vel[i][j] = u[j] + alpha*(vel[i][j]-u[j]);
+                }
+        }
+        else {
+            for (int i = start; i < end; i++)
+                if (masses[i] != 0.0)
+                    for (int j = 0; j < 3; j++)
+                        vel[i][j] = V[j] + alpha*(vel[i][j]-V[j]);
+        }
     });
 }
 
