@@ -189,6 +189,24 @@ def test_momentum_to_round_off_in_a_periodic_box(platform, props, bound):
     assert ig.computeHeatBathEnergy().value_in_unit(unit.kilojoule_per_mole) != 0
 
 
+def test_npt_with_a_monte_carlo_barostat_keeps_momentum():
+    """The barostat moves the box in updateContextState, before the step's first event: the volume changes and
+    the thermostat still keeps P to round-off (pairwise forces on Reference)."""
+    system, x, m = _cutoff_water_box()
+    system.addForce(mm.MonteCarloBarostat(1 * unit.bar, 300 * unit.kelvin, 5))
+    ig = N(2 * unit.femtoseconds, "verlet", system=system, temperature=300, random_seed=8)
+    ctx = mm.Context(system, ig, _platform("Reference"))
+    ctx.setPositions(x)
+    ctx.setVelocitiesToTemperature(300, 3)
+    _, v0 = _xv(ctx)
+    volume = ctx.getState().getPeriodicBoxVolume()
+    ig.step(150)
+    _, v1 = _xv(ctx)
+    assert ctx.getState().getPeriodicBoxVolume() != volume
+    p0, p1 = (m[:, None] * v0).sum(axis=0), (m[:, None] * v1).sum(axis=0)
+    assert np.linalg.norm(p1 - p0) <= 1e-13 * float(np.sum(m[:, None] * np.abs(v0)))
+
+
 @pytest.mark.parametrize("platform,props,exact,bound", [
     ("Reference", {}, False, 1e-11), ("CPU", {}, True, 1e-11),
     pytest.param("OpenCL", {"Precision": "double"}, False, 1e-11, marks=needs_opencl, id="OpenCL-double"),
@@ -269,14 +287,17 @@ def test_water_box_mean_temperature(tmp_path):
 
 
 # -- checkpoints, XML, the NVE program ----------------------------------------------------------------------------
-def test_checkpoint_continues_bit_for_bit(water8):
-    """The heat-bath energy and the random state are in the checkpoint; the interval's phase is the step count."""
+@pytest.mark.parametrize("platform,props", [
+    ("Reference", {}), pytest.param("OpenCL", {"Precision": "double"}, marks=needs_opencl, id="OpenCL-double")])
+def test_checkpoint_continues_bit_for_bit(platform, props, water8):
+    """The heat-bath energy and the random state are in the checkpoint; the interval's phase is the step count.
+    (Bit for bit on OpenCL too here: its fixed-point force sums are deterministic.)"""
     def integrator():
         return N(2 * unit.femtoseconds, "yoshida-4", system=water8.system, temperature=300, thermostat_interval=3,
                  random_seed=17)
 
     ig = integrator()
-    ctx = water8.context(ig)
+    ctx = water8.context(ig, platform, props)
     ig.step(25)
     chk = ctx.createCheckpoint()
     ig.step(40)
@@ -286,7 +307,7 @@ def test_checkpoint_continues_bit_for_bit(water8):
     again = _xv(ctx), ig.computeHeatBathEnergy()
     ig2 = integrator()
     ig2.setRandomNumberSeed(1)  # the checkpoint's random state wins over the seed
-    ctx2 = mm.Context(water8.system, ig2, _platform("Reference"))
+    ctx2 = mm.Context(water8.system, ig2, _platform(platform), props)
     ctx2.loadCheckpoint(chk)
     ig2.step(40)
     fresh = _xv(ctx2), ig2.computeHeatBathEnergy()
@@ -296,7 +317,7 @@ def test_checkpoint_continues_bit_for_bit(water8):
         assert b == bath
     # a checkpoint of the NVE program is refused by the thermostatted one (another program signature)
     nve = N(2 * unit.femtoseconds, "yoshida-4", system=water8.system)
-    ctx3 = water8.context(nve)
+    ctx3 = water8.context(nve, platform, props)
     with pytest.raises(mm.OpenMMException, match="another program.*with a thermostat"):
         ctx2.loadCheckpoint(ctx3.createCheckpoint())
 
