@@ -125,6 +125,7 @@ class PRKIntegrator(IntegratorBase, mm.CustomIntegrator):
         self.thermostat = p.thermostat
         if p.thermostat is not None:
             mm.CustomIntegrator.setRandomNumberSeed(self, p.thermostat.seed)
+
         self._signature = float(self.program_info.signature)
         self._reset_binding()
         meta = {"class": type(self).__name__, "method": self.method_name,
@@ -190,15 +191,15 @@ class PRKIntegrator(IntegratorBase, mm.CustomIntegrator):
 
     # -- the thermostat (see IntegratorBase for the accessors) ---------------------------------------------
     def _set_thermostat_mask(self, n: int):
-        """Fill the per-DOF mask of the chi-squared sum (dof - 1 ones) once the Context is known to have the
-        System's particle count: from the masses of system=, or (an integrator read from XML) those of its
-        Context's System, unless the mask it carries already has dof - 1 ones for n particles."""
+        """Check, once the Context is known to have the System's particle count, that the per-DOF mask of the
+        chi-squared sum holds dof - 1 ones for n particles, and fill it if not: from the masses of system=, or
+        (an integrator read from XML without it) those of its Context's System."""
         ones = self.thermostat.dof - 1
+        current = self.getPerDofVariableByName(thermostat_program.MASK_VAR)
+        if len(current) == n and sum(sum(vec) for vec in current) == ones:
+            return
         m = self._masses
         if m is None:
-            current = self.getPerDofVariableByName(thermostat_program.MASK_VAR)
-            if len(current) == n and sum(sum(vec) for vec in current) == ones:
-                return
             context = self._bound_context()
             if context is None:
                 raise RuntimeError(f"{type(self).__name__}({self.method_name}): the thermostat's mask could not be "
@@ -223,6 +224,14 @@ class PRKIntegrator(IntegratorBase, mm.CustomIntegrator):
         return self.getGlobalVariableByName(thermostat_program.HEAT_BATH_VAR)
 
     def _after_step(self):
+        if self.thermostat is not None and self.getGlobalVariableByName(thermostat_program.LOST_MASK_VAR):
+            # the Context was reinitialized without its state (per-DOF values set while bound are lost): the
+            # events of this call did nothing (alpha = 1); fill the mask again for the next steps
+            self.setGlobalVariableByName(thermostat_program.LOST_MASK_VAR, 0.0)
+            self._set_thermostat_mask(len(self.getPerDofVariableByName(program.PROBE_PER_DOF)))
+            warnings.warn(f"{type(self).__name__}({self.method_name}): the thermostat's per-DOF mask was lost (the "
+                          f"Context was reinitialized without preserving its state), so the steps of this call ran "
+                          f"without the thermostat; it is restored for the next steps.", RuntimeWarning, stacklevel=3)
         if not self._checked_probe:
             self._checked_probe = True
             if self.getGlobalVariableByName(program.PROBE_CONSTRAINTS_VAR) > 0 and not self.program_info.constraints:

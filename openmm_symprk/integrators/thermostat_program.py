@@ -25,7 +25,7 @@ import openmm as mm
 from ..physics.temperature import R_KJ
 from .thermostat import ThermostatSettings
 
-__all__ = ["PREFIX", "TEMPERATURE_VAR", "COLLISION_TIME_VAR", "HEAT_BATH_VAR", "MASK_VAR", "ALPHA_VAR",
+__all__ = ["PREFIX", "LOST_MASK_VAR", "TEMPERATURE_VAR", "COLLISION_TIME_VAR", "HEAT_BATH_VAR", "MASK_VAR", "ALPHA_VAR",
            "KINETIC_VAR", "NEW_KINETIC_VAR", "add_variables", "emit_half_event", "mask_values"]
 
 PREFIX = "symprk_ts_"
@@ -36,6 +36,9 @@ MASK_VAR = PREFIX + "mask"  # per DOF: exactly dof - 1 ones
 ALPHA_VAR = PREFIX + "alpha"  # the last factor applied
 KINETIC_VAR = PREFIX + "kpec"  # the last peculiar kinetic energy before the event (kJ/mol)
 NEW_KINETIC_VAR = PREFIX + "knew"  # and after
+#: set to 1 by an event that found the mask without its dof - 1 ones (a Context reinitialized without its state
+#: loses per-DOF values set while bound): the event then does nothing, and the integrator fills the mask again
+LOST_MASK_VAR = PREFIX + "lost_mask"
 
 _AXES = ("x", "y", "z")
 _PAIRS = ("xx", "yy", "zz", "xy", "yz", "zx")
@@ -46,7 +49,8 @@ def _v(name: str) -> str:
 
 
 def _globals(keep_rotation: bool) -> tuple:
-    names = ["M", *(f"P{a}" for a in _AXES), "K", *(f"V{a}" for a in _AXES), "c", "s", "r1", "chi2", "ok", "sgn"]
+    names = ["M", *(f"P{a}" for a in _AXES), "K", *(f"V{a}" for a in _AXES), "c", "s", "r1", "chi2", "nmask", "ok",
+             "sgn"]
     if keep_rotation:
         names += [*(f"mx{a}" for a in _AXES), *(f"q{p}" for p in _PAIRS), *(f"L{a}" for a in _AXES),
                   *(f"R{a}" for a in _AXES), *(f"I{p}" for p in _PAIRS), *(f"adj{p}" for p in _PAIRS), "det",
@@ -64,7 +68,8 @@ def add_variables(integrator: mm.CustomIntegrator, settings: ThermostatSettings)
     :func:`mask_values` once the Context is known to have the System's particle count."""
     ig = integrator
     for name, value in ((TEMPERATURE_VAR, settings.temperature), (COLLISION_TIME_VAR, settings.collision_time),
-                        (HEAT_BATH_VAR, 0.0), (ALPHA_VAR, 1.0), (KINETIC_VAR, 0.0), (NEW_KINETIC_VAR, 0.0)):
+                        (HEAT_BATH_VAR, 0.0), (ALPHA_VAR, 1.0), (KINETIC_VAR, 0.0), (NEW_KINETIC_VAR, 0.0),
+                        (LOST_MASK_VAR, 0.0)):
         ig.addGlobalVariable(name, float(value))
     for name in _globals(settings.keep_rotation):
         ig.addGlobalVariable(name, 0.0)
@@ -185,7 +190,10 @@ def emit_half_event(integrator: mm.CustomIntegrator, settings: ThermostatSetting
     ig.addComputeGlobal(v("c"), f"exp(-{_num(0.5 * settings.interval)}*dt/{COLLISION_TIME_VAR})")
     ig.addComputeGlobal(v("s"), f"{_num(0.5 * dof * R_KJ)}*{TEMPERATURE_VAR}/{dof}")  # target / dof
     c, s, r1, chi2 = v("c"), v("s"), v("r1"), v("chi2")
-    ig.addComputeGlobal(v("ok"), f"1 - step(-{K})")  # K_pec > 0: something to scale
+    # the mask holds its dof - 1 ones (else the Context lost it: do nothing and say so), and K_pec > 0
+    ig.addComputeSum(v("nmask"), MASK_VAR)
+    ig.addComputeGlobal(LOST_MASK_VAR, f"max({LOST_MASK_VAR}, 1 - delta({v('nmask')} - {dof - 1}))")
+    ig.addComputeGlobal(v("ok"), f"(1 - step(-{K}))*delta({v('nmask')} - {dof - 1})")
     new = (f"{c}*{K} + (1 - {c})*{s}*({r1}*{r1} + {chi2}) + 2*{r1}*sqrt({c}*(1 - {c})*{K}*{s})")
     ig.addComputeGlobal(NEW_KINETIC_VAR, f"select({v('ok')}, {new}, {K})")
     # the velocity came out reversed along itself: r1 + sqrt(c K / ((1 - c) s)) < 0
