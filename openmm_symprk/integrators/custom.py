@@ -88,6 +88,9 @@ class PRKIntegrator(IntegratorBase, mm.CustomIntegrator):
         (:mod:`openmm_symprk.methods.respa`; :func:`openmm_symprk.systems.forcegroups.split_forces` sets the groups).
     inner_method : the kick/drift method of the inner levels (default: the same as the outer one).
     tolerance, max_iterations : implicit methods only: fixed-point tolerance (nm) and iteration cap.
+    temperature, collision_time, thermostat_interval, random_seed : the velocity-rescaling thermostat (NVT), see
+        :func:`openmm_symprk.integrators.thermostat.thermostat_settings` and :mod:`.thermostat_program`;
+        ``temperature`` needs ``system=``.  Without ``temperature`` the program is the NVE one, bit for bit.
     """
 
     backend = "custom"
