@@ -403,12 +403,13 @@ def test_water_box_temperature_and_kinetic_energy_are_canonical(backend, box):
     StateDataReporter's and ConservationReporter's temperature columns agree with it."""
     system, x = box
     ig, rec, sdr, cons, _ = _water_box_run(backend, system, x, 4000)
+    cons_text = cons._out.getvalue()
     m = masses(system)
     dof = ig.thermostat_dof
     kT = R_KJ * 300.0
     K = np.array([peculiar_kinetic(xs, vs, m, False) for xs, vs in zip(rec.x, rec.v)])
     T = series_stats(2 * K / (dof * R_KJ))
-    assert abs(T.mean - 300.0) < 3 * T.se and T.se < 3.0
+    assert abs(T.mean - 300.0) < 3 * T.se and T.se < 4.0  # resolves 300 K to ~1 %
     k = series_stats(K)
     assert abs(k.mean - dof * kT / 2) < 3 * k.se
     var = series_stats((K - K.mean()) ** 2)
@@ -418,6 +419,9 @@ def test_water_box_temperature_and_kinetic_energy_are_canonical(backend, box):
     rows = [line.split(",") for line in sdr.splitlines()[1:]]
     t_sdr = series_stats([float(r[1]) for r in rows])
     assert abs(t_sdr.mean - 300.0 * dof / (dof + 3)) < 3 * t_sdr.se
+    # ConservationReporter reports the effective energy (total + heat bath) and says so in its header
+    assert cons.records[-1]["heat_bath"] == ig.computeHeatBathEnergy().value_in_unit(unit.kilojoule_per_mole) != 0
+    assert '"Total + heat-bath energy (kJ/mol)"' in cons_text
     # ConservationReporter's translational and rotational temperatures: equipartition at 300 K
     for key in ("T_trans", "T_rot"):
         s = series_stats([r[key] for r in cons.records])
