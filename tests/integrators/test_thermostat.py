@@ -626,3 +626,25 @@ def test_copies_keep_the_thermostat(backend, cluster, how):
         runs.append((state_arrays(ctx)[1].tobytes(), integrator.computeHeatBathEnergy()))
         del ctx
     assert runs[0] == runs[1]
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_no_conservation_warning_for_its_own_thermostat(backend, cluster):
+    """The package's thermostat keeps P (and L here), so neither the integrator nor ConservationReporter warns
+    about it, as they do about OpenMM's thermostats."""
+    import warnings
+
+    from openmm_symprk.conservation import ConservationReporter
+    from openmm_symprk.systems.checks import ConservationWarning
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", ConservationWarning)
+        ig = SymplecticIntegrator(0.002, "verlet", system=cluster.system, backend=backend, temperature=300,
+                                  random_seed=1)
+        sim = app.Simulation(cluster.topology, cluster.system, ig, mm.Platform.getPlatformByName(REF))
+        sim.context.setPositions(cluster.positions)
+        sim.context.setVelocities(cluster.velocities)
+        reporter = ConservationReporter(io.StringIO(), 5)
+        sim.reporters.append(reporter)
+        sim.step(10)
+    assert reporter.issues == [] and len(reporter.records) == 2
