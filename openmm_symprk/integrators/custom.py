@@ -208,7 +208,8 @@ class PRKIntegrator(IntegratorBase, mm.CustomIntegrator):
                 raise RuntimeError(f"{type(self).__name__}({self.method_name}): the thermostat's mask could not be "
                                    f"set (its Context was not found); create the integrator with system=")
             m = masses(context.getSystem())
-        self.setPerDofVariableByName(thermostat_program.MASK_VAR, thermostat_program.mask_values(m, self.thermostat.dof))
+        self.setPerDofVariableByName(thermostat_program.MASK_VAR,
+                                     thermostat_program.mask_values(m, self.thermostat.dof))
 
     def _thermostat_values(self):
         """The settings with the temperature and collision time the program holds now (a checkpoint restores

@@ -28,6 +28,8 @@ from openmm_symprk.systems.scenes import water_box, water_cluster
 REF = "Reference"
 #: the periodic box and the barostat get their one-time ConservationWarning, as in NVE: not the subject here
 pytestmark = pytest.mark.filterwarnings("ignore::openmm_symprk.systems.checks.ConservationWarning")
+#: the CPU platform, reproducible run to run (forces summed in a fixed order), so that fixed seeds fix the outcome
+CPU_PROPERTIES = {"Threads": "2", "DeterministicForces": "true"}
 
 
 # -- systems ---------------------------------------------------------------------------------------------
@@ -359,7 +361,7 @@ def npt_box(box):
     system.addForce(barostat)
     ig = mm.LangevinMiddleIntegrator(300 * unit.kelvin, 5 / unit.picosecond, 2 * unit.femtoseconds)
     ig.setRandomNumberSeed(17)
-    ctx = mm.Context(system, ig, mm.Platform.getPlatformByName("CPU"), {"Threads": "2"})
+    ctx = mm.Context(system, ig, mm.Platform.getPlatformByName("CPU"), CPU_PROPERTIES)
     ctx.setPositions(x)
     ctx.setVelocitiesToTemperature(300 * unit.kelvin, 17)
     ig.step(2000)
@@ -383,7 +385,7 @@ def _water_box_run(backend, system, x, steps, seed=5, platform="CPU", equilibrat
             top.addBond(o, top.addAtom(name, app.element.hydrogen, res))
     top.setPeriodicBoxVectors(system.getDefaultPeriodicBoxVectors())
     sim = app.Simulation(top, system, ig, mm.Platform.getPlatformByName(platform),
-                         {"Threads": "2"} if platform == "CPU" else {})
+                         CPU_PROPERTIES if platform == "CPU" else {})
     if box_vectors is not None:
         sim.context.setPeriodicBoxVectors(*box_vectors)
     sim.context.setPositions(x)
@@ -401,8 +403,7 @@ def _water_box_run(backend, system, x, steps, seed=5, platform="CPU", equilibrat
 def test_water_box_temperature_and_kinetic_energy_are_canonical(backend, box):
     """64 rigid waters (PME), 8 ps sampled every 20 fs: <T> of the peculiar kinetic energy within 3 standard errors
     of 300 K, the mean and variance of K within 3 standard errors (of 8 blocks) of N_f kT/2 and N_f (kT)^2/2;
-    StateDataReporter's and ConservationReporter's temperature columns agree with it.  (CPU with PME: forces
-    summed by threads in no fixed order, so the run is not bitwise reproducible; the bounds are statistical.)"""
+    StateDataReporter's and ConservationReporter's temperature columns agree with it."""
     system, x = box
     ig, rec, sdr, cons, _ = _water_box_run(backend, system, x, 4000)
     cons_text = cons._out.getvalue()
@@ -513,7 +514,7 @@ def test_effective_energy_drift_equals_the_nve_drift(backend):
     the heat-bath energy are a random walk's)."""
     scene = water_cluster(27, temperature=300.0, angular_velocity=(0.0, 0.0, 0.0))
     system = scene.system
-    x, _ = equilibrate(system, scene.positions, 300.0, 2.0, seed=7)
+    x, _ = equilibrate(system, scene.positions, 300.0, 2.0, seed=7, platform=REF)
     slopes = {"nve": [], "nvt": []}
     for replica in range(8):
         v = maxwell_boltzmann(system, x, 300.0, 100 + replica)
@@ -613,12 +614,14 @@ def test_copies_keep_the_thermostat(backend, cluster, how):
     ig = SymplecticIntegrator(0.002, "omelyan-2", system=cluster.system, backend=backend, temperature=320,
                               collision_time=0.3, thermostat_interval=2, random_seed=21)
     ig.setTemperature(330)  # changed after creation: the copy has the current value
-    copied = {"xml": lambda: deserialize(mm.XmlSerializer.serialize(ig)), "pickle": lambda: pickle.loads(pickle.dumps(ig)),
+    copied = {"xml": lambda: deserialize(mm.XmlSerializer.serialize(ig)),
+              "pickle": lambda: pickle.loads(pickle.dumps(ig)),
               "deepcopy": lambda: copy.deepcopy(ig)}[how]()
     assert type(copied) is type(ig)
     assert copied.getTemperature() == 330 * unit.kelvin
     assert copied.getCollisionTime().value_in_unit(unit.picoseconds) == pytest.approx(0.3, rel=1e-15)
-    assert (copied.getThermostatInterval(), copied.getRandomNumberSeed(), copied.thermostat_dof) == (2, 21, ig.thermostat_dof)
+    assert (copied.getThermostatInterval(), copied.getRandomNumberSeed(), copied.thermostat_dof) == \
+        (2, 21, ig.thermostat_dof)
     assert copied.thermostat.keep_rotation and "330 K" in copied.describe()
     # and it runs the same trajectory (same seed, fresh Contexts)
     runs = []
