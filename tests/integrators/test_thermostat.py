@@ -653,3 +653,26 @@ def test_no_conservation_warning_for_its_own_thermostat(backend, cluster):
         sim.reporters.append(reporter)
         sim.step(10)
     assert reporter.issues == [] and len(reporter.records) == 2
+
+
+@pytest.mark.parametrize("method", ["gauss-2", "lobatto-iiia-iiib-3"])
+def test_general_tableaux_take_the_thermostat_too(method):
+    """The CustomIntegrator backend's implicit PRK methods with the thermostat (Morse molecule, isolated: N_f = 6):
+    the events wrap the stages, P and L stay to round-off, heat is exchanged."""
+    from openmm_symprk.systems.scenes import morse_molecule
+
+    scene = morse_molecule()
+    ig = SymplecticIntegrator(0.0005, method, system=scene.system, temperature=600, collision_time=0.01,
+                              random_seed=6)
+    assert ig.backend == "custom" and ig.thermostat_dof == 6
+    assert sum("gaussian" in e for _, _, e in _computations(ig)) == 4
+    ctx = context(scene.system, ig, scene.positions, scene.velocities)
+    m = masses(scene.system)
+    x0, v0, _ = state_arrays(ctx)
+    ig.step(200)
+    x, v, _ = state_arrays(ctx)
+    scale = float(np.sum(m[:, None] * np.abs(v)))
+    assert np.linalg.norm((m[:, None] * (v - v0)).sum(0)) < 1e-12 * scale
+    L0, L = (m[:, None] * np.cross(x0, v0)).sum(0), (m[:, None] * np.cross(x, v)).sum(0)
+    assert np.linalg.norm(L - L0) < 1e-11 * np.linalg.norm(L0)
+    assert ig.computeHeatBathEnergy().value_in_unit(unit.kilojoule_per_mole) != 0
