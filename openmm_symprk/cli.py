@@ -105,9 +105,11 @@ def _cmd_info(args):
 
     print(f"openmm_symprk {openmm_symprk.__version__}, OpenMM {mm.__version__}")
     details = plugin.details()
+    thermostat = set(plugin.thermostat_platforms())
     for n, how in details.items():
         backend = "native plugin" if how == "native" else f"CustomIntegrator program (native: {how})"
-        print(f"  platform {n:10s} backend for splittings: {backend}")
+        nvt = "native" if n in thermostat else "CustomIntegrator program"
+        print(f"  platform {n:10s} backend for splittings: {backend}; NVT thermostat (temperature=): {nvt}")
     auto = "native" if plugin.available() and all(how == "native" for how in details.values()) else "custom"
     print(f"  SymplecticIntegrator(backend='auto') gives: {auto} for splittings and compositions, "
           f"custom for implicit and general tableaux")

@@ -10,7 +10,8 @@ are requested unwrapped (``periodic: False``): wrapping molecules into a box wou
 momentum that is being reported.
 
 :class:`ConservationReporter` writes, like ``StateDataReporter``, one line per report: step, time,
-total energy, its drift (slope of a least-squares line through all reports so far, in kJ/mol per ns
+total energy (plus the heat-bath energy for an integrator of this package run with ``temperature=``: the
+conserved effective energy of NVT, and the column says so), its drift (slope of a least-squares line through all reports so far, in kJ/mol per ns
 per degree of freedom; :class:`openmm_symprk.stats.RunningLine`, constant work per report), |P - P0|, |L - L0|/|L0| (L about the centre of mass, or about the origin),
 the largest relative constraint violation, and the translational and rotational kinetic temperatures of the
 molecules (:mod:`openmm_symprk.physics.temperature`); every figure is computed in float64 from the State
@@ -117,6 +118,8 @@ class ConservationReporter:
         L = momenta.angular_momentum(x, v, m, about=self._about)
         ke = momenta.kinetic_energy(v, m)
         total = ke + state.getPotentialEnergy().value_in_unit(_KJ)
+        heat_bath = self._heat_bath(simulation)
+        total += heat_bath  # NVT with the package's thermostat: the conserved effective energy
         t = state.getTime().value_in_unit(unit.picosecond)
         step = simulation.currentStep
         if self._P0 is None:
@@ -125,7 +128,7 @@ class ConservationReporter:
         drift = slope * 1000.0 / max(self._dof, 1)  # per ps -> per ns
         nL0 = float(np.linalg.norm(self._L0))
         temps = kinetic_temperatures(x, v, m, self._molecules, True, self._system.getNumConstraints())
-        rec = {"step": step, "time": t, "total_energy": total, "energy_drift": drift,
+        rec = {"step": step, "time": t, "total_energy": total, "heat_bath": heat_bath, "energy_drift": drift,
                "dP": float(np.linalg.norm(P - self._P0)),
                "dL_rel": float(np.linalg.norm(L - self._L0) / nL0) if nL0 > 0 else float("nan"),
                "constraint_error": constraint_violation(x, self._constraints),
@@ -141,6 +144,14 @@ class ConservationReporter:
             pass
 
     # -- helpers ----------------------------------------------------------------------------------
+    @staticmethod
+    def _heat_bath(simulation) -> float:
+        """The heat-bath energy (kJ/mol) of an integrator of this package run with ``temperature=``, else 0."""
+        integrator = simulation.integrator
+        if getattr(integrator, "thermostat", None) is None:
+            return 0.0
+        return float(integrator.computeHeatBathEnergy().value_in_unit(_KJ))
+
     def _initialise(self, simulation):
         self._system = simulation.system
         self._masses = masses(self._system)
@@ -155,7 +166,10 @@ class ConservationReporter:
             for key, msg in integrator_issues(simulation.integrator):
                 warn_once(key, f"ConservationReporter: {msg}", stacklevel=4)
         if not self._append:
-            print("#" + self._sep.join(f'"{c}"' for c in self.COLUMNS), file=self._out)
+            columns = list(self.COLUMNS)
+            if getattr(simulation.integrator, "thermostat", None) is not None:
+                columns[2] = "Total + heat-bath energy (kJ/mol)"
+            print("#" + self._sep.join(f'"{c}"' for c in columns), file=self._out)
         self._initialised = True
 
     def close(self):

@@ -23,13 +23,15 @@ from ..systems.checks import validate_system, warn_once
 from ..systems.forcegroups import check_groups
 from ..systems.properties import SystemSignature, signature
 from .base import check_max_speed, step_size_in_ps
+from .thermostat import THERMOSTAT_OPTIONS, ThermostatSettings, thermostat_settings
 
 __all__ = ["BACKENDS", "NATIVE_OPTIONS", "CUSTOM_OPTIONS", "OPTIONS", "choose_backend", "check_option_names",
            "prepare", "Prepared", "BackendWarning", "NativeMethodError", "NativeUnavailableError"]
 
 BACKENDS = ("auto", "native", "custom")
 #: Options of SymplecticIntegrator that both backends take (the native backend takes these only).
-NATIVE_OPTIONS = frozenset({"exact_momentum", "check_finite", "max_speed", "groups", "inner_method"})
+NATIVE_OPTIONS = frozenset({"exact_momentum", "check_finite", "max_speed", "groups", "inner_method",
+                            *THERMOSTAT_OPTIONS})
 #: Options only the CustomIntegrator backend takes.
 CUSTOM_OPTIONS = frozenset({"allow_nonsymplectic", "constraints", "tolerance", "max_iterations"})
 #: Every option of SymplecticIntegrator.
@@ -70,17 +72,21 @@ class Prepared:
     check_finite: bool
     max_speed: float  # nm/ps, 0: only NaN and infinity
     system: SystemSignature | None  # the facts of system=, None without one
+    thermostat: ThermostatSettings | None = None  # None: no thermostat (NVE)
 
 
 def prepare(where: str, stepSize, method, system=None, *, exact_momentum=False, check_finite=True, max_speed=None,
             groups=None, inner_method=None, constraints=None, name=None, splittings_only: str | None = None,
-            skip_checks=()) -> Prepared:
+            skip_checks=(), temperature=None, collision_time=None, thermostat_interval=None,
+            random_seed=None) -> Prepared:
     """The checks and derivations both backends share, in one place.
 
     Validates the step size and options, refuses ``exact_momentum`` without ``system``, resolves the method with
     the System's constraint facts (``constraints`` overrides them; without a System kick/drift methods keep
     RATTLE steps), checks the System (one warning per kind of conservation issue, less ``skip_checks``) and the
-    force groups of multiple time stepping against it.  ``splittings_only``: the backend runs kick/drift
+    force groups of multiple time stepping against it.  The thermostat options (``temperature``,
+    ``collision_time``, ``thermostat_interval``, ``random_seed``) are checked by
+    :func:`.thermostat.thermostat_settings` and give ``Prepared.thermostat``.  ``splittings_only``: the backend runs kick/drift
     methods only; a general PRK pair raises NativeMethodError with this hint."""
     dt = step_size_in_ps(stepSize)
     max_speed = check_max_speed(max_speed)
@@ -89,6 +95,7 @@ def prepare(where: str, stepSize, method, system=None, *, exact_momentum=False, 
                          "is only right for an isolated System, which is checked, and it uses the System's masses")
     if system is not None and not isinstance(system, mm.System):
         raise TypeError(f"system must be an openmm.System, got {type(system).__name__}")
+    thermostat = thermostat_settings(system, temperature, collision_time, thermostat_interval, random_seed)
     facts = signature(system) if system is not None else None
     if constraints is None and facts is not None:
         constraints = facts.constraints
@@ -105,7 +112,7 @@ def prepare(where: str, stepSize, method, system=None, *, exact_momentum=False, 
         validate_system(system, f"{where}({resolved.name})", exact_momentum, skip=skip_checks)
         if resolved.groups is not None:
             check_groups(system, resolved.groups)
-    return Prepared(dt, resolved, bool(exact_momentum), bool(check_finite), max_speed, facts)
+    return Prepared(dt, resolved, bool(exact_momentum), bool(check_finite), max_speed, facts, thermostat)
 
 
 def choose_backend(method, backend: str = "auto", options=None) -> str:

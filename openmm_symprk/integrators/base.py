@@ -12,8 +12,16 @@ program of :mod:`.custom` or the plugin's SymPRKIntegrator of :mod:`.native`).  
 * copies: ``pickle``, ``copy.copy`` and ``copy.deepcopy`` go through OpenMM's XML serialization (as for
   OpenMM's own integrators) and give back the same Python class with its conveniences.
 
+* the thermostat's accessors (``temperature=`` of :func:`.thermostat.thermostat_settings`), in OpenMM's idiom:
+  ``getTemperature``/``setTemperature``, ``getCollisionTime``/``setCollisionTime``, ``getThermostatInterval``,
+  ``setRandomNumberSeed`` (checked), ``computeHeatBathEnergy``, ``thermostat_dof`` /
+  ``getThermostatDegreesOfFreedom``; ``thermostat`` holds the :class:`.thermostat.ThermostatSettings` (None:
+  NVE).
+
 Backends implement the hooks ``_blowup_step()``, ``_clear_blowup()``, ``_raw_steps_taken()`` and may
-override ``_before_step()`` / ``_after_step()``.
+override ``_before_step()`` / ``_after_step()``; with a thermostat, ``_heat_bath_energy()`` (kJ/mol) and
+``_apply_thermostat(settings)`` (give the running program a new temperature or collision time), and may
+override ``_thermostat_values()`` where the program holds them (a checkpoint may bring back older ones).
 """
 from __future__ import annotations
 
@@ -25,6 +33,7 @@ import openmm as mm
 import openmm.unit as unit
 
 from ..methods.catalogue import get_method
+from .thermostat import check_seed
 
 __all__ = ["IntegratorBase", "SimulationBlowUpError", "ConvergenceWarning", "SystemMismatchError",
            "CheckpointMismatchError", "step_size_in_ps", "check_max_speed"]
@@ -108,6 +117,7 @@ class IntegratorBase:
     max_speed: float = 0.0
     compiled_for = None  # SystemSignature of system=, or None
     resolved = None  # the ResolvedMethod it runs (openmm_symprk.methods.resolved), None if not known
+    thermostat = None  # ThermostatSettings, None without a thermostat (NVE)
     #: attributes a copy does not carry (the C++ object, per-Context handles)
     _transient: tuple = ("this", "thisown")
 
@@ -174,6 +184,78 @@ class IntegratorBase:
 
     def describe(self) -> str:
         """The integrator's program: backend, stages, constraint handling, force evaluations per step."""
+        raise NotImplementedError
+
+    # -- the thermostat ---------------------------------------------------------------------------------
+    @property
+    def has_thermostat(self) -> bool:
+        return self.thermostat is not None
+
+    def _require_thermostat(self, what: str):
+        if self.thermostat is None:
+            raise ValueError(f"{type(self).__name__}({self.method_name}).{what}: this integrator was created without "
+                             f"temperature=, so it runs NVE and has no thermostat; create it with e.g. "
+                             f"temperature=300*unit.kelvin (and system=) for NVT")
+        return self._thermostat_values()
+
+    def _thermostat_values(self):
+        """The settings the program runs now (a backend whose program holds them reads them there)."""
+        return self.thermostat
+
+    @property
+    def thermostat_dof(self) -> int | None:
+        """Degrees of freedom the thermostat samples (None without one): 3 per particle with mass - constraints
+        - 3 (centre-of-mass velocity kept) - 3 more for an isolated System (rigid rotation kept)."""
+        return None if self.thermostat is None else int(self.thermostat.dof)
+
+    def getThermostatDegreesOfFreedom(self) -> int:
+        return int(self._require_thermostat("getThermostatDegreesOfFreedom()").dof)
+
+    def getTemperature(self):
+        """The thermostat's target temperature (a Quantity in K)."""
+        return self._require_thermostat("getTemperature()").temperature * unit.kelvin
+
+    def setTemperature(self, temperature):
+        """Set the target temperature (a Quantity or a number of K); allowed while the integrator runs."""
+        settings = self._require_thermostat("setTemperature()").with_temperature(temperature)
+        self._apply_thermostat(settings)
+        self.thermostat = settings
+
+    def getCollisionTime(self):
+        """The thermostat's collision time tau (a Quantity in ps)."""
+        return self._require_thermostat("getCollisionTime()").collision_time * unit.picoseconds
+
+    def setCollisionTime(self, collision_time):
+        """Set the collision time tau (a time Quantity or a number of ps); allowed while the integrator runs."""
+        settings = self._require_thermostat("setCollisionTime()").with_collision_time(collision_time)
+        self._apply_thermostat(settings)
+        self.thermostat = settings
+
+    def getThermostatInterval(self) -> int:
+        """The thermostat acts every this many steps."""
+        return int(self._require_thermostat("getThermostatInterval()").interval)
+
+    def setRandomNumberSeed(self, seed):
+        """OpenMM's setRandomNumberSeed, checked (an int from 0 to 2**31 - 1; 0: a fresh seed each time a Context
+        is created).  As in OpenMM it takes effect when the next Context is created."""
+        seed = check_seed(seed)
+        result = super().setRandomNumberSeed(seed)
+        if self.thermostat is not None:
+            self.thermostat = self.thermostat.with_seed(seed)
+        return result
+
+    def computeHeatBathEnergy(self):
+        """The heat-bath energy (a Quantity in kJ/mol): minus the energy the thermostat gave the system, so that
+        total energy + heat-bath energy is conserved up to the integrator's own error (as
+        NoseHooverIntegrator.computeHeatBathEnergy).  0 without a thermostat."""
+        if self.thermostat is None:
+            return 0.0 * unit.kilojoule_per_mole
+        return float(self._heat_bath_energy()) * unit.kilojoule_per_mole
+
+    def _heat_bath_energy(self) -> float:
+        raise NotImplementedError
+
+    def _apply_thermostat(self, settings):
         raise NotImplementedError
 
     # -- copies ---------------------------------------------------------------------------------------

@@ -17,13 +17,14 @@ from __future__ import annotations
 import json
 import math
 import warnings
+from dataclasses import replace
 
 import openmm as mm
 import openmm.unit as unit
 
 from ..systems.checks import warn_once
 from ..systems.properties import masses
-from . import program
+from . import program, thermostat_program
 from .backend import CUSTOM_OPTIONS, NATIVE_OPTIONS, check_option_names, prepare
 from .base import CheckpointMismatchError, ConvergenceWarning, IntegratorBase, SystemMismatchError, step_size_in_ps
 from .projection import set_masses
@@ -87,6 +88,9 @@ class PRKIntegrator(IntegratorBase, mm.CustomIntegrator):
         (:mod:`openmm_symprk.methods.respa`; :func:`openmm_symprk.systems.forcegroups.split_forces` sets the groups).
     inner_method : the kick/drift method of the inner levels (default: the same as the outer one).
     tolerance, max_iterations : implicit methods only: fixed-point tolerance (nm) and iteration cap.
+    temperature, collision_time, thermostat_interval, random_seed : the velocity-rescaling thermostat (NVT), see
+        :func:`openmm_symprk.integrators.thermostat.thermostat_settings` and :mod:`.thermostat_program`;
+        ``temperature`` needs ``system=``.  Without ``temperature`` the program is the NVE one, bit for bit.
     """
 
     backend = "custom"
@@ -94,7 +98,8 @@ class PRKIntegrator(IntegratorBase, mm.CustomIntegrator):
     def __init__(self, stepSize, tableau, system: mm.System | None = None, constraints: bool | None = None,
                  allow_nonsymplectic: bool = False, exact_momentum: bool = False, check_finite: bool = True,
                  max_speed=None, groups=None, inner_method=None, tolerance: float = 1e-12, max_iterations: int = 60,
-                 name: str | None = None, **unknown):
+                 name: str | None = None, temperature=None, collision_time=None, thermostat_interval=None,
+                 random_seed=None, **unknown):
         check_option_names(unknown, _PRK_ARGS, type(self).__name__)
         if constraints is not None and not isinstance(constraints, bool):
             raise TypeError(f"constraints must be True, False or None (from system=), got {constraints!r}")
@@ -105,7 +110,8 @@ class PRKIntegrator(IntegratorBase, mm.CustomIntegrator):
             raise ValueError(f"max_iterations must be at least 1, got {max_iterations!r}")
         p = prepare(type(self).__name__, stepSize, tableau, system, exact_momentum=exact_momentum,
                     check_finite=check_finite, max_speed=max_speed, groups=groups, inner_method=inner_method,
-                    constraints=constraints, name=name)
+                    constraints=constraints, name=name, temperature=temperature, collision_time=collision_time,
+                    thermostat_interval=thermostat_interval, random_seed=random_seed)
         r = p.method
         r.check_symplectic(allow_nonsymplectic)
         has_sites = p.system.virtual_sites if p.system is not None else True
@@ -113,12 +119,16 @@ class PRKIntegrator(IntegratorBase, mm.CustomIntegrator):
         self._set_resolved(r)
         self.program_info = program.compile_program(
             self, r, has_sites, exact_momentum=p.exact_momentum, check_finite=p.check_finite, max_speed=p.max_speed,
-            tolerance=tolerance, max_iterations=int(max_iterations))
+            tolerance=tolerance, max_iterations=int(max_iterations), thermostat=p.thermostat)
         self.check_finite = p.check_finite
         self.max_speed = p.max_speed
         self.exact_momentum = p.exact_momentum
         self.compiled_for = sig = p.system
-        self._masses = masses(system) if p.exact_momentum else None
+        self._masses = masses(system) if p.exact_momentum or p.thermostat is not None else None
+        self.thermostat = p.thermostat
+        if p.thermostat is not None:
+            mm.CustomIntegrator.setRandomNumberSeed(self, p.thermostat.seed)
+
         self._signature = float(self.program_info.signature)
         self._reset_binding()
         meta = {"class": type(self).__name__, "method": self.method_name,
@@ -129,6 +139,8 @@ class PRKIntegrator(IntegratorBase, mm.CustomIntegrator):
                 "system": None if sig is None else {"n_particles": sig.n_particles, "constraints": sig.constraints,
                                                     "virtual_sites": sig.virtual_sites,
                                                     "total_mass": sig.total_mass, "masses_digest": sig.masses_digest}}
+        if p.thermostat is not None:  # (an NVE program's metadata stays as it was)
+            meta["thermostat"] = p.thermostat.as_dict()
         self.addGlobalVariable(META_PREFIX + json.dumps(meta, separators=(",", ":")).encode().hex(), 0.0)
 
     def _set_resolved(self, r):
@@ -174,11 +186,56 @@ class PRKIntegrator(IntegratorBase, mm.CustomIntegrator):
             raise SystemMismatchError(
                 f"{type(self).__name__}({self.method_name}) was compiled for a System of {expected} particles, but "
                 f"its Context's System has {n}: create the integrator with system= the System you simulate")
-        if self._masses is not None:
+        if self._masses is not None and self.exact_momentum:
             set_masses(self, self._masses)
+        if self.thermostat is not None:
+            self._set_thermostat_mask(n)
         self._checked_context = True
 
+    # -- the thermostat (see IntegratorBase for the accessors) ---------------------------------------------
+    def _set_thermostat_mask(self, n: int):
+        """Check, once the Context is known to have the System's particle count, that the per-DOF mask of the
+        chi-squared sum holds dof - 1 ones for n particles, and fill it if not: from the masses of system=, or
+        (an integrator read from XML without it) those of its Context's System."""
+        ones = self.thermostat.dof - 1
+        current = self.getPerDofVariableByName(thermostat_program.MASK_VAR)
+        if len(current) == n and sum(sum(vec) for vec in current) == ones:
+            return
+        m = self._masses
+        if m is None:
+            context = self._bound_context()
+            if context is None:
+                raise RuntimeError(f"{type(self).__name__}({self.method_name}): the thermostat's mask could not be "
+                                   f"set (its Context was not found); create the integrator with system=")
+            m = masses(context.getSystem())
+        self.setPerDofVariableByName(thermostat_program.MASK_VAR,
+                                     thermostat_program.mask_values(m, self.thermostat.dof))
+
+    def _thermostat_values(self):
+        """The settings with the temperature and collision time the program holds now (a checkpoint restores
+        the ones it was saved with) and the seed OpenMM will use."""
+        if self.thermostat is None:
+            return None
+        return replace(self.thermostat, temperature=self.getGlobalVariableByName(thermostat_program.TEMPERATURE_VAR),
+                       collision_time=self.getGlobalVariableByName(thermostat_program.COLLISION_TIME_VAR),
+                       seed=int(mm.CustomIntegrator.getRandomNumberSeed(self)))
+
+    def _apply_thermostat(self, settings):
+        self.setGlobalVariableByName(thermostat_program.TEMPERATURE_VAR, settings.temperature)
+        self.setGlobalVariableByName(thermostat_program.COLLISION_TIME_VAR, settings.collision_time)
+
+    def _heat_bath_energy(self) -> float:
+        return self.getGlobalVariableByName(thermostat_program.HEAT_BATH_VAR)
+
     def _after_step(self):
+        if self.thermostat is not None and self.getGlobalVariableByName(thermostat_program.LOST_MASK_VAR):
+            # the Context was reinitialized without its state (per-DOF values set while bound are lost): the
+            # events of this call did nothing (alpha = 1); fill the mask again for the next steps
+            self.setGlobalVariableByName(thermostat_program.LOST_MASK_VAR, 0.0)
+            self._set_thermostat_mask(len(self.getPerDofVariableByName(program.PROBE_PER_DOF)))
+            warnings.warn(f"{type(self).__name__}({self.method_name}): the thermostat's per-DOF mask was lost (the "
+                          f"Context was reinitialized without preserving its state), so the steps of this call ran "
+                          f"without the thermostat; it is restored for the next steps.", RuntimeWarning, stacklevel=3)
         if not self._checked_probe:
             self._checked_probe = True
             if self.getGlobalVariableByName(program.PROBE_CONSTRAINTS_VAR) > 0 and not self.program_info.constraints:
@@ -266,6 +323,8 @@ class PRKIntegrator(IntegratorBase, mm.CustomIntegrator):
         lines += [f"  {n}" for n in info.notes]
         if self.mts_levels:
             lines.append("  " + self.resolved.describe_levels())
+        if self.thermostat is not None:
+            lines.append("  " + self._thermostat_values().describe())
         return "\n".join(lines)
 
 

@@ -8,6 +8,11 @@ same trajectory bit for bit) without CustomIntegrator's per-degree-of-freedom in
 Reference and CPU (one kernel), OpenCL and CUDA (the Common compute source); :mod:`openmm_symprk.plugin`
 loads them and says why the backend is unavailable when it is.
 
+With ``temperature=`` the plugin runs the stochastic velocity-rescaling thermostat
+(:mod:`.thermostat` checks the options; the plugin's host code draws the noise and computes the factor, the
+kernels reduce the velocities and rescale them: on OpenCL/CUDA one device reduction and one download per
+event).  The C++ object holds the settings, so a copy or an integrator read back from XML has them.
+
 The C++ integrator checks, when a Context is created, that its System has the particle count and the
 constraints of ``system=`` (``setExpectedSystem``); its checkpoints carry a signature of the program and
 refuse another one; a platform without a kernel fails with a message naming the platforms that have one.
@@ -22,6 +27,7 @@ from .backend import NATIVE_OPTIONS, check_option_names, prepare
 from .base import IntegratorBase
 from .program import ProgramInfo
 from .symplectic import SymplecticIntegrator
+from .thermostat import ThermostatSettings
 
 __all__ = ["NativeSymplecticIntegrator", "native_available"]
 
@@ -45,11 +51,14 @@ class NativeSymplecticIntegrator(SymplecticIntegrator, _PluginIntegrator, backen
     splittings: ``stepSize``, ``method``, ``system`` (decides the RATTLE sequence -- compositions are taken over
     velocity Verlet under constraints --, is checked for anything that breaks conservation, and is recorded:
     a Context of another System is refused), ``exact_momentum`` (needs ``system=``), ``check_finite`` and
-    ``max_speed``.  Raises NativeUnavailableError (with the reason and the fix) when the plugin is unavailable
+    ``max_speed``, and the thermostat's ``temperature``, ``collision_time``, ``thermostat_interval`` and
+    ``random_seed`` (see :func:`~openmm_symprk.integrators.thermostat.thermostat_settings`; with groups= it wraps
+    the outer step).  Raises NativeUnavailableError (with the reason and the fix) when the plugin is unavailable
     and NativeMethodError for implicit and general tableaux, which only the CustomIntegrator backend runs."""
 
     def __init__(self, stepSize, method="verlet", system=None, backend="native", exact_momentum=False,
-                 check_finite=True, max_speed=None, groups=None, inner_method=None, **unknown):
+                 check_finite=True, max_speed=None, groups=None, inner_method=None, temperature=None,
+                 collision_time=None, thermostat_interval=None, random_seed=None, **unknown):
         self._check_backend(backend)
         check_option_names(unknown, NATIVE_OPTIONS_ARGS, type(self).__name__)
         if _swig is None:
@@ -58,7 +67,8 @@ class NativeSymplecticIntegrator(SymplecticIntegrator, _PluginIntegrator, backen
         # the native kernels place virtual sites after every drift: no CustomIntegrator caveat
         p = prepare(type(self).__name__, stepSize, method, system, exact_momentum=exact_momentum,
                     check_finite=check_finite, max_speed=max_speed, groups=groups, inner_method=inner_method,
-                    splittings_only="the native backend runs kick/drift splittings and compositions only. Use "
+                    temperature=temperature, collision_time=collision_time, thermostat_interval=thermostat_interval,
+                    random_seed=random_seed, splittings_only="the native backend runs kick/drift splittings and compositions only. Use "
                                     "SymplecticIntegrator(..., backend='custom') for it.", skip_checks=("virtualsites",))
         r = p.method
         subs = r.substeps
@@ -69,6 +79,8 @@ class NativeSymplecticIntegrator(SymplecticIntegrator, _PluginIntegrator, backen
         self.setMaxSpeed(p.max_speed)
         if p.system is not None:
             self.setExpectedSystem(p.system.n_particles, r.constraints)
+        if p.thermostat is not None:
+            self.thermostat = p.thermostat  # the property below hands it to the plugin
         self._set_resolved(r)
         self.check_finite = p.check_finite
         self.max_speed = p.max_speed
@@ -106,6 +118,47 @@ class NativeSymplecticIntegrator(SymplecticIntegrator, _PluginIntegrator, backen
         self.this = typed.this
         self.thisown = own
 
+    # -- the thermostat: the plugin holds its settings -------------------------------------------------------
+    @property
+    def thermostat(self):
+        """The thermostat's settings (:class:`~openmm_symprk.integrators.thermostat.ThermostatSettings`), read from
+        the plugin; None without a thermostat."""
+        if not self.hasThermostat():
+            return None
+        return ThermostatSettings(float(self.getThermostatTemperature()), float(_PluginIntegrator.getCollisionTime(self)),
+                                  int(_PluginIntegrator.getThermostatInterval(self)), int(self.getRandomNumberSeed()),
+                                  int(self.getThermostatDof()), bool(self.getThermostatKeepsRotation()))
+
+    @thermostat.setter
+    def thermostat(self, settings):
+        if settings is None:
+            if self.hasThermostat():
+                raise ValueError("the thermostat of a NativeSymplecticIntegrator cannot be removed: create an integrator "
+                                 "without temperature= for an NVE run")
+            return
+        self._apply_thermostat(settings)
+        _PluginIntegrator.setRandomNumberSeed(self, int(settings.seed))
+
+    def _apply_thermostat(self, settings):
+        current = self.thermostat
+        if current is not None and current.temperature != settings.temperature:
+            self.setThermostatTemperature(float(settings.temperature))  # allowed while bound
+        if current is None or (current.collision_time, current.interval, current.dof, current.keep_rotation) != \
+                (settings.collision_time, settings.interval, settings.dof, settings.keep_rotation):
+            try:
+                self.setThermostat(float(settings.temperature), float(settings.collision_time), int(settings.interval),
+                                   int(settings.dof), bool(settings.keep_rotation))
+            except mm.OpenMMException as exc:
+                if "bound" not in str(exc):
+                    raise
+                raise ValueError(f"the native backend cannot change the thermostat's collision time (from "
+                                 f"{current.collision_time:g} ps to {settings.collision_time:g} ps) once the integrator "
+                                 f"runs a Context: its checkpoints and program signature carry it. Set it before "
+                                 f"creating the Context, or create a new integrator") from None
+
+    def _heat_bath_energy(self) -> float:
+        return float(self.getHeatBathEnergy())
+
     # -- conveniences ----------------------------------------------------------------------------------------
     @property
     def force_evals(self) -> int:
@@ -127,7 +180,15 @@ class NativeSymplecticIntegrator(SymplecticIntegrator, _PluginIntegrator, backen
                 f"  program: splitting, {self.getNumSubsteps()} kicks and drifts, constraints="
                 f"{'RATTLE' if self.program_info.constraints else 'none'}, force evaluations per step: "
                 f"{self.force_evals}, exact momentum: {self.getExactMomentum()}"
-                + (f"\n  {self.resolved.describe_levels()}" if self.mts_levels else ""))
+                + (f"\n  {self.resolved.describe_levels()}" if self.mts_levels else "")
+                + self._describe_thermostat())
+
+    def _describe_thermostat(self) -> str:
+        settings = self.thermostat
+        if settings is None:
+            return ""
+        where = ", around the outer step" if self.mts_levels else ""
+        return f"\n  {settings.describe()}{where}"
 
 
 # IntegratorBase.step must come before the plugin's own step in the method resolution order.

@@ -24,6 +24,11 @@ One compiler for everything (docs/openmm_notes.md explains each rule):
   velocity projection), with the System's masses in double.
 * The blow-up check: the first step at which some velocity is NaN or infinite (or faster than a given
   speed) is kept in a global variable.
+* Optional thermostat (:mod:`.thermostat_program`, only with ``thermostat=`` settings: without them not one
+  computation or variable differs from the NVE program): a half velocity-rescaling event after the header,
+  before the first sub-step of every ``interval`` steps, and one after the end-of-step velocity projection
+  of the ``interval``-th step (Trotter splitting; ``if`` blocks on the step counter when interval > 1).  With
+  multiple time stepping the events wrap the outer step, which is the whole program.
 """
 from __future__ import annotations
 
@@ -87,10 +92,11 @@ class _Emitter:
     """Appends computations to a CustomIntegrator, with the shared header, kick and drift rules."""
 
     def __init__(self, integrator: mm.CustomIntegrator, constraints: bool, exact_momentum: bool,
-                 update_context_state: bool = True):
+                 update_context_state: bool = True, thermostat=None):
         if integrator.getNumComputations() or integrator.getNumGlobalVariables() or integrator.getNumPerDofVariables():
             raise ValueError("compile into an empty CustomIntegrator: this one already has a program")
         self.ig = integrator
+        self.thermostat = thermostat
         self.constraints = constraints
         self.exact_momentum = exact_momentum
         self._vars: set = set()
@@ -101,9 +107,28 @@ class _Emitter:
             from .projection import add_projection_variables
 
             add_projection_variables(integrator)
+        if thermostat is not None:
+            from .thermostat_program import add_variables
+
+            add_variables(integrator, thermostat)
         if update_context_state:
             integrator.addUpdateContextState()
         self._probe()
+        self._thermostat_event(STEP_VAR)
+
+    def _thermostat_event(self, counter: str):
+        """A half thermostat event, in an ``if`` block on ``counter`` (a multiple of the interval) when the
+        thermostat acts every n > 1 steps."""
+        if self.thermostat is None:
+            return
+        from .thermostat_program import emit_half_event
+
+        n = int(self.thermostat.interval)
+        if n > 1:
+            self.ig.beginIfBlock(f"{counter} - {n}*floor(({counter})/{n}) < 0.5")
+        emit_half_event(self.ig, self.thermostat)
+        if n > 1:
+            self.ig.endBlock()
 
     def _probe(self):
         """Once per Context (first step): does its System have constraints?  ConstrainVelocities changes the
@@ -182,6 +207,7 @@ class _Emitter:
             emit_constrain_velocities(self.ig)
         elif self.constraints:
             self.ig.addConstrainVelocities()
+        self._thermostat_event(f"{STEP_VAR} + 1")
         self.ig.addComputeGlobal(STEP_VAR, f"{STEP_VAR} + 1")
         if check_finite:
             # Count the degrees of freedom whose speed is NaN (every comparison with NaN is false, so
@@ -198,11 +224,12 @@ class _Emitter:
 
 
 def compile_splitting(integrator, method: ResolvedMethod, constraints: bool, exact_momentum=False,
-                      check_finite=True, update_context_state=True, max_speed=0.0) -> ProgramInfo:
+                      check_finite=True, update_context_state=True, max_speed=0.0, thermostat=None) -> ProgramInfo:
     """Emit the program of a resolved kick/drift method: its sub-steps as they run, with a velocity projection
     before every drift flagged for one.  ``constraints``: emit the RATTLE steps (the System has constraints, or
-    virtual sites that only ConstrainPositions places on the Common platforms)."""
-    em = _Emitter(integrator, constraints, exact_momentum, update_context_state)
+    virtual sites that only ConstrainPositions places on the Common platforms); ``thermostat``: the
+    :class:`~.thermostat.ThermostatSettings` of a velocity-rescaling thermostat (None: NVE)."""
+    em = _Emitter(integrator, constraints, exact_momentum, update_context_state, thermostat)
     for sub in method.substeps:
         c = float(sub.coefficient)
         if sub.kind == SubstepKind.DRIFT:
@@ -225,13 +252,13 @@ def _lincomb(base: str, coeffs, names) -> str:
 
 def compile_tableau(integrator, tab: PRKTableau, exact_momentum=False, check_finite=True,
                     update_context_state=True, tolerance=1e-12, max_iterations=60, max_speed=0.0,
-                    place_virtual_sites=False) -> ProgramInfo:
+                    place_virtual_sites=False, thermostat=None) -> ProgramInfo:
     """Emit the program of a general PRK pair (unconstrained systems only).
 
     Per-DOF variables: symprk_x0/v0 (start of step), symprk_k<i> (stage accelerations F(Q_i)/m),
     symprk_p<i> (stage velocities P_i), symprk_q<i> (implicit stage positions).  ``place_virtual_sites``
     ends the step with a ConstrainPositions (which only places virtual sites in an unconstrained System)."""
-    em = _Emitter(integrator, False, exact_momentum, update_context_state)
+    em = _Emitter(integrator, False, exact_momentum, update_context_state, thermostat)
     s = tab.stages
     A, Ah, b, bh = (np.asarray(m, dtype=np.float64) for m in (tab.A, tab.A_hat, tab.b, tab.b_hat))
     for v in ("symprk_x0", "symprk_v0"):
@@ -315,7 +342,7 @@ def compile_program(integrator, method: ResolvedMethod, virtual_sites: bool = Fa
     A kick/drift method gets RATTLE steps where it was resolved with constraints or the System has
     ``virtual_sites`` (whose ConstrainPositions places them); a general PRK pair (resolved without constraints)
     ends the step with a ConstrainPositions where there are virtual sites."""
-    common = ("exact_momentum", "check_finite", "update_context_state", "max_speed")
+    common = ("exact_momentum", "check_finite", "update_context_state", "max_speed", "thermostat")
     if method.is_splitting:
         keep = {k: v for k, v in options.items() if k in common}
         return compile_splitting(integrator, method, method.constraints or virtual_sites, **keep)

@@ -23,6 +23,7 @@ from . import program
 from .custom import CustomSymplecticIntegrator, PRKIntegrator, read_metadata
 from .native import NativeSymplecticIntegrator, native_available
 from .program import ProgramInfo
+from .thermostat import ThermostatSettings
 
 __all__ = ["restore", "deserialize"]
 
@@ -77,6 +78,7 @@ def _restore_custom(integrator: mm.CustomIntegrator):
         check_finite=bool(options.get("check_finite", True)), max_speed=float(options.get("max_speed") or 0.0),
         exact_momentum=bool(options.get("exact_momentum", False)),
         compiled_for=SystemSignature(**system) if system else None, _masses=None,
+        thermostat=ThermostatSettings(**meta["thermostat"]) if meta.get("thermostat") else None,
         _signature=obj.getGlobalVariable(0),
         program_info=ProgramInfo(kind, constraints, resolved.force_evals if resolved is not None else None,
                                  len(resolved.substeps) if resolved is not None else 0,

@@ -33,7 +33,12 @@ class SymplecticIntegrator(IntegratorBase):
       needs ``system=``), ``check_finite`` (raise SimulationBlowUpError on NaN/inf velocities),
       ``max_speed`` (nm/ps: also count faster velocities as a blow-up); the CustomIntegrator backend also
       takes ``allow_nonsymplectic``, ``constraints``, ``tolerance`` and ``max_iterations``
-      (see :class:`~openmm_symprk.integrators.custom.PRKIntegrator`).
+      (see :class:`~openmm_symprk.integrators.custom.PRKIntegrator`);
+    * NVT: ``temperature`` (K, needs ``system=``), ``collision_time`` (ps, default 0.1), ``thermostat_interval``
+      (default 1) and ``random_seed`` (default 0: fresh per Context) add stochastic velocity rescaling around
+      the step, keeping total momentum (and angular momentum of an isolated System) exactly
+      (:mod:`openmm_symprk.integrators.thermostat`, docs/thermostat.md); accessors ``getTemperature``,
+      ``setTemperature``, ``computeHeatBathEnergy``, ``thermostat_dof``... (:class:`~.base.IntegratorBase`).
     """
 
     #: backend name -> concrete class (filled by the subclasses)

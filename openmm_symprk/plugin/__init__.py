@@ -27,7 +27,7 @@ SERVES = {"Reference": ("Reference", "CPU"), "OpenCL": ("OpenCL",), "CUDA": ("CU
 #: The command that rebuilds the plugin of an installation from its source checkout.
 REBUILD = "pip install --force-reinstall --no-deps <path of your openmm_symprk checkout>"
 
-__all__ = ["available", "unavailable_reason", "fix_hint", "platforms", "details", "build_info", "build_directory",
+__all__ = ["available", "unavailable_reason", "fix_hint", "platforms", "thermostat_platforms", "details", "build_info", "build_directory",
            "swig_module", "NativeUnavailableError", "KERNEL_NAME"]
 
 
@@ -144,6 +144,15 @@ def platforms() -> list:
     if st.swig is None:
         return []
     return [p for p in _platform_names() if _has_kernel(p)]
+
+
+def thermostat_platforms() -> list:
+    """Names of the platforms on which the native integrator runs the velocity-rescaling thermostat
+    (``temperature=``): every platform with a kernel, when the build has the thermostat (SymPRKIntegrator.setThermostat)."""
+    st = _load()
+    if st.swig is None or not hasattr(st.swig.SymPRKIntegrator, "setThermostat"):
+        return []
+    return platforms()
 
 
 def _library_of(platform: str) -> str:

@@ -11,8 +11,10 @@ import openmm as mm
 import openmm.app as app
 import openmm.unit as unit
 
+from ..physics.velocity_rescaling import thermostat_dof
+
 __all__ = ["masses", "has_constraints", "constraint_arrays", "constraint_violation", "degrees_of_freedom",
-           "virtual_sites", "frozen_particles", "force_names", "molecules", "SystemSignature", "signature"]
+           "thermostat_degrees_of_freedom", "virtual_sites", "frozen_particles", "force_names", "molecules", "SystemSignature", "signature"]
 
 
 def masses(system: mm.System) -> np.ndarray:
@@ -55,6 +57,20 @@ def degrees_of_freedom(system: mm.System) -> int:
     if any(isinstance(f, mm.CMMotionRemover) for f in system.getForces()):
         dof -= 3
     return dof
+
+
+def thermostat_degrees_of_freedom(system: mm.System, isolated: bool) -> int:
+    """Degrees of freedom a velocity-rescaling thermostat samples in ``system``: 3 per particle with mass
+    (virtual sites and other massless particles never move by themselves), minus one per constraint that
+    involves a particle with mass (OpenMM's rule, as in StateDataReporter), minus 3 for the centre-of-mass
+    velocity (kept), minus 3 more for the rigid rotation when the System is ``isolated`` (kept too).
+    The rule itself is :func:`openmm_symprk.physics.velocity_rescaling.thermostat_dof`."""
+    m = masses(system)
+    n_constraints = 0
+    for k in range(system.getNumConstraints()):
+        i, j, _ = system.getConstraintParameters(k)
+        n_constraints += bool(m[i] > 0 or m[j] > 0)
+    return thermostat_dof(int(np.count_nonzero(m > 0)), n_constraints, isolated)
 
 
 def virtual_sites(system: mm.System) -> list:

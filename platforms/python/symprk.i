@@ -102,6 +102,18 @@ public:
     int getExpectedNumParticles() const;
     bool getExpectedConstraints() const;
     long long getProgramSignature() const;
+    void setThermostat(double temperature, double collisionTime, int interval, int dof, bool keepRotation);
+    bool hasThermostat() const;
+    double getThermostatTemperature() const;
+    void setThermostatTemperature(double temperature);
+    double getCollisionTime() const;
+    int getThermostatInterval() const;
+    int getThermostatDof() const;
+    bool getThermostatKeepsRotation() const;
+    int getRandomNumberSeed() const;
+    void setRandomNumberSeed(int seed);
+    double getHeatBathEnergy() const;
+    static std::vector<double> computeRescalingFactor(double kinetic, double target, int dof, double c, double r1, double chi2);
     static void registerMissingKernelFactories();
     void step(int steps);
     %extend {

@@ -103,11 +103,11 @@ def test_custom_program_projects_where_flagged(name, water8):
 def test_xml_carries_the_flags_and_refuses_the_old_format(water8):
     ig = NativeSymplecticIntegrator(0.001, "pefrl", system=water8.system)
     xml = mm.XmlSerializer.serialize(ig)
-    assert 'version="2"' in xml and xml.count("flags=") == ig.getNumSubsteps()
+    assert 'version="3"' in xml and xml.count("flags=") == ig.getNumSubsteps()
     back = deserialize(xml)
     assert _plugin_substeps(back) == _plugin_substeps(ig) and back.resolved.substeps == ig.resolved.substeps
     assert back.resolved.order == 4 and back.resolved.name == "pefrl"
-    old = xml.replace('version="2"', 'version="1"', 1)
+    old = xml.replace('version="3"', 'version="1"', 1)
     with pytest.raises(Exception, match="older openmm_symprk .serialization version 1"):
         mm.XmlSerializer.deserialize(old)
 
@@ -118,10 +118,11 @@ def test_checkpoint_of_the_old_format_is_refused(water8):
     ctx = water8.context(ig)
     ig.step(2)
     chk = ctx.createCheckpoint()
-    magic = struct.pack("<q", 0x53796d50524b0003)
-    assert chk.count(magic) == 1  # format 3
-    with pytest.raises(Exception, match="older openmm_symprk .checkpoint format 2"):
-        ctx.loadCheckpoint(chk.replace(magic, struct.pack("<q", 0x53796d50524b0002)))
+    magic = struct.pack("<q", 0x53796d50524b0004)
+    assert chk.count(magic) == 1  # format 4 (3 and the thermostat's block)
+    for old in (2, 3):
+        with pytest.raises(Exception, match=f"older openmm_symprk .checkpoint format {old}"):
+            ctx.loadCheckpoint(chk.replace(magic, struct.pack("<q", 0x53796d50524b0000 + old)))
     ctx.loadCheckpoint(chk)
 
 

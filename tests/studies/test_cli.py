@@ -80,6 +80,8 @@ def test_methods_and_info(capsys):
     assert rc == 0 and "pefrl" in out and "sequence (applied left to right)" in out
     rc, out, _ = _run(["info"], capsys)
     assert rc == 0 and "platform Reference" in out and "catalogue: 28 methods" in out
+    if "Reference" in plugin.thermostat_platforms():
+        assert "NVT thermostat (temperature=): native" in out
     rc, _, err = _run(["info", "--require-native", "Nosuch"], capsys)
     assert rc == 2 and "does not serve Nosuch" in err
 

@@ -49,6 +49,13 @@ void CommonIntegrateSymPRKStepKernel::initialize(const System& system, const Sym
     rigid.initialize(cc, 9, useDouble ? sizeof(double) : sizeof(float), "symprkRigid");
     vBefore.initialize(cc, cc.getPaddedNumAtoms(), useDouble ? 4*sizeof(double) : 4*sizeof(float), "symprkVelocitiesBefore");
     badStep.initialize<int>(cc, 1, "symprkBadStep");
+    if (integrator.hasThermostat()) {
+        thermostatSumsKernel = program->createKernel("symprkThermostatSums");
+        thermostatApplyKernel = program->createKernel("symprkThermostatApply");
+        // the sums' type: double where the device has it (symprk_acc in the device source)
+        thermostatSums.initialize(cc, SymPRKThermostat::NumSums, cc.getSupportsDoublePrecision() ? sizeof(double) : sizeof(float),
+                                  "symprkThermostatSums");
+    }
     set<int> kickGroups;
     for (int s = 0; s < integrator.getNumSubsteps(); s++)
         if (integrator.getSubstepKind(s) == SymPRKIntegrator::Kick)
@@ -147,6 +154,26 @@ void CommonIntegrateSymPRKStepKernel::execute(ContextImpl& context, const SymPRK
         projectionKernel->addArg(cc.getVelm());
         projectionKernel->addArg(cc.getLongForceBuffer());
         projectionKernel->addArg(projection);
+        if (integrator.hasThermostat()) {
+            const int withPositions = integrator.getThermostatKeepsRotation() ? 1 : 0;
+            thermostatSumsKernel->addArg(cc.getPosq());
+            if (mixed)
+                thermostatSumsKernel->addArg(cc.getPosqCorrection());
+            else
+                thermostatSumsKernel->addArg(nullptr);
+            thermostatSumsKernel->addArg(cc.getVelm());
+            thermostatSumsKernel->addArg(withPositions);
+            thermostatSumsKernel->addArg(thermostatSums);
+            thermostatApplyKernel->addArg(cc.getPosq());
+            if (mixed)
+                thermostatApplyKernel->addArg(cc.getPosqCorrection());
+            else
+                thermostatApplyKernel->addArg(nullptr);
+            thermostatApplyKernel->addArg(cc.getVelm());
+            thermostatApplyKernel->addArg(withPositions);
+            for (int i = 0; i < 10; i++)
+                thermostatApplyKernel->addArg();  // alpha, V, R, w: set per event
+        }
     }
     const double dt = integrator.getStepSize();
     const double tol = integrator.getConstraintTolerance();
@@ -167,6 +194,10 @@ void CommonIntegrateSymPRKStepKernel::execute(ContextImpl& context, const SymPRK
     if (!forcesAreValid)
         for (auto& entry : groupForcesValid)
             entry.second = false;  // cached forces of a multiple-time-step method belong to old positions
+    // Thermostat: a half event before the first step of every interval (after the Context's state updates, a
+    // barostat's move included), and one after its last step (below).
+    if (thermostatBefore(integrator, stepIndex))
+        thermostatEvent(integrator);
     for (int s = 0; s < numSubsteps; s++) {
         const double cdt = integrator.getSubstepCoefficient(s)*dt;
         const int checkStep = (s == lastVelocityStep && blowUpStep == 0 ? check : 0);
@@ -238,6 +269,8 @@ void CommonIntegrateSymPRKStepKernel::execute(ContextImpl& context, const SymPRK
     }
     if (hasConstraints)
         projectVelocities(tol, exact);
+    if (thermostatAfter(integrator, stepIndex))
+        thermostatEvent(integrator);
     cc.setTime(cc.getTime()+dt);
     cc.setStepCount(cc.getStepCount()+1);
     cc.reorderAtoms();
@@ -258,6 +291,29 @@ void CommonIntegrateSymPRKStepKernel::projectVelocities(double tol, bool exact) 
     setMixedArg(rigidSumsKernel, 1, 1.0);
     rigidSumsKernel->execute(projectionBlockSize, projectionBlockSize);
     rigidApplyKernel->execute(cc.getNumAtoms());
+}
+
+void CommonIntegrateSymPRKStepKernel::thermostatEvent(const SymPRKIntegrator& integrator) {
+    // One reduction on the device, one download of its sums, the factor and the kept field on the host
+    // (SymPRKThermostat), one kernel applying them.
+    thermostatSumsKernel->execute(projectionBlockSize, projectionBlockSize);
+    vector<double> sums(SymPRKThermostat::NumSums);
+    if (thermostatSums.getElementSize() == sizeof(double))
+        thermostatSums.download(sums);
+    else {
+        vector<float> single(SymPRKThermostat::NumSums);
+        thermostatSums.download(single);
+        for (int i = 0; i < SymPRKThermostat::NumSums; i++)
+            sums[i] = single[i];
+    }
+    const SymPRKThermostat::Event e = thermostat.event(sums.data(), integrator, thermostatDecay(integrator));
+    if (!e.apply)
+        return;
+    const double values[10] = {e.alpha, e.velocity[0], e.velocity[1], e.velocity[2], e.centre[0], e.centre[1], e.centre[2],
+                               e.omega[0], e.omega[1], e.omega[2]};
+    for (int i = 0; i < 10; i++)
+        setMixedArg(thermostatApplyKernel, 4+i, values[i]);
+    thermostatApplyKernel->execute(cc.getNumAtoms());
 }
 
 double CommonIntegrateSymPRKStepKernel::computeKineticEnergy(ContextImpl& context, const SymPRKIntegrator& integrator) {

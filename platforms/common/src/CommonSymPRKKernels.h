@@ -36,13 +36,15 @@ public:
 private:
     void setMixedArg(ComputeKernel& kernel, int index, double value);
     void projectVelocities(double tol, bool exact);
+    void thermostatEvent(const SymPRKIntegrator& integrator);
     ComputeContext& cc;
     bool hasInitializedKernels, hasConstraints, multipleGroups;
     std::map<int, std::unique_ptr<ComputeArray> > groupForces;  // multiple time stepping: forces per group mask
     std::map<int, bool> groupForcesValid;
     int projectionBlockSize;
     long long blowUpStep;
-    ComputeArray projection, badStep, rigid, vBefore;
+    ComputeArray projection, badStep, rigid, vBefore, thermostatSums;
+    ComputeKernel thermostatSumsKernel, thermostatApplyKernel;
     ComputeKernel kickKernel, kickProjectedKernel, driftKernel, driftDeltaKernel, driftApplyKernel, projectionKernel, rigidSumsKernel, rigidApplyKernel;
 };
 

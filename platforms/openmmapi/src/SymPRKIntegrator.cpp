@@ -13,18 +13,22 @@
 #include <ostream>
 #include <set>
 #include <sstream>
+#include <string>
 
 using namespace OpenMM;
 using namespace std;
 
-// Checkpoint format: "SymPRK" + version.  Version 3 (sub-steps with flags in the program signature) refuses the
-// older versions 1 and 2, whose signatures were computed without the flags.
+// Checkpoint format: "SymPRK" + version.  Version 4 (the thermostat's heat-bath energy and random state after the
+// method name) refuses the older versions 1-3 (3: sub-steps with flags, no thermostat block; 1-2: signatures
+// computed without the flags).
 static const int64_t CHECKPOINT_MAGIC_BASE = 0x53796d50524b0000LL;
-static const int64_t CHECKPOINT_MAGIC = CHECKPOINT_MAGIC_BASE + 3;
+static const int64_t CHECKPOINT_MAGIC = CHECKPOINT_MAGIC_BASE + 4;
 
 SymPRKIntegrator::SymPRKIntegrator(double stepSize) : exactMomentum(false), forcesAreValid(false),
         methodName("verlet"), stepsTaken(0), blowUpStep(0), maxSpeed(0.0), expectedParticles(-1),
-        expectedConstraints(false) {
+        expectedConstraints(false),
+        thermostat(false), keepRotation(false), thermostatTemperature(0.0), collisionTime(0.0), thermostatInterval(1),
+        thermostatDof(0), randomSeed(0) {
     setStepSize(stepSize);
     setConstraintTolerance(1e-5);
     setSubsteps({Kick, Drift, Kick}, {0.5, 1.0, 0.5}, {-1, -1, -1}, {ForcesCached, 0, 0});
@@ -33,7 +37,9 @@ SymPRKIntegrator::SymPRKIntegrator(double stepSize) : exactMomentum(false), forc
 SymPRKIntegrator::SymPRKIntegrator(double stepSize, const vector<int>& kinds, const vector<double>& coefficients,
         const vector<int>& groups, const vector<int>& flags) :
         exactMomentum(false), forcesAreValid(false), methodName(""), stepsTaken(0), blowUpStep(0), maxSpeed(0.0),
-        expectedParticles(-1), expectedConstraints(false) {
+        expectedParticles(-1), expectedConstraints(false),
+        thermostat(false), keepRotation(false), thermostatTemperature(0.0), collisionTime(0.0), thermostatInterval(1),
+        thermostatDof(0), randomSeed(0) {
     setStepSize(stepSize);
     setConstraintTolerance(1e-5);
     setSubsteps(kinds, coefficients, groups, flags);
@@ -141,6 +147,57 @@ void SymPRKIntegrator::setExpectedSystem(int numParticles, bool constraints) {
     expectedConstraints = constraints;
 }
 
+void SymPRKIntegrator::setThermostat(double temperature, double tau, int interval, int dof, bool keep) {
+    if (owner != NULL)
+        throw OpenMMException("SymPRKIntegrator: the thermostat cannot be changed once the integrator is bound to a Context");
+    stringstream msg;
+    msg << "SymPRKIntegrator: ";
+    if (!(temperature > 0) || !std::isfinite(temperature))
+        msg << "the thermostat temperature is " << temperature << " K; expected a finite temperature > 0 K";
+    else if (!(tau > 0) || !std::isfinite(tau))
+        msg << "the collision time is " << tau << " ps; expected a finite time > 0 ps";
+    else if (interval < 1)
+        msg << "the thermostat interval is " << interval << " steps; expected a whole number >= 1";
+    else if (dof < 1)
+        msg << "the thermostat has " << dof << " degrees of freedom; a System without degrees of freedom to "
+               "thermostat cannot be thermostatted (expected >= 1)";
+    else {
+        thermostat = true;
+        thermostatTemperature = temperature;
+        collisionTime = tau;
+        thermostatInterval = interval;
+        thermostatDof = dof;
+        keepRotation = keep;
+        return;
+    }
+    throw OpenMMException(msg.str());
+}
+
+void SymPRKIntegrator::setThermostatTemperature(double temperature) {
+    if (!thermostat)
+        throw OpenMMException("SymPRKIntegrator: there is no thermostat whose temperature could be set (setThermostat adds one)");
+    if (!(temperature > 0) || !std::isfinite(temperature)) {
+        stringstream msg;
+        msg << "SymPRKIntegrator: the thermostat temperature is " << temperature << " K; expected a finite temperature > 0 K";
+        throw OpenMMException(msg.str());
+    }
+    thermostatTemperature = temperature;
+}
+
+double SymPRKIntegrator::getHeatBathEnergy() const {
+    if (!thermostat || context == NULL)
+        return 0.0;
+    return const_cast<Kernel&>(kernel).getAs<IntegrateSymPRKStepKernel>().getThermostat().getHeatBathEnergy();
+}
+
+vector<double> SymPRKIntegrator::computeRescalingFactor(double kinetic, double target, int dof, double c, double r1, double chi2) {
+    if (dof < 1)
+        throw OpenMMException("SymPRKIntegrator::computeRescalingFactor: dof must be >= 1");
+    double newKinetic;
+    double alpha = SymPRKThermostat::rescalingFactor(kinetic, target, dof, c, r1, chi2, newKinetic);
+    return {alpha, newKinetic};
+}
+
 long long SymPRKIntegrator::getProgramSignature() const {
     // FNV-1a over the sub-step kinds, coefficients' bits, force groups and flags, and the exact-momentum option.
     uint64_t hash = 1469598103934665603ULL;
@@ -160,6 +217,15 @@ long long SymPRKIntegrator::getProgramSignature() const {
     }
     int32_t exact = exactMomentum ? 1 : 0;
     mix(&exact, sizeof(exact));
+    if (thermostat) {
+        // the thermostat's settings but its temperature (nothing without one: the NVE signature is unchanged)
+        int32_t tag = 0x54686572, interval = thermostatInterval, dof = thermostatDof, keep = keepRotation ? 1 : 0;
+        mix(&tag, sizeof(tag));
+        mix(&collisionTime, sizeof(double));
+        mix(&interval, sizeof(interval));
+        mix(&dof, sizeof(dof));
+        mix(&keep, sizeof(keep));
+    }
     return (long long) (hash & 0x7fffffffffffffffULL);
 }
 
@@ -220,6 +286,7 @@ void SymPRKIntegrator::initialize(ContextImpl& contextRef) {
     kernel = context->getPlatform().createKernel(IntegrateSymPRKStepKernel::Name(), contextRef);
     kernel.getAs<IntegrateSymPRKStepKernel>().initialize(contextRef.getSystem(), *this);
     kernel.getAs<IntegrateSymPRKStepKernel>().setBlowUpStep(contextRef, blowUpStep);
+    kernel.getAs<IntegrateSymPRKStepKernel>().getThermostat().initialize(randomSeed);
     forcesAreValid = false;
 }
 
@@ -259,6 +326,18 @@ void SymPRKIntegrator::createCheckpoint(ostream& stream) const {
                          (int64_t) getProgramSignature(), (int64_t) methodName.size()};
     stream.write((const char*) values, sizeof(values));
     stream.write(methodName.data(), methodName.size());
+    // the thermostat: a flag, then the heat-bath energy and the generator's state (length and text)
+    int64_t hasBath = thermostat ? 1 : 0;
+    stream.write((const char*) &hasBath, sizeof(hasBath));
+    if (thermostat) {
+        SymPRKThermostat& bath = const_cast<Kernel&>(kernel).getAs<IntegrateSymPRKStepKernel>().getThermostat();
+        double energy = bath.getHeatBathEnergy();
+        string state = bath.getRandomState();
+        int64_t size = state.size();
+        stream.write((const char*) &energy, sizeof(energy));
+        stream.write((const char*) &size, sizeof(size));
+        stream.write(state.data(), state.size());
+    }
 }
 
 void SymPRKIntegrator::loadCheckpoint(istream& stream) {
@@ -268,8 +347,9 @@ void SymPRKIntegrator::loadCheckpoint(istream& stream) {
         stringstream msg;
         msg << "SymPRKIntegrator: the checkpoint was written by an older openmm_symprk (checkpoint format "
             << (values[0]-CHECKPOINT_MAGIC_BASE) << "; this one reads format " << (CHECKPOINT_MAGIC-CHECKPOINT_MAGIC_BASE)
-            << ", whose program signature covers the sub-step flags): it cannot be loaded. Load the positions and "
-               "velocities of the saved run (a State or a PDB/XML file) instead";
+            << ", which carries the thermostat's heat-bath energy and random state" << (values[0]-CHECKPOINT_MAGIC_BASE < 3 ?
+               " and whose program signature covers the sub-step flags" : "") << "): it cannot be loaded. Load the "
+               "positions and velocities of the saved run (a State or a PDB/XML file) instead";
         throw OpenMMException(msg.str());
     }
     if (!stream || values[0] != CHECKPOINT_MAGIC)
@@ -286,7 +366,30 @@ void SymPRKIntegrator::loadCheckpoint(istream& stream) {
     if (more[0] != getProgramSignature())
         throw OpenMMException("SymPRKIntegrator: the checkpoint was written by a SymPRKIntegrator running another program "
                 "(method '"+name+"'; this one runs '"+methodName+"' with exact momentum "+(exactMomentum ? "on" : "off")+
-                "): create the integrator with the same method and options as when the checkpoint was saved");
+                (thermostat ? ", with a thermostat" : ", without a thermostat")+"): create the integrator with the same "
+                "method and options as when the checkpoint was saved");
+    int64_t hasBath = 0;
+    stream.read((char*) &hasBath, sizeof(hasBath));
+    double energy = 0.0;
+    string state;
+    if (stream && hasBath == 1) {
+        int64_t size = 0;
+        stream.read((char*) &energy, sizeof(energy));
+        stream.read((char*) &size, sizeof(size));
+        if (stream && size > 0 && size < (1 << 20)) {
+            state.resize(size);
+            stream.read(&state[0], size);
+        }
+        else
+            stream.setstate(ios::failbit);
+    }
+    if (!stream || hasBath != (thermostat ? 1 : 0))
+        throw OpenMMException("SymPRKIntegrator: the checkpoint is truncated or damaged (its thermostat block)");
+    if (thermostat && context != NULL) {
+        SymPRKThermostat& bath = kernel.getAs<IntegrateSymPRKStepKernel>().getThermostat();
+        bath.setRandomState(state);
+        bath.setHeatBathEnergy(energy);
+    }
     stepsTaken = values[1];
     blowUpStep = values[2];
     if (context != NULL)

@@ -133,18 +133,84 @@ Vec3 ReferenceIntegrateSymPRKStepKernel::solveInertia(Vec3 d, Vec3 o, Vec3 tau) 
     // d = (sum m x^2, sum m y^2, sum m z^2), o = (sum m xy, sum m xz, sum m yz) about the centre of mass.
     // The inertia tensor is regularised by 1e-12 of its trace (a linear molecule or a single particle then
     // gives a finite result; the shift changes a round-off-sized torque by 1e-12 of itself).
-    double Ixx = d[1]+d[2], Iyy = d[0]+d[2], Izz = d[0]+d[1];
-    double Ixy = -o[0], Ixz = -o[1], Iyz = -o[2];
-    double shift = 1e-12*(Ixx+Iyy+Izz);
-    Ixx += shift;
-    Iyy += shift;
-    Izz += shift;
-    double axx = Iyy*Izz-Iyz*Iyz, ayy = Ixx*Izz-Ixz*Ixz, azz = Ixx*Iyy-Ixy*Ixy;
-    double axy = Ixz*Iyz-Izz*Ixy, axz = Ixy*Iyz-Iyy*Ixz, ayz = Ixy*Ixz-Ixx*Iyz;
-    double det = Ixx*axx+Ixy*axy+Ixz*axz;
-    if (det == 0.0 || !std::isfinite(det))
-        return Vec3();
-    return Vec3(axx*tau[0]+axy*tau[1]+axz*tau[2], axy*tau[0]+ayy*tau[1]+ayz*tau[2], axz*tau[0]+ayz*tau[1]+azz*tau[2])/det;
+    return SymPRKThermostat::solveInertia(d, o, tau);
+}
+
+void ReferenceIntegrateSymPRKStepKernel::thermostatEvent(const SymPRKIntegrator& integrator) {
+    // The sums in double, serially in particle order (deterministic, whatever the thread count); the host
+    // computes the kept field and the factor (SymPRKThermostat), then every particle with mass is rescaled.
+    const vector<Vec3>& pos = *data.positions;
+    vector<Vec3>& vel = *data.velocities;
+    const bool rotation = integrator.getThermostatKeepsRotation();
+    double sums[SymPRKThermostat::NumSums] = {0};
+    double M = 0, px = 0, py = 0, pz = 0, twiceK = 0;
+    for (int i = 0; i < numParticles; i++) {
+        const double m = masses[i];
+        if (m == 0.0)
+            continue;
+        const Vec3& v = vel[i];
+        M += m;
+        px += m*v[0];
+        py += m*v[1];
+        pz += m*v[2];
+        twiceK += m*(v[0]*v[0]+v[1]*v[1]+v[2]*v[2]);
+    }
+    sums[SymPRKThermostat::SumMass] = M;
+    sums[SymPRKThermostat::SumMomentum] = px;
+    sums[SymPRKThermostat::SumMomentum+1] = py;
+    sums[SymPRKThermostat::SumMomentum+2] = pz;
+    sums[SymPRKThermostat::SumTwiceKinetic] = twiceK;
+    if (rotation) {
+        // the positions' moments and the angular momentum about the origin
+        double mx = 0, my = 0, mz = 0, xx = 0, xy = 0, xz = 0, yy = 0, yz = 0, zz = 0, lx = 0, ly = 0, lz = 0;
+        for (int i = 0; i < numParticles; i++) {
+            const double m = masses[i];
+            if (m == 0.0)
+                continue;
+            const Vec3& x = pos[i];
+            const Vec3& v = vel[i];
+            mx += m*x[0];
+            my += m*x[1];
+            mz += m*x[2];
+            xx += m*x[0]*x[0];
+            xy += m*x[0]*x[1];
+            xz += m*x[0]*x[2];
+            yy += m*x[1]*x[1];
+            yz += m*x[1]*x[2];
+            zz += m*x[2]*x[2];
+            lx += m*(x[1]*v[2]-x[2]*v[1]);
+            ly += m*(x[2]*v[0]-x[0]*v[2]);
+            lz += m*(x[0]*v[1]-x[1]*v[0]);
+        }
+        const double moments[12] = {mx, my, mz, xx, xy, xz, yy, yz, zz, lx, ly, lz};
+        for (int j = 0; j < 3; j++) {
+            sums[SymPRKThermostat::SumMomentX+j] = moments[j];
+            sums[SymPRKThermostat::SumAngular+j] = moments[9+j];
+        }
+        for (int j = 0; j < 6; j++)
+            sums[SymPRKThermostat::SumSecond+j] = moments[3+j];
+    }
+    const SymPRKThermostat::Event e = thermostat.event(sums, integrator, thermostatDecay(integrator));
+    if (!e.apply)
+        return;
+    const double alpha = e.alpha;
+    const Vec3 V = e.velocity, R = e.centre, w = e.omega;
+    parallelFor([&] (int t, int start, int end) {
+        if (rotation) {
+            for (int i = start; i < end; i++)
+                if (masses[i] != 0.0) {
+                    const Vec3 u = V + w.cross(pos[i]-R);
+                    for (int j = 0; j < 3; j++)
+                        vel[i][j] = u[j] + alpha*(vel[i][j]-u[j]);
+                }
+        }
+        else {
+            for (int i = start; i < end; i++)
+                if (masses[i] != 0.0)
+                    for (int j = 0; j < 3; j++)
+                        vel[i][j] = V[j] + alpha*(vel[i][j]-V[j]);
+        }
+    });
 }
 
 void ReferenceIntegrateSymPRKStepKernel::removeRigidChange(const vector<Vec3>& pos, vector<Vec3>& vel, Vec3 dP, Vec3 dL) {
@@ -235,6 +301,10 @@ void ReferenceIntegrateSymPRKStepKernel::execute(ContextImpl& context, const Sym
         forcesAreValid = false;
     if (!forcesAreValid)
         groupForces.clear();  // the cached forces of a multiple-time-step method belong to old positions
+    // Thermostat: a half event before the first step of every interval (after the Context's state updates, a
+    // barostat's move included), and one after its last step (below).
+    if (thermostatBefore(integrator, stepIndex))
+        thermostatEvent(integrator);
 
     // One pass over the atoms per kick and per drift; a kick directly followed by a drift (every kick but a
     // step's last) shares its pass with it.  The per-atom arithmetic is the same either way.
@@ -362,6 +432,8 @@ void ReferenceIntegrateSymPRKStepKernel::execute(ContextImpl& context, const Sym
     }
     if (hasConstraints)
         projectVelocities(pos, vel, tol, exact);
+    if (thermostatAfter(integrator, stepIndex))
+        thermostatEvent(integrator);
 
     // Record the first step that leaves a velocity NaN, infinite or beyond the blow-up speed (NaN fails every <=).
     if (blowUpStep == 0) {

@@ -38,6 +38,7 @@ private:
     void removeRigidChange(const std::vector<Vec3>& pos, std::vector<Vec3>& vel, Vec3 dP, Vec3 dL);
     void projectVelocities(std::vector<Vec3>& pos, std::vector<Vec3>& vel, double tol, bool exact);
     static Vec3 solveInertia(Vec3 diag, Vec3 offdiag, Vec3 rhs);
+    void thermostatEvent(const SymPRKIntegrator& integrator);
     ReferencePlatform::PlatformData& data;
     const System* system;
     std::vector<double> masses, inverseMasses;

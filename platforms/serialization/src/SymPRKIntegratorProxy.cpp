@@ -16,7 +16,7 @@ SymPRKIntegratorProxy::SymPRKIntegratorProxy() : SerializationProxy("SymPRKInteg
 
 void SymPRKIntegratorProxy::serialize(const void* object, SerializationNode& node) const {
     const SymPRKIntegrator& integrator = *reinterpret_cast<const SymPRKIntegrator*>(object);
-    node.setIntProperty("version", 2);  // 2: every sub-step carries its flags
+    node.setIntProperty("version", 3);  // 2: every sub-step carries its flags; 3: the thermostat (and the seed)
     node.setDoubleProperty("stepSize", integrator.getStepSize());
     node.setDoubleProperty("constraintTolerance", integrator.getConstraintTolerance());
     node.setIntProperty("integrationForceGroups", integrator.getIntegrationForceGroups());
@@ -25,6 +25,15 @@ void SymPRKIntegratorProxy::serialize(const void* object, SerializationNode& nod
     node.setDoubleProperty("maxSpeed", integrator.getMaxSpeed());
     node.setIntProperty("expectedParticles", integrator.getExpectedNumParticles());
     node.setBoolProperty("expectedConstraints", integrator.getExpectedConstraints());
+    node.setIntProperty("randomSeed", integrator.getRandomNumberSeed());
+    if (integrator.hasThermostat()) {
+        SerializationNode& bath = node.createChildNode("Thermostat");
+        bath.setDoubleProperty("temperature", integrator.getThermostatTemperature());
+        bath.setDoubleProperty("collisionTime", integrator.getCollisionTime());
+        bath.setIntProperty("interval", integrator.getThermostatInterval());
+        bath.setIntProperty("dof", integrator.getThermostatDof());
+        bath.setBoolProperty("keepRotation", integrator.getThermostatKeepsRotation());
+    }
     SerializationNode& substeps = node.createChildNode("Substeps");
     for (int i = 0; i < integrator.getNumSubsteps(); i++) {
         SerializationNode& s = substeps.createChildNode("Substep");
@@ -42,8 +51,8 @@ void* SymPRKIntegratorProxy::deserialize(const SerializationNode& node) const {
         throw OpenMMException("SymPRKIntegrator: this XML was written by an older openmm_symprk (serialization version 1, "
                 "sub-steps without their projection and cached-force flags) and cannot be read: create the integrator "
                 "again (openmm_symprk.SymplecticIntegrator with the same method and options) and serialize it anew");
-    if (version != 2)
-        throw OpenMMException("SymPRKIntegrator: unsupported serialization version "+to_string(version)+" (this build reads 2)");
+    if (version != 2 && version != 3)
+        throw OpenMMException("SymPRKIntegrator: unsupported serialization version "+to_string(version)+" (this build reads 2 and 3)");
     vector<int> kinds, groups, flags;
     vector<double> coefficients;
     for (const SerializationNode& s : node.getChildNode("Substeps").getChildren()) {
@@ -65,6 +74,13 @@ void* SymPRKIntegratorProxy::deserialize(const SerializationNode& node) const {
     integrator->setMethodName(node.getStringProperty("method", ""));
     integrator->setMaxSpeed(node.getDoubleProperty("maxSpeed", 0.0));
     integrator->setExpectedSystem(node.getIntProperty("expectedParticles", -1), node.getBoolProperty("expectedConstraints", false));
+    // version 3: the random seed, and the thermostat when there is one (version 2 has neither)
+    integrator->setRandomNumberSeed(node.getIntProperty("randomSeed", 0));
+    for (const SerializationNode& child : node.getChildren())
+        if (child.getName() == "Thermostat")
+            integrator->setThermostat(child.getDoubleProperty("temperature"), child.getDoubleProperty("collisionTime"),
+                                      child.getIntProperty("interval"), child.getIntProperty("dof"),
+                                      child.getBoolProperty("keepRotation"));
     return integrator;
 }
 

@@ -36,6 +36,8 @@ int main() {
         original.setMethodName("omelyan-2 with a twist");
         original.setMaxSpeed(250.0);
         original.setExpectedSystem(42, true);
+        original.setThermostat(310.5, 0.25, 3, 120, true);
+        original.setRandomNumberSeed(1234);
 
         stringstream buffer;
         XmlSerializer::serialize<Integrator>(&original, "Integrator", buffer);
@@ -64,6 +66,50 @@ int main() {
         }
         CHECK_EQUAL(5, restored->getNumSubsteps());
         CHECK_EQUAL(2, restored->getSubstepForceGroups(2));
+        CHECK_EQUAL(true, restored->hasThermostat());
+        CHECK_EQUAL(original.getThermostatTemperature(), restored->getThermostatTemperature());
+        CHECK_EQUAL(original.getCollisionTime(), restored->getCollisionTime());
+        CHECK_EQUAL(3, restored->getThermostatInterval());
+        CHECK_EQUAL(120, restored->getThermostatDof());
+        CHECK_EQUAL(true, restored->getThermostatKeepsRotation());
+        CHECK_EQUAL(1234, restored->getRandomNumberSeed());
+
+        // The program signature covers the thermostat's settings but not its temperature; without a thermostat
+        // it is what it was before the thermostat existed.
+        SymPRKIntegrator plain(0.0015, kinds, coefficients, groups, flags), warmer(0.0015, kinds, coefficients, groups, flags);
+        plain.setExactMomentum(true);
+        warmer.setExactMomentum(true);
+        warmer.setThermostat(400.0, 0.25, 3, 120, true);
+        if (plain.getProgramSignature() == original.getProgramSignature()) {
+            cerr << "the program signature ignores the thermostat" << endl;
+            failures++;
+        }
+        CHECK_EQUAL(original.getProgramSignature(), warmer.getProgramSignature());
+        warmer.setThermostatTemperature(250.0);
+        CHECK_EQUAL(250.0, warmer.getThermostatTemperature());
+
+        // XML of serialization version 2 (before the thermostat: no seed, no Thermostat node) still loads.
+        stringstream plainXml;
+        XmlSerializer::serialize<Integrator>(&plain, "Integrator", plainXml);
+        string text = plainXml.str();
+        size_t at = text.find("version=\"3\"");
+        size_t seed = text.find(" randomSeed=\"0\"");
+        if (at == string::npos || seed == string::npos || text.find("Thermostat") != string::npos) {
+            cerr << "unexpected XML of an integrator without a thermostat:\n" << text << endl;
+            return 1;
+        }
+        text.erase(seed, string(" randomSeed=\"0\"").size());
+        text.replace(text.find("version=\"3\""), 11, "version=\"2\"");
+        stringstream version2(text);
+        unique_ptr<Integrator> old(XmlSerializer::deserialize<Integrator>(version2));
+        SymPRKIntegrator* oldRestored = dynamic_cast<SymPRKIntegrator*>(old.get());
+        if (oldRestored == NULL) {
+            cerr << "version-2 XML did not come back as a SymPRKIntegrator" << endl;
+            return 1;
+        }
+        CHECK_EQUAL(false, oldRestored->hasThermostat());
+        CHECK_EQUAL(0, oldRestored->getRandomNumberSeed());
+        CHECK_EQUAL(plain.getProgramSignature(), oldRestored->getProgramSignature());
     }
     catch (const exception& e) {
         cerr << "exception: " << e.what() << endl;

@@ -387,3 +387,90 @@ KERNEL void symprkRigidApply(GLOBAL const real4* RESTRICT posq, GLOBAL const rea
         }
     }
 }
+
+/*
+ * Thermostat (stochastic velocity rescaling), part 1: the sums over particles with mass that the host turns into
+ * the kept velocity field and the rescaling factor (SymPRKThermostat::SumIndex): [0] M, [1..3] sum m x,
+ * [4..6] P, [7] sum m v.v, [8..13] sum m x x^T about the origin (xx, xy, xz, yy, yz, zz), [14..16] L about the
+ * origin; positions only when withPositions (the rotation is kept).  Accumulated in double where the device has
+ * it (else in the mixed type), one block of WORK_GROUP_SIZE threads, partial sums added in a fixed order: one
+ * buffer, downloaded once per event.
+ */
+#ifdef SUPPORTS_DOUBLE_PRECISION
+typedef double symprk_acc;
+#else
+typedef mixed symprk_acc;
+#endif
+#define SYMPRK_THERMOSTAT_SUMS 17
+
+KERNEL void symprkThermostatSums(GLOBAL const real4* RESTRICT posq, GLOBAL const real4* RESTRICT posqCorrection,
+        GLOBAL const mixed4* RESTRICT velm, int withPositions, GLOBAL symprk_acc* RESTRICT sums) {
+    LOCAL symprk_acc partial[SYMPRK_THERMOSTAT_SUMS*WORK_GROUP_SIZE];
+    const int tid = LOCAL_ID;
+    symprk_acc s[SYMPRK_THERMOSTAT_SUMS];
+    for (int k = 0; k < SYMPRK_THERMOSTAT_SUMS; k++)
+        s[k] = 0;
+    for (int index = tid; index < NUM_ATOMS; index += WORK_GROUP_SIZE) {
+        mixed4 v = velm[index];
+        if (v.w != 0) {
+            const symprk_acc m = 1/(symprk_acc) v.w;
+            const symprk_acc vx = v.x, vy = v.y, vz = v.z;
+            s[0] += m;
+            s[4] += m*vx;
+            s[5] += m*vy;
+            s[6] += m*vz;
+            s[7] += m*(vx*vx+vy*vy+vz*vz);
+            if (withPositions) {
+                mixed4 p = symprkLoadPos(posq, posqCorrection, index);
+                const symprk_acc x = p.x, y = p.y, z = p.z;
+                s[1] += m*x;
+                s[2] += m*y;
+                s[3] += m*z;
+                s[8] += m*x*x;
+                s[9] += m*x*y;
+                s[10] += m*x*z;
+                s[11] += m*y*y;
+                s[12] += m*y*z;
+                s[13] += m*z*z;
+                s[14] += m*(y*vz-z*vy);
+                s[15] += m*(z*vx-x*vz);
+                s[16] += m*(x*vy-y*vx);
+            }
+        }
+    }
+    for (int k = 0; k < SYMPRK_THERMOSTAT_SUMS; k++)
+        partial[k*WORK_GROUP_SIZE+tid] = s[k];
+    SYNC_THREADS;
+    if (tid < SYMPRK_THERMOSTAT_SUMS) {
+        symprk_acc sum = 0;
+        for (int i = 0; i < WORK_GROUP_SIZE; i++)
+            sum += partial[tid*WORK_GROUP_SIZE+i];
+        sums[tid] = sum;
+    }
+}
+
+/**
+ * Thermostat, part 2: v <- u + alpha (v - u) for particles with mass, with the kept field
+ * u = V + w x (x - R) (w = 0 unless the rotation is kept: then withPositions).
+ */
+KERNEL void symprkThermostatApply(GLOBAL const real4* RESTRICT posq, GLOBAL const real4* RESTRICT posqCorrection,
+        GLOBAL mixed4* RESTRICT velm, int withPositions, mixed alpha, mixed Vx, mixed Vy, mixed Vz, mixed Rx, mixed Ry,
+        mixed Rz, mixed wx, mixed wy, mixed wz) {
+    for (int index = GLOBAL_ID; index < NUM_ATOMS; index += GLOBAL_SIZE) {
+        mixed4 v = velm[index];
+        if (v.w != 0) {
+            mixed ux = Vx, uy = Vy, uz = Vz;
+            if (withPositions) {
+                mixed4 p = symprkLoadPos(posq, posqCorrection, index);
+                mixed rx = p.x-Rx, ry = p.y-Ry, rz = p.z-Rz;
+                ux += wy*rz-wz*ry;
+                uy += wz*rx-wx*rz;
+                uz += wx*ry-wy*rx;
+            }
+            v.x = ux+alpha*(v.x-ux);
+            v.y = uy+alpha*(v.y-uy);
+            v.z = uz+alpha*(v.z-uz);
+            velm[index] = v;
+        }
+    }
+}

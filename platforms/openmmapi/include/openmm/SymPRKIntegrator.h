@@ -20,6 +20,13 @@
  *
  * This is the same program openmm_symprk/integrators/program.py compiles into a CustomIntegrator,
  * without the per-degree-of-freedom interpreter.
+ *
+ * An optional thermostat (setThermostat) samples the canonical ensemble by stochastic velocity rescaling of
+ * the peculiar velocities (Bussi, Donadio and Parrinello 2007): a half event before the first of every
+ * `interval` steps and one after the last, each with c = exp(-interval*dt/(2 tau)).  The centre-of-mass
+ * velocity is kept (and the rigid rotation about the centre of mass when keepRotation), so total momentum
+ * (and angular momentum) is unchanged; one scalar factor leaves the velocity constraints satisfied.  Without
+ * a thermostat a step is exactly the NVE one.
  */
 
 #include "openmm/Integrator.h"
@@ -123,7 +130,61 @@ public:
         return expectedConstraints;
     }
     /**
-     * A hash of the sub-step program and the exact-momentum option.  Checkpoints carry it, and
+     * Add the stochastic velocity-rescaling thermostat: target temperature (K, > 0), collision time tau (ps,
+     * > 0), an event every `interval` steps (>= 1; half events around each block of interval steps), the
+     * degrees of freedom it samples (>= 1: 3 per particle with mass, less constraints, less 3 for the kept
+     * centre-of-mass velocity, less 3 more when the rotation is kept) and whether the rigid rotation about the
+     * centre of mass is kept (only right for an isolated System).  Cannot be called once the integrator is
+     * bound to a Context.
+     */
+    void setThermostat(double temperature, double collisionTime, int interval, int dof, bool keepRotation);
+    bool hasThermostat() const {
+        return thermostat;
+    }
+    /** The target temperature (K); 0 without a thermostat. */
+    double getThermostatTemperature() const {
+        return thermostatTemperature;
+    }
+    /** Change the target temperature (K, > 0) of the thermostat, also while bound to a Context (the next event uses it). */
+    void setThermostatTemperature(double temperature);
+    /** The collision time tau (ps); 0 without a thermostat. */
+    double getCollisionTime() const {
+        return collisionTime;
+    }
+    int getThermostatInterval() const {
+        return thermostatInterval;
+    }
+    int getThermostatDof() const {
+        return thermostatDof;
+    }
+    bool getThermostatKeepsRotation() const {
+        return keepRotation;
+    }
+    /**
+     * The seed of the thermostat's random numbers (std::mt19937_64 on the host), used when a Context is created:
+     * 0 (the default) takes a new seed from std::random_device each time, as OpenMM's integrators do.
+     */
+    int getRandomNumberSeed() const {
+        return randomSeed;
+    }
+    void setRandomNumberSeed(int seed) {
+        randomSeed = seed;
+    }
+    /**
+     * The heat-bath energy (kJ/mol): minus the kinetic energy the thermostat has added since the integrator was
+     * bound (kept in checkpoints), so that total energy plus heat-bath energy is the conserved effective
+     * energy.  0 when not bound or without a thermostat.
+     */
+    double getHeatBathEnergy() const;
+    /**
+     * (alpha, K'): the rescaling factor and the new peculiar kinetic energy for a peculiar kinetic energy
+     * `kinetic` (kJ/mol), a target dof*kT/2, c = exp(-t/tau), a standard normal r1 and a chi-squared variable
+     * chi2 of dof-1 degrees of freedom: the expression every kernel uses (for tests against other backends).
+     */
+    static std::vector<double> computeRescalingFactor(double kinetic, double target, int dof, double c, double r1, double chi2);
+    /**
+     * A hash of the sub-step program, the exact-momentum option and the thermostat's settings (not its
+     * temperature, which may change during a run; nothing of it without a thermostat).  Checkpoints carry it, and
      * loadCheckpoint() refuses a checkpoint written by a SymPRKIntegrator running another program.
      */
     long long getProgramSignature() const;
@@ -157,6 +218,9 @@ private:
     double maxSpeed;
     int expectedParticles;
     bool expectedConstraints;
+    bool thermostat, keepRotation;
+    double thermostatTemperature, collisionTime;
+    int thermostatInterval, thermostatDof, randomSeed;
     Kernel kernel;
 };
 

@@ -5,6 +5,8 @@
 #include "openmm/Platform.h"
 #include "openmm/System.h"
 #include "openmm/SymPRKIntegrator.h"
+#include "openmm/internal/SymPRKThermostat.h"
+#include <cmath>
 #include <string>
 
 namespace OpenMM {
@@ -40,6 +42,26 @@ public:
     virtual long long getBlowUpStep(ContextImpl& context) = 0;
     /** Restore the value returned by getBlowUpStep() (checkpoints). */
     virtual void setBlowUpStep(ContextImpl& context, long long step) = 0;
+    /**
+     * The host side of the thermostat (random state, heat-bath energy), per Context.  execute() runs an event
+     * before a step whose 0-based index is a multiple of the interval and after a step that completes one.
+     */
+    SymPRKThermostat& getThermostat() {
+        return thermostat;
+    }
+    /** Whether a thermostat event comes before / after step stepIndex (1-based, as execute() gets it). */
+    static bool thermostatBefore(const SymPRKIntegrator& integrator, long long stepIndex) {
+        return integrator.hasThermostat() && (stepIndex-1) % integrator.getThermostatInterval() == 0;
+    }
+    static bool thermostatAfter(const SymPRKIntegrator& integrator, long long stepIndex) {
+        return integrator.hasThermostat() && stepIndex % integrator.getThermostatInterval() == 0;
+    }
+    /** c = exp(-interval*dt/(2 tau)) of a half event. */
+    static double thermostatDecay(const SymPRKIntegrator& integrator) {
+        return std::exp(-0.5*integrator.getThermostatInterval()*integrator.getStepSize()/integrator.getCollisionTime());
+    }
+protected:
+    SymPRKThermostat thermostat;
 };
 
 } // namespace OpenMM

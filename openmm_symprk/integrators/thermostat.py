@@ -1,0 +1,196 @@
+"""The velocity-rescaling thermostat's settings, shared by both backends: the option checks, the unit
+conversions and the System facts it needs (degrees of freedom, whether the rigid rotation is kept).
+
+    settings = thermostat_settings(system, temperature=300*unit.kelvin, collision_time=0.1*unit.picoseconds)
+
+returns a :class:`ThermostatSettings` (or None without ``temperature``: no thermostat).  The numerics of an
+event are :mod:`openmm_symprk.physics.velocity_rescaling`; each backend emits or runs them (the CustomIntegrator
+program: :mod:`.thermostat_program`; the native plugin: its kernels).  docs/thermostat.md describes the scheme.
+"""
+from __future__ import annotations
+
+import math
+import operator
+from dataclasses import dataclass, replace
+
+import numpy as np
+import openmm as mm
+import openmm.unit as unit
+
+from ..physics.temperature import R_KJ
+from ..physics.velocity_rescaling import relaxation_factor
+from ..systems.checks import EXACT_MOMENTUM_FORBIDDEN, conservation_issues
+from ..systems.properties import thermostat_degrees_of_freedom
+
+__all__ = ["ThermostatSettings", "thermostat_settings", "temperature_in_kelvin", "collision_time_in_ps",
+           "check_interval", "check_seed", "system_is_isolated", "DEFAULT_COLLISION_TIME", "THERMOSTAT_OPTIONS",
+           "MAX_SEED"]
+
+#: Default collision time tau (ps) when ``temperature`` is given without ``collision_time``.
+DEFAULT_COLLISION_TIME = 0.1
+#: The options of the thermostat (both backends take them).
+THERMOSTAT_OPTIONS = ("temperature", "collision_time", "thermostat_interval", "random_seed")
+#: Largest random seed: OpenMM's setRandomNumberSeed takes a 32-bit signed int.
+MAX_SEED = 2**31 - 1
+
+
+def _is_truth_value(value) -> bool:
+    raw = value._value if unit.is_quantity(value) else value
+    return isinstance(raw, (bool, np.bool_))
+
+
+def temperature_in_kelvin(temperature) -> float:
+    """A temperature as a float in K: a Quantity compatible with kelvin, or a plain number taken as kelvin;
+    positive and finite."""
+    hint = "give e.g. 300*unit.kelvin (a plain number is taken as kelvin)"
+    if _is_truth_value(temperature):
+        raise TypeError(f"temperature {temperature!r} is a truth value, not a temperature: {hint}")
+    if unit.is_quantity(temperature):
+        if not temperature.unit.is_compatible(unit.kelvin):
+            raise TypeError(f"temperature {temperature} is not a temperature: {hint}")
+        value = temperature.value_in_unit(unit.kelvin)
+    else:
+        value = temperature
+    try:
+        value = float(value)
+    except (TypeError, ValueError):
+        raise TypeError(f"temperature {temperature!r} is not a temperature: {hint}") from None
+    if not math.isfinite(value) or value <= 0:
+        raise ValueError(f"temperature must be positive and finite, got {temperature} ({hint})")
+    return value
+
+
+def collision_time_in_ps(collision_time) -> float:
+    """The collision time tau as a float in ps: a time Quantity or a plain number of picoseconds; > 0, finite."""
+    hint = "give e.g. 0.1*unit.picoseconds (a plain number is taken as picoseconds)"
+    if _is_truth_value(collision_time):
+        raise TypeError(f"collision_time {collision_time!r} is a truth value, not a time: {hint}")
+    if unit.is_quantity(collision_time):
+        if not collision_time.unit.is_compatible(unit.picoseconds):
+            raise TypeError(f"collision_time {collision_time} is not a time: {hint}")
+        value = collision_time.value_in_unit(unit.picoseconds)
+    else:
+        value = collision_time
+    try:
+        value = float(value)
+    except (TypeError, ValueError):
+        raise TypeError(f"collision_time {collision_time!r} is not a time: {hint}") from None
+    if not math.isfinite(value) or value <= 0:
+        raise ValueError(f"collision_time must be a positive, finite time, got {collision_time} ({hint})")
+    return value
+
+
+def _whole_number(value, what: str, minimum: int, accepted: str) -> int:
+    if isinstance(value, (bool, np.bool_)):
+        raise TypeError(f"{what} {value!r} is a truth value; {accepted}")
+    try:
+        n = operator.index(value)
+    except TypeError:
+        raise TypeError(f"{what} must be a whole number, got {value!r}; {accepted}") from None
+    if n < minimum:
+        raise ValueError(f"{what} must be >= {minimum}, got {n}; {accepted}")
+    return int(n)
+
+
+def check_interval(interval) -> int:
+    """The thermostat interval n (the thermostat acts every n steps): an int >= 1."""
+    return _whole_number(interval, "thermostat_interval", 1, "give the number of steps between thermostat "
+                                                               "events, e.g. 1 (every step) or 10")
+
+
+def check_seed(seed) -> int:
+    """A random seed: an int in [0, 2**31 - 1] (0: a fresh seed each time a Context is created)."""
+    n = _whole_number(seed, "random_seed", 0, f"give an integer from 0 (a fresh seed for every Context) "
+                                              f"to {MAX_SEED}")
+    if n > MAX_SEED:
+        raise ValueError(f"random_seed must be at most {MAX_SEED} (OpenMM takes a 32-bit seed), got {n}")
+    return n
+
+
+def system_is_isolated(system: mm.System) -> bool:
+    """True for a System that conserves angular momentum: not periodic, no frozen (massless, non virtual-site)
+    particles and no external field (the facts of :func:`openmm_symprk.systems.checks.conservation_issues`)."""
+    return not any(key in EXACT_MOMENTUM_FORBIDDEN for key, _ in conservation_issues(system))
+
+
+@dataclass(frozen=True)
+class ThermostatSettings:
+    """What a backend needs to run the thermostat.
+
+    ``temperature`` (K), ``collision_time`` tau (ps), ``interval`` n (it acts every n steps), ``seed`` (0: a
+    fresh one per Context), ``dof`` (the degrees of freedom it samples), ``keep_rotation`` (the System is
+    isolated: the rigid rotation about the centre of mass is kept, as the centre-of-mass velocity always is)."""
+
+    temperature: float
+    collision_time: float
+    interval: int
+    seed: int
+    dof: int
+    keep_rotation: bool
+
+    def c_half(self, step_ps: float) -> float:
+        """c = exp(-(n dt / 2) / tau): the relaxation factor of one half event (two per n steps)."""
+        return relaxation_factor(0.5 * self.interval * step_ps, self.collision_time)
+
+    @property
+    def target_kinetic(self) -> float:
+        """N_f k T / 2 (kJ/mol): the mean kinetic energy of the peculiar velocities."""
+        return 0.5 * self.dof * R_KJ * self.temperature
+
+    def with_temperature(self, temperature) -> "ThermostatSettings":
+        return replace(self, temperature=temperature_in_kelvin(temperature))
+
+    def with_collision_time(self, collision_time) -> "ThermostatSettings":
+        return replace(self, collision_time=collision_time_in_ps(collision_time))
+
+    def with_seed(self, seed) -> "ThermostatSettings":
+        return replace(self, seed=check_seed(seed))
+
+    def as_dict(self) -> dict:
+        return {"temperature": self.temperature, "collision_time": self.collision_time, "interval": self.interval,
+                "seed": self.seed, "dof": self.dof, "keep_rotation": self.keep_rotation}
+
+    def describe(self) -> str:
+        kept = "centre-of-mass velocity and rigid rotation kept" if self.keep_rotation else \
+            "centre-of-mass velocity kept"
+        every = "every step" if self.interval == 1 else f"every {self.interval} steps"
+        return (f"thermostat: stochastic velocity rescaling at {self.temperature:g} K, collision time "
+                f"{self.collision_time:g} ps, {every} (half events around the step), {self.dof} degrees of "
+                f"freedom, {kept}, seed {self.seed if self.seed else 'fresh per Context'}")
+
+
+def thermostat_settings(system, temperature=None, collision_time=None, thermostat_interval=None,
+                        random_seed=None) -> ThermostatSettings | None:
+    """The checked thermostat settings of an integrator's options, or None without ``temperature``.
+
+    ``collision_time`` (default 0.1 ps), ``thermostat_interval`` (default 1) and ``random_seed`` (default 0)
+    only make sense with ``temperature``; ``system`` (the System the integrator will run) is required with it,
+    since the degrees of freedom come from it."""
+    if temperature is None:
+        given = [name for name, value in (("collision_time", collision_time),
+                                          ("thermostat_interval", thermostat_interval),
+                                          ("random_seed", random_seed)) if value is not None]
+        if given:
+            raise ValueError(f"{', '.join(given)} {'was' if len(given) == 1 else 'were'} given without temperature: "
+                             f"{'it sets' if len(given) == 1 else 'they set'} up the thermostat, which only runs with "
+                             f"temperature= (e.g. temperature=300*unit.kelvin); drop "
+                             f"{'it' if len(given) == 1 else 'them'} for an NVE run")
+        return None
+    kelvin = temperature_in_kelvin(temperature)
+    tau = collision_time_in_ps(DEFAULT_COLLISION_TIME if collision_time is None else collision_time)
+    interval = check_interval(1 if thermostat_interval is None else thermostat_interval)
+    seed = check_seed(0 if random_seed is None else random_seed)
+    if system is None:
+        raise ValueError("temperature= needs system= (the System the integrator will run): the thermostat's "
+                         "degrees of freedom and whether the rotation is kept come from it")
+    if not isinstance(system, mm.System):
+        raise TypeError(f"system must be an openmm.System, got {type(system).__name__}")
+    isolated = system_is_isolated(system)
+    dof = thermostat_degrees_of_freedom(system, isolated)
+    if dof <= 0:
+        raise ValueError(
+            f"no degrees of freedom to thermostat: the System has {system.getNumParticles()} particle(s) and "
+            f"{system.getNumConstraints()} constraint(s), which leaves {dof} degrees of freedom once the "
+            f"centre-of-mass velocity{' and the rigid rotation (isolated System)' if isolated else ''} are kept "
+            f"(3 per particle with mass - constraints - 3{' - 3' if isolated else ''})")
+    return ThermostatSettings(kelvin, tau, interval, seed, dof, isolated)

@@ -1,0 +1,210 @@
+"""The velocity-rescaling thermostat as CustomIntegrator computations (the CustomIntegrator backend).
+
+One half event (:func:`emit_half_event`) computes, with ``addComputeSum`` over the degrees of freedom,
+
+    M = sum m,  P = sum m v,  K = sum m v.v / 2
+    and, when the rotation is kept (isolated System): sum m x, the second moments sum m x_a x_b, L about the origin,
+
+then in global expressions the kept field u = V + w x (x - R) (V = P/M; R the centre of mass, I the inertia
+tensor about it, w = I^-1 (L - R x P)), the peculiar kinetic energy K_pec = K - |P|^2/(2M) (- (L - R x P).w/2),
+a standard normal r1 (``gaussian``), chi2 = sum gaussian^2 * mask over a per-DOF mask holding exactly
+N_f - 1 ones, and (alpha, K') as :func:`openmm_symprk.physics.velocity_rescaling.rescaling_factor` writes them,
+sign included.  Then ``v = u + alpha (v - u)`` for every particle with mass, and the heat-bath energy goes
+down by K' - K_pec.
+
+Components are selected by per-DOF selector vectors (1,0,0), (0,1,0), (0,0,1) and cross products are formed
+from two cyclic permutations of x, so every pass but the two permutations runs on OpenMM's scalar path (see
+:mod:`.projection`).  The temperature (K) and the collision time (ps) are global variables, so that
+setTemperature/setCollisionTime act on a running Context (and a checkpoint brings back the ones it was
+saved with); c = exp(-(n dt/2)/tau) is computed from ``dt`` at every event, so setStepSize is followed.
+"""
+from __future__ import annotations
+
+import openmm as mm
+
+from ..physics.temperature import R_KJ
+from .thermostat import ThermostatSettings
+
+__all__ = ["PREFIX", "LOST_MASK_VAR", "TEMPERATURE_VAR", "COLLISION_TIME_VAR", "HEAT_BATH_VAR", "MASK_VAR", "ALPHA_VAR",
+           "KINETIC_VAR", "NEW_KINETIC_VAR", "add_variables", "emit_half_event", "mask_values"]
+
+PREFIX = "symprk_ts_"
+TEMPERATURE_VAR = PREFIX + "temperature"  # K
+COLLISION_TIME_VAR = PREFIX + "tau"  # ps
+HEAT_BATH_VAR = PREFIX + "heat_bath"  # kJ/mol
+MASK_VAR = PREFIX + "mask"  # per DOF: exactly dof - 1 ones
+ALPHA_VAR = PREFIX + "alpha"  # the last factor applied
+KINETIC_VAR = PREFIX + "kpec"  # the last peculiar kinetic energy before the event (kJ/mol)
+NEW_KINETIC_VAR = PREFIX + "knew"  # and after
+#: set to 1 by an event that found the mask without its dof - 1 ones (a Context reinitialized without its state
+#: loses per-DOF values set while bound): the event then does nothing, and the integrator fills the mask again
+LOST_MASK_VAR = PREFIX + "lost_mask"
+
+_AXES = ("x", "y", "z")
+_PAIRS = ("xx", "yy", "zz", "xy", "yz", "zx")
+
+
+def _v(name: str) -> str:
+    return PREFIX + name
+
+
+def _globals(keep_rotation: bool) -> tuple:
+    names = ["M", *(f"P{a}" for a in _AXES), "K", *(f"V{a}" for a in _AXES), "c", "s", "r1", "chi2", "nmask", "ok",
+             "sgn"]
+    if keep_rotation:
+        names += [*(f"mx{a}" for a in _AXES), *(f"q{p}" for p in _PAIRS), *(f"L{a}" for a in _AXES),
+                  *(f"R{a}" for a in _AXES), *(f"I{p}" for p in _PAIRS), *(f"adj{p}" for p in _PAIRS), "det",
+                  *(f"Lc{a}" for a in _AXES), *(f"w{a}" for a in _AXES), *(f"k{a}" for a in _AXES)]
+    return tuple(_v(n) for n in names)
+
+
+def _per_dof(keep_rotation: bool) -> tuple:
+    return tuple(_v(n) for n in ("ex", "ey", "ez", *(("xp", "xpp", "u") if keep_rotation else ())))
+
+
+def add_variables(integrator: mm.CustomIntegrator, settings: ThermostatSettings) -> None:
+    """Declare the thermostat's variables (the settings' temperature and collision time as initial values,
+    the heat-bath energy at 0, the selector vectors broadcast from one value).  The mask is filled by
+    :func:`mask_values` once the Context is known to have the System's particle count."""
+    ig = integrator
+    for name, value in ((TEMPERATURE_VAR, settings.temperature), (COLLISION_TIME_VAR, settings.collision_time),
+                        (HEAT_BATH_VAR, 0.0), (ALPHA_VAR, 1.0), (KINETIC_VAR, 0.0), (NEW_KINETIC_VAR, 0.0),
+                        (LOST_MASK_VAR, 0.0)):
+        ig.addGlobalVariable(name, float(value))
+    for name in _globals(settings.keep_rotation):
+        ig.addGlobalVariable(name, 0.0)
+    for name in (*_per_dof(settings.keep_rotation), MASK_VAR):
+        ig.addPerDofVariable(name, 0.0)
+    for name, e in (("ex", (1, 0, 0)), ("ey", (0, 1, 0)), ("ez", (0, 0, 1))):
+        ig.setPerDofVariableByName(_v(name), [mm.Vec3(*e)])
+
+
+def mask_values(masses, dof: int) -> list:
+    """The per-DOF mask: ones on the first ``dof - 1`` degrees of freedom of the particles with mass (in
+    particle order, x, y, z), zeros elsewhere; summing gaussian^2 over it gives a chi-squared variable of
+    dof - 1 degrees of freedom."""
+    ones = max(int(dof) - 1, 0)
+    out = []
+    for m in masses:
+        row = [0.0, 0.0, 0.0]
+        if m > 0:
+            for k in range(3):
+                if ones > 0:
+                    row[k] = 1.0
+                    ones -= 1
+        out.append(mm.Vec3(*row))
+    if ones:
+        raise ValueError(f"the System's particles with mass have fewer than {dof - 1} degrees of freedom")
+    return out
+
+
+def _num(c) -> str:
+    return repr(float(c))
+
+
+def _comb(a: str, b: str, c: str) -> str:
+    """The global vector (a, b, c) as a per-DOF expression on the scalar path."""
+    return f"({_v(a)}*{_v('ex')} + {_v(b)}*{_v('ey')} + {_v(c)}*{_v('ez')})"
+
+
+def _emit_sums(ig, keep_rotation: bool):
+    v = _v
+    e = {a: v(f"e{a}") for a in _AXES}
+    ig.addComputeSum(v("M"), f"m*{e['x']}")
+    for a in _AXES:
+        ig.addComputeSum(v(f"P{a}"), f"m*v*{e[a]}")
+    ig.addComputeSum(v("K"), "0.5*m*v*v")
+    if not keep_rotation:
+        return
+    xp, xpp = v("xp"), v("xpp")
+    ig.addComputePerDof(xp, "vector(_y(x), _z(x), _x(x))")
+    ig.addComputePerDof(xpp, "vector(_z(x), _x(x), _y(x))")
+    for a in _AXES:
+        ig.addComputeSum(v(f"mx{a}"), f"m*x*{e[a]}")
+    for a in _AXES:
+        ig.addComputeSum(v(f"q{a}{a}"), f"m*x*x*{e[a]}")
+    for a, p in zip(_AXES, ("xy", "yz", "zx")):  # x * xp = (x y, y z, z x)
+        ig.addComputeSum(v(f"q{p}"), f"m*x*{xp}*{e[a]}")
+    # L about the origin: (x X v)_x = [xpp v]_z - [xp v]_y and cyclically
+    for a, b, d in (("x", "z", "y"), ("y", "x", "z"), ("z", "y", "x")):
+        ig.addComputeSum(v(f"L{a}"), f"m*v*({xpp}*{e[b]} - {xp}*{e[d]})")
+
+
+def _emit_rotation(ig):
+    """R, I about R, its adjugate and determinant, L about R and w = I^-1 L (0 for a singular I), and
+    k = V - w x R, so that the kept field is k + w x x."""
+    v = _v
+    M = v("M")
+    inv = f"select({M}, 1/{M}, 0)"
+    for a in _AXES:
+        ig.addComputeGlobal(v(f"R{a}"), f"{v(f'mx{a}')}*{inv}")
+    R = {a: v(f"R{a}") for a in _AXES}
+    C = {p: f"({v(f'q{p}')} - {M}*{R[p[0]]}*{R[p[1]]})" for p in _PAIRS}
+    ig.addComputeGlobal(v("Ixx"), f"{C['yy']} + {C['zz']}")
+    ig.addComputeGlobal(v("Iyy"), f"{C['xx']} + {C['zz']}")
+    ig.addComputeGlobal(v("Izz"), f"{C['xx']} + {C['yy']}")
+    for p in ("xy", "yz", "zx"):
+        ig.addComputeGlobal(v(f"I{p}"), f"-{C[p]}")
+    A, B, Z, D, E, F = (v(f"I{p}") for p in ("xx", "yy", "zz", "xy", "zx", "yz"))
+    ig.addComputeGlobal(v("adjxx"), f"{B}*{Z} - {F}*{F}")
+    ig.addComputeGlobal(v("adjyy"), f"{A}*{Z} - {E}*{E}")
+    ig.addComputeGlobal(v("adjzz"), f"{A}*{B} - {D}*{D}")
+    ig.addComputeGlobal(v("adjxy"), f"{E}*{F} - {Z}*{D}")
+    ig.addComputeGlobal(v("adjzx"), f"{D}*{F} - {B}*{E}")
+    ig.addComputeGlobal(v("adjyz"), f"{D}*{E} - {A}*{F}")
+    ig.addComputeGlobal(v("det"), f"{A}*{v('adjxx')} + {D}*{v('adjxy')} + {E}*{v('adjzx')}")
+    P = {a: v(f"P{a}") for a in _AXES}
+    for a, b, d in (("x", "y", "z"), ("y", "z", "x"), ("z", "x", "y")):  # Lc = L - R x P
+        ig.addComputeGlobal(v(f"Lc{a}"), f"{v(f'L{a}')} - ({R[b]}*{P[d]} - {R[d]}*{P[b]})")
+    adj = {p: v(f"adj{p}") for p in _PAIRS}
+    adj.update({"yx": adj["xy"], "xz": adj["zx"], "zy": adj["yz"]})
+    det = v("det")
+    for a in _AXES:
+        row = " + ".join(f"{adj[a + b]}*{v(f'Lc{b}')}" for b in _AXES)
+        ig.addComputeGlobal(v(f"w{a}"), f"select({det}, ({row})/{det}, 0)")
+    w = {a: v(f"w{a}") for a in _AXES}
+    for a, b, d in (("x", "y", "z"), ("y", "z", "x"), ("z", "x", "y")):  # k = V - w x R
+        ig.addComputeGlobal(v(f"k{a}"), f"{v(f'V{a}')} - ({w[b]}*{R[d]} - {w[d]}*{R[b]})")
+
+
+def emit_half_event(integrator: mm.CustomIntegrator, settings: ThermostatSettings) -> None:
+    """Append one half thermostat event (relaxation factor c = exp(-(n dt/2)/tau))."""
+    ig = integrator
+    v = _v
+    rot = settings.keep_rotation
+    dof = int(settings.dof)
+    _emit_sums(ig, rot)
+    M = v("M")
+    inv = f"select({M}, 1/{M}, 0)"
+    for a in _AXES:
+        ig.addComputeGlobal(v(f"V{a}"), f"{v(f'P{a}')}*{inv}")
+    kept = f"0.5*({v('Px')}*{v('Px')} + {v('Py')}*{v('Py')} + {v('Pz')}*{v('Pz')})*{inv}"
+    if rot:
+        _emit_rotation(ig)
+        kept += " + 0.5*(" + " + ".join(f"{v(f'Lc{a}')}*{v(f'w{a}')}" for a in _AXES) + ")"
+    K = KINETIC_VAR
+    ig.addComputeGlobal(K, f"{v('K')} - ({kept})")
+    # the noise, and (alpha, K') as physics.velocity_rescaling.rescaling_factor writes them
+    ig.addComputeGlobal(v("r1"), "gaussian")
+    ig.addComputeSum(v("chi2"), f"gaussian*gaussian*{MASK_VAR}")
+    ig.addComputeGlobal(v("c"), f"exp(-{_num(0.5 * settings.interval)}*dt/{COLLISION_TIME_VAR})")
+    ig.addComputeGlobal(v("s"), f"{_num(0.5 * dof * R_KJ)}*{TEMPERATURE_VAR}/{dof}")  # target / dof
+    c, s, r1, chi2 = v("c"), v("s"), v("r1"), v("chi2")
+    # the mask holds its dof - 1 ones (else the Context lost it: do nothing and say so), and K_pec > 0
+    ig.addComputeSum(v("nmask"), MASK_VAR)
+    ig.addComputeGlobal(LOST_MASK_VAR, f"max({LOST_MASK_VAR}, 1 - delta({v('nmask')} - {dof - 1}))")
+    ig.addComputeGlobal(v("ok"), f"(1 - step(-{K}))*delta({v('nmask')} - {dof - 1})")
+    new = (f"{c}*{K} + (1 - {c})*{s}*({r1}*{r1} + {chi2}) + 2*{r1}*sqrt({c}*(1 - {c})*{K}*{s})")
+    ig.addComputeGlobal(NEW_KINETIC_VAR, f"select({v('ok')}, {new}, {K})")
+    # the velocity came out reversed along itself: r1 + sqrt(c K / ((1 - c) s)) < 0
+    ig.addComputeGlobal(v("sgn"), f"2*step({r1} + sqrt({c}*{K}/((1 - {c})*{s}))) - 1")
+    ig.addComputeGlobal(ALPHA_VAR, f"select({v('ok')}, {v('sgn')}*sqrt(max({NEW_KINETIC_VAR}, 0)/{K}), 1)")
+    ig.addComputeGlobal(HEAT_BATH_VAR, f"{HEAT_BATH_VAR} - ({NEW_KINETIC_VAR} - {K})")
+    alpha = ALPHA_VAR
+    if rot:
+        u = v("u")
+        ig.addComputePerDof(u, f"{_comb('kx', 'ky', 'kz')} + {_comb('wy', 'wz', 'wx')}*{v('xpp')}"
+                               f" - {_comb('wz', 'wx', 'wy')}*{v('xp')}")
+    else:
+        u = _comb("Vx", "Vy", "Vz")
+    ig.addComputePerDof("v", f"select(m, {u} + {alpha}*(v - {u}), v)")
