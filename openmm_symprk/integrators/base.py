@@ -28,11 +28,11 @@ from __future__ import annotations
 import math
 import operator
 
-import numpy as np
 import openmm as mm
 import openmm.unit as unit
 
 from ..methods.catalogue import get_method
+from .quantities import positive_quantity
 from .thermostat import check_seed
 
 __all__ = ["IntegratorBase", "SimulationBlowUpError", "ConvergenceWarning", "SystemMismatchError",
@@ -57,26 +57,7 @@ class CheckpointMismatchError(RuntimeError):
 
 def step_size_in_ps(step_size) -> float:
     """Validate a step size: a positive time Quantity, or a positive number taken as picoseconds."""
-    raw = step_size._value if unit.is_quantity(step_size) else step_size
-    if isinstance(raw, (bool, np.bool_)):
-        raise TypeError(f"step size {step_size!r} is a truth value, not a time: give e.g. 2*unit.femtoseconds "
-                        f"or a number of picoseconds")
-    if unit.is_quantity(step_size):
-        if not step_size.unit.is_compatible(unit.picoseconds):
-            raise TypeError(f"step size {step_size} is not a time: give it in time units, e.g. "
-                            f"2*unit.femtoseconds (a plain number is taken as picoseconds)")
-        value = step_size.value_in_unit(unit.picoseconds)
-    else:
-        value = step_size
-    try:
-        value = float(value)
-    except (TypeError, ValueError):
-        raise TypeError(f"step size {step_size!r} is not a time: give e.g. 2*unit.femtoseconds "
-                        f"or a number of picoseconds") from None
-    if not math.isfinite(value) or value <= 0:
-        raise ValueError(f"step size must be positive and finite, got {step_size} "
-                         f"(e.g. 2*unit.femtoseconds or 0.002 ps)")
-    return value
+    return positive_quantity(step_size, "step size", unit.picoseconds, "time", "2*unit.femtoseconds")
 
 
 def check_max_speed(max_speed) -> float:

@@ -9,7 +9,6 @@ program: :mod:`.thermostat_program`; the native plugin: its kernels).  docs/ther
 """
 from __future__ import annotations
 
-import math
 import operator
 from dataclasses import dataclass, replace
 
@@ -21,6 +20,7 @@ from ..physics.temperature import R_KJ
 from ..physics.velocity_rescaling import relaxation_factor
 from ..systems.checks import EXACT_MOMENTUM_FORBIDDEN, conservation_issues
 from ..systems.properties import thermostat_degrees_of_freedom
+from .quantities import positive_quantity
 
 __all__ = ["ThermostatSettings", "thermostat_settings", "temperature_in_kelvin", "collision_time_in_ps",
            "check_interval", "check_seed", "system_is_isolated", "DEFAULT_COLLISION_TIME", "THERMOSTAT_OPTIONS",
@@ -34,50 +34,15 @@ THERMOSTAT_OPTIONS = ("temperature", "collision_time", "thermostat_interval", "r
 MAX_SEED = 2**31 - 1
 
 
-def _is_truth_value(value) -> bool:
-    raw = value._value if unit.is_quantity(value) else value
-    return isinstance(raw, (bool, np.bool_))
-
-
 def temperature_in_kelvin(temperature) -> float:
     """A temperature as a float in K: a Quantity compatible with kelvin, or a plain number taken as kelvin;
     positive and finite."""
-    hint = "give e.g. 300*unit.kelvin (a plain number is taken as kelvin)"
-    if _is_truth_value(temperature):
-        raise TypeError(f"temperature {temperature!r} is a truth value, not a temperature: {hint}")
-    if unit.is_quantity(temperature):
-        if not temperature.unit.is_compatible(unit.kelvin):
-            raise TypeError(f"temperature {temperature} is not a temperature: {hint}")
-        value = temperature.value_in_unit(unit.kelvin)
-    else:
-        value = temperature
-    try:
-        value = float(value)
-    except (TypeError, ValueError):
-        raise TypeError(f"temperature {temperature!r} is not a temperature: {hint}") from None
-    if not math.isfinite(value) or value <= 0:
-        raise ValueError(f"temperature must be positive and finite, got {temperature} ({hint})")
-    return value
+    return positive_quantity(temperature, "temperature", unit.kelvin, "temperature", "300*unit.kelvin")
 
 
 def collision_time_in_ps(collision_time) -> float:
     """The collision time tau as a float in ps: a time Quantity or a plain number of picoseconds; > 0, finite."""
-    hint = "give e.g. 0.1*unit.picoseconds (a plain number is taken as picoseconds)"
-    if _is_truth_value(collision_time):
-        raise TypeError(f"collision_time {collision_time!r} is a truth value, not a time: {hint}")
-    if unit.is_quantity(collision_time):
-        if not collision_time.unit.is_compatible(unit.picoseconds):
-            raise TypeError(f"collision_time {collision_time} is not a time: {hint}")
-        value = collision_time.value_in_unit(unit.picoseconds)
-    else:
-        value = collision_time
-    try:
-        value = float(value)
-    except (TypeError, ValueError):
-        raise TypeError(f"collision_time {collision_time!r} is not a time: {hint}") from None
-    if not math.isfinite(value) or value <= 0:
-        raise ValueError(f"collision_time must be a positive, finite time, got {collision_time} ({hint})")
-    return value
+    return positive_quantity(collision_time, "collision_time", unit.picoseconds, "time", "0.1*unit.picoseconds")
 
 
 def _whole_number(value, what: str, minimum: int, accepted: str) -> int:

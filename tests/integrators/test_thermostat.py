@@ -133,7 +133,7 @@ BAD = [
     (dict(temperature=float("inf")), ValueError, "got inf"),
     (dict(temperature=300 * unit.nanometer), TypeError, "temperature 300 nm is not a temperature"),
     (dict(temperature="hot"), TypeError, "temperature 'hot' is not a temperature"),
-    (dict(temperature=300, collision_time=0), ValueError, "collision_time must be a positive, finite time, got 0"),
+    (dict(temperature=300, collision_time=0), ValueError, "collision_time must be positive and finite, got 0"),
     (dict(temperature=300, collision_time=-1 * unit.picoseconds), ValueError, "got -1 ps"),
     (dict(temperature=300, collision_time=float("inf")), ValueError, "got inf"),
     (dict(temperature=300, collision_time=5 * unit.kelvin), TypeError, "collision_time 5 K is not a time"),

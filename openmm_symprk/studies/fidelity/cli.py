@@ -4,27 +4,20 @@ and against Verlet extrapolated to h -> 0."""
 from __future__ import annotations
 
 import argparse
-import os
 import sys
 
+from ..core.cli import add_study_arguments, run_study_command
 from . import presets
 
 
 def build_parser():
     ap = argparse.ArgumentParser(prog="symprk fidelity", description=__doc__)
-    ap.add_argument("--quick", action="store_true", help="64 waters, 0.6-ps runs, 2 replicas: seconds, large errors")
-    ap.add_argument("--out", default="fidelity-results", help="output folder (finished runs are reused)")
-    ap.add_argument("--workers", type=int, default=2, help="worker processes (each runs one run at a time)")
-    ap.add_argument("--scheduler", metavar="ADDRESS",
-                    help="Dask distributed scheduler address (e.g. tcp://host:8786) instead of local workers; "
-                         "needs the 'cluster' extra")
+    add_study_arguments(ap, quick="64 waters, 0.6-ps runs, 2 replicas: seconds, large errors", out="fidelity-results",
+                        workers="worker processes (each runs one run at a time)",
+                        length="measured length per run (frames every sample_fs)")
     ap.add_argument("--rows", default=None,
                     help="comma-separated labels of the preset rows to run (the reference is always run), "
                          "e.g. 'verlet 2 fs,omelyan-2 4 fs'; default: all")
-    ap.add_argument("--replicas", type=int, default=None)
-    ap.add_argument("--length-ps", type=float, default=None, help="measured length per run (frames every sample_fs)")
-    ap.add_argument("--no-timing", action="store_true", help="skip the wall-time measurement in turns")
-    ap.add_argument("--no-progress", action="store_true")
     return ap
 
 
@@ -43,31 +36,13 @@ def select_rows(cfg: dict, text: str) -> list:
 def main(argv=None) -> int:
     args = build_parser().parse_args(argv)
     cfg = presets.quick() if args.quick else presets.full()
-    try:
+
+    def configure(cfg):
         if args.rows:
             cfg["rows"] = select_rows(cfg, args.rows)
-        if args.replicas is not None:
-            cfg["replicas"] = args.replicas
-        if args.length_ps is not None:
-            cfg["length_ps"] = args.length_ps
-        if args.workers < 1:
-            raise ValueError(f"--workers must be >= 1, got {args.workers}")
-        if os.path.isfile(args.out):
-            raise ValueError(f"--out {args.out} is a file; give a folder")
-        from .report import format_summary
-        from .simulation import run_study
 
-        summary = run_study(cfg, args.out, workers=args.workers, timing=not args.no_timing,
-                            progress=not args.no_progress, scheduler=args.scheduler)
-    except KeyboardInterrupt:
-        print("symprk fidelity: interrupted (finished runs are kept; run again to continue)", file=sys.stderr)
-        return 130
-    except (ValueError, KeyError, OSError, RuntimeError, ImportError) as exc:
-        print(f"symprk fidelity: error: {exc}", file=sys.stderr)
-        return 2
-    print(format_summary(summary))
-    print(f"\nwrote {os.path.join(args.out, 'summary.txt')}, results.json and fidelity.png")
-    return 0
+    return run_study_command("symprk fidelity", args, cfg, configure, "openmm_symprk.studies.fidelity.simulation",
+                             "openmm_symprk.studies.fidelity.report", "fidelity.png")
 
 
 if __name__ == "__main__":

@@ -1,0 +1,50 @@
+"""What the command lines of the studies share: their common options and the run-and-report frame (options
+checked before anything runs, finished runs kept on Ctrl-C, one-line errors with exit status 2)."""
+from __future__ import annotations
+
+import os
+import sys
+from importlib import import_module
+
+__all__ = ["add_study_arguments", "run_study_command"]
+
+
+def add_study_arguments(ap, *, quick: str, out: str, workers: str, length: str) -> None:
+    """--quick, --out, --workers, --scheduler, --replicas, --length-ps, --no-timing and --no-progress."""
+    ap.add_argument("--quick", action="store_true", help=quick)
+    ap.add_argument("--out", default=out, help="output folder (finished runs are reused)")
+    ap.add_argument("--workers", type=int, default=2, help=workers)
+    ap.add_argument("--scheduler", metavar="ADDRESS",
+                    help="Dask distributed scheduler address (e.g. tcp://host:8786) instead of local workers; "
+                         "needs the 'cluster' extra")
+    ap.add_argument("--replicas", type=int, default=None)
+    ap.add_argument("--length-ps", type=float, default=None, help=length)
+    ap.add_argument("--no-timing", action="store_true", help="skip the wall-time measurement in turns")
+    ap.add_argument("--no-progress", action="store_true")
+
+
+def run_study_command(prog: str, args, cfg: dict, configure, study: str, report: str, chart: str) -> int:
+    """Apply ``configure(cfg)`` (the study's own options; raises ValueError on a bad one) and the common options,
+    run ``run_study`` of the module ``study`` and print ``format_summary`` of the module ``report`` (both imported
+    only then, so that ``--help`` and bad options answer at once)."""
+    try:
+        configure(cfg)
+        if args.replicas is not None:
+            cfg["replicas"] = args.replicas
+        if args.length_ps is not None:
+            cfg["length_ps"] = args.length_ps
+        if args.workers < 1:
+            raise ValueError(f"--workers must be >= 1, got {args.workers}")
+        if os.path.isfile(args.out):
+            raise ValueError(f"--out {args.out} is a file; give a folder")
+        summary = import_module(study).run_study(cfg, args.out, workers=args.workers, timing=not args.no_timing,
+                                  progress=not args.no_progress, scheduler=args.scheduler)
+    except KeyboardInterrupt:
+        print(f"{prog}: interrupted (finished runs are kept; run again to continue)", file=sys.stderr)
+        return 130
+    except (ValueError, KeyError, OSError, RuntimeError, ImportError) as exc:
+        print(f"{prog}: error: {exc}", file=sys.stderr)
+        return 2
+    print(import_module(report).format_summary(summary))
+    print(f"\nwrote {os.path.join(args.out, 'summary.txt')}, results.json and {chart}")
+    return 0
