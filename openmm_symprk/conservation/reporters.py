@@ -162,9 +162,9 @@ class ConservationReporter:
         self._line = RunningLine()
         self.issues = conservation_issues(self._system) + integrator_issues(simulation.integrator)
         if self._warn:
-            warn_conservation(self._system, context="ConservationReporter", stacklevel=4)
+            warn_conservation(self._system, context="ConservationReporter")
             for key, msg in integrator_issues(simulation.integrator):
-                warn_once(key, f"ConservationReporter: {msg}", stacklevel=4)
+                warn_once(key, f"ConservationReporter: {msg}")
         if not self._append:
             columns = list(self.COLUMNS)
             if getattr(simulation.integrator, "thermostat", None) is not None:
@@ -236,7 +236,7 @@ class VelocityTRRReporter:
                 warn_once(f"virtual-site-{kind}", f"VelocityTRRReporter: virtual sites of type {kind} (particle {i}"
                           f"{' and others' if len(self._sites.unsupported) > 1 else ''}) are written with OpenMM's "
                           f"zero velocity: their velocity from the parents' is not known for that type",
-                          category=UserWarning, stacklevel=3)
+                          category=UserWarning)
         x = np.asarray(state.getPositions(asNumpy=True).value_in_unit(_NM), dtype=np.float64)
         v = np.asarray(state.getVelocities(asNumpy=True).value_in_unit(_NM_PS), dtype=np.float64)
         if self._sites:

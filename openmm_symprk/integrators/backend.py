@@ -15,11 +15,10 @@ from __future__ import annotations
 import difflib
 from dataclasses import dataclass
 
-import openmm as mm
 
 from .. import plugin
 from ..methods.resolved import ConstraintSupportError, ResolvedMethod, resolve
-from ..systems.checks import validate_system, warn_once
+from ..systems.checks import check_system_type, validate_system, warn_once
 from ..systems.forcegroups import check_groups
 from ..systems.properties import SystemSignature, signature
 from .base import check_max_speed, step_size_in_ps
@@ -93,8 +92,8 @@ def prepare(where: str, stepSize, method, system=None, *, exact_momentum=False, 
     if exact_momentum and system is None:
         raise ValueError("exact_momentum=True needs system= (the System the integrator will run): the projection "
                          "is only right for an isolated System, which is checked, and it uses the System's masses")
-    if system is not None and not isinstance(system, mm.System):
-        raise TypeError(f"system must be an openmm.System, got {type(system).__name__}")
+    if system is not None:
+        check_system_type(system)
     thermostat = thermostat_settings(system, temperature, collision_time, thermostat_interval, random_seed)
     facts = signature(system) if system is not None else None
     if constraints is None and facts is not None:

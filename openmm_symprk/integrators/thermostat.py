@@ -18,7 +18,7 @@ import openmm.unit as unit
 
 from ..physics.temperature import R_KJ
 from ..physics.velocity_rescaling import relaxation_factor
-from ..systems.checks import EXACT_MOMENTUM_FORBIDDEN, conservation_issues
+from ..systems.checks import EXACT_MOMENTUM_FORBIDDEN, check_system_type, conservation_issues
 from ..systems.properties import thermostat_degrees_of_freedom
 from .quantities import positive_quantity
 
@@ -148,8 +148,7 @@ def thermostat_settings(system, temperature=None, collision_time=None, thermosta
     if system is None:
         raise ValueError("temperature= needs system= (the System the integrator will run): the thermostat's "
                          "degrees of freedom and whether the rotation is kept come from it")
-    if not isinstance(system, mm.System):
-        raise TypeError(f"system must be an openmm.System, got {type(system).__name__}")
+    check_system_type(system)
     isolated = system_is_isolated(system)
     dof = thermostat_degrees_of_freedom(system, isolated)
     if dof <= 0:

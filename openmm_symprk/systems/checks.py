@@ -6,6 +6,8 @@ with ``warn_once.reset()``); every module that warns about conservation goes thr
 """
 from __future__ import annotations
 
+import os
+import sys
 import warnings
 
 import openmm as mm
@@ -28,17 +30,31 @@ class ConservationWarning(UserWarning):
     """The system cannot conserve a quantity the user may expect to be conserved."""
 
 
+_PACKAGE_ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__))) + os.sep
+
+
+def _outside_caller() -> int:
+    """The stacklevel, counted from the caller of WarnOnce.__call__'s warnings.warn, of the first frame whose code
+    lies outside the openmm_symprk package (so that a warning names the user's line)."""
+    frame, level = sys._getframe(2), 2
+    while frame is not None and os.path.abspath(frame.f_code.co_filename).startswith(_PACKAGE_ROOT):
+        frame, level = frame.f_back, level + 1
+    return level
+
+
 class WarnOnce:
     """Warn at most once per process for each key."""
 
     def __init__(self):
         self._seen: set = set()
 
-    def __call__(self, key: str, message: str, category=ConservationWarning, stacklevel: int = 3) -> bool:
+    def __call__(self, key: str, message: str, category=ConservationWarning, stacklevel: int | None = None) -> bool:
+        """Warn once for ``key``.  The warning points at the first caller outside this package (the user's line),
+        unless ``stacklevel`` is given."""
         if key in self._seen:
             return False
         self._seen.add(key)
-        warnings.warn(message, category, stacklevel=stacklevel + 1)
+        warnings.warn(message, category, stacklevel=stacklevel + 1 if stacklevel is not None else _outside_caller())
         return True
 
     def seen(self, key: str) -> bool:
@@ -103,7 +119,7 @@ def integrator_issues(integrator) -> list:
     return []
 
 
-def warn_conservation(system: mm.System, context: str = "openmm_symprk", skip=(), stacklevel: int = 3) -> list:
+def warn_conservation(system: mm.System, context: str = "openmm_symprk", skip=(), stacklevel: int | None = None) -> list:
     """One ConservationWarning per kind of issue found (once per process per kind); returns the issues."""
     issues = conservation_issues(system)
     for key, msg in issues:
@@ -117,12 +133,19 @@ def warn_conservation(system: mm.System, context: str = "openmm_symprk", skip=()
 EXACT_MOMENTUM_FORBIDDEN = ("periodic", "frozen", *(n.lower() for n in EXTERNAL_FIELD_FORCES))
 
 
+def check_system_type(system) -> None:
+    """TypeError unless ``system`` is an openmm.System (naming what it got, and ``.system`` where it has one)."""
+    if not isinstance(system, mm.System):
+        hint = (" (it has one: pass its .system)" if isinstance(getattr(system, "system", None), mm.System)
+                else "")
+        raise TypeError(f"system must be an openmm.System, got {type(system).__name__}{hint}")
+
+
 def validate_system(system, context: str, exact_momentum: bool = False, skip=()) -> None:
     """What every integrator checks of its ``system=``: its type, one warning per kind of conservation issue
     (less the kinds in ``skip``), and exact momentum refused where the System is not isolated."""
-    if not isinstance(system, mm.System):
-        raise TypeError(f"system must be an openmm.System, got {type(system).__name__}")
-    issues = warn_conservation(system, context, skip=skip, stacklevel=4)
+    check_system_type(system)
+    issues = warn_conservation(system, context, skip=skip)
     if exact_momentum:
         bad = [msg for key, msg in issues if key in EXACT_MOMENTUM_FORBIDDEN]
         if bad:

@@ -23,7 +23,7 @@ def add_study_arguments(ap, *, quick: str, out: str, workers: str, length: str) 
     ap.add_argument("--no-progress", action="store_true")
 
 
-def run_study_command(prog: str, args, cfg: dict, configure, study: str, report: str, chart: str) -> int:
+def run_study_command(prog: str, args, cfg: dict, configure, study: str, report: str) -> int:
     """Apply ``configure(cfg)`` (the study's own options; raises ValueError on a bad one) and the common options,
     run ``run_study`` of the module ``study`` and print ``format_summary`` of the module ``report`` (both imported
     only then, so that ``--help`` and bad options answer at once)."""
@@ -46,5 +46,6 @@ def run_study_command(prog: str, args, cfg: dict, configure, study: str, report:
         print(f"{prog}: error: {exc}", file=sys.stderr)
         return 2
     print(import_module(report).format_summary(summary))
-    print(f"\nwrote {os.path.join(args.out, 'summary.txt')}, results.json and {chart}")
+    written = sorted(f for f in os.listdir(args.out) if f.endswith((".txt", ".json", ".png")))
+    print(f"\nwrote in {args.out}: {', '.join(written)}")
     return 0

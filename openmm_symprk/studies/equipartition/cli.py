@@ -56,7 +56,7 @@ def main(argv=None) -> int:
             cfg["models"] = {m: rows for m in cfg["models"]}
 
     return run_study_command("symprk equipartition", args, cfg, configure, "openmm_symprk.studies.equipartition.study",
-                             "openmm_symprk.studies.equipartition.report", "equipartition.png")
+                             "openmm_symprk.studies.equipartition.report")
 
 
 if __name__ == "__main__":

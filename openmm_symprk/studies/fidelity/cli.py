@@ -42,7 +42,7 @@ def main(argv=None) -> int:
             cfg["rows"] = select_rows(cfg, args.rows)
 
     return run_study_command("symprk fidelity", args, cfg, configure, "openmm_symprk.studies.fidelity.simulation",
-                             "openmm_symprk.studies.fidelity.report", "fidelity.png")
+                             "openmm_symprk.studies.fidelity.report")
 
 
 if __name__ == "__main__":
