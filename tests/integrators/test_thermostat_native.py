@@ -445,3 +445,25 @@ def test_native_and_custom_backends_sample_the_same_distribution():
     assert abs(a.mean - b.mean) <= 3 * math.hypot(a.se, b.se)
     for s in means:
         assert abs(s.mean - target) <= 3 * s.se
+
+
+def test_native_seeded_run_repeats_whatever_the_reporting():
+    """docs/thermostat.md: on the native backend a seeded NVT run repeats bit for bit on Reference even when one
+    run also asks the Context for energies between steps (the thermostat's random stream is the plugin's own)."""
+    from openmm_symprk.systems.scenes import water_cluster
+
+    scene = water_cluster(4)
+
+    def run(energies):
+        ig = SymplecticIntegrator(2 * unit.femtoseconds, "verlet", system=scene.system, backend="native",
+                                  temperature=300, random_seed=7)
+        ctx = mm.Context(scene.system, ig, mm.Platform.getPlatformByName("Reference"))
+        ctx.setPositions(scene.positions)
+        ctx.setVelocities(scene.velocities)
+        for _ in range(5):
+            ig.step(10)
+            if energies:
+                ctx.getState(getEnergy=True)
+        return ctx.getState(getPositions=True).getPositions(asNumpy=True)._value
+
+    assert np.array_equal(run(False), run(True))
