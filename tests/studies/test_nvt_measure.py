@@ -35,20 +35,33 @@ def test_every_row_kind_builds_its_integrator():
 
 @needs_native
 def test_cost_quick_measures_every_row(capsys):
-    out = cost.run(scenes=("water",), quick=True, steps=2, rounds=1)
+    out = cost.run(scenes=("water",), quick=True, steps=2, rounds=3)
     table = out["water"]
     names = [r.name for r in cost.default_rows()]
     assert [r["row"] for r in table] == names
     for r in table:
         assert r["s_per_step"] > 0 and math.isfinite(r["ratio"]) and r["ratio"] > 0, r
+        assert 0 < r["ratio_q25"] <= r["ratio"] <= r["ratio_q75"] and math.isfinite(r["ratio_q75"])
+        assert r["ratio_best"] > 0 and math.isfinite(r["ratio_best"])
         assert math.isfinite(r["ratio_per_ps"]) and r["ratio_per_ps"] > 0
         assert (r["peer_ratio"] is None) == (not r["peer"]) and (r["peer_ratio"] is None or r["peer_ratio"] > 0)
     by = {r["row"]: r for r in table}
-    assert by[cost.BASELINE]["ratio"] == 1.0
+    assert by[cost.BASELINE]["ratio"] == 1.0 == by[cost.BASELINE]["ratio_q75"]  # block by block against itself
     assert by["omelyan-2 + thermostat"]["ratio_per_ps"] == pytest.approx(by["omelyan-2 + thermostat"]["ratio"] / 2)
     assert math.isfinite(cost.event_cost(table))
     printed = capsys.readouterr().out
     assert all(n in printed for n in names) and "one half thermostat event" in printed
+
+
+def test_interleaved_keeps_every_block():
+    from openmm_symprk.studies.timing import interleaved
+
+    done = []
+    out = interleaved({"a": done.append, "b": done.append}, {"a": 2, "b": 3}, rounds=4)
+    assert done == [2, 3] * 4
+    for t in out.values():
+        assert len(t.blocks) == 4 and t.best == min(t.blocks)
+        assert t.total == pytest.approx(sum(b * (t.steps // 4) for b in t.blocks))
 
 
 @needs_native

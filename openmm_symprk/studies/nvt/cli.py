@@ -1,6 +1,6 @@
 """``symprk nvt cost`` and ``symprk nvt drift``: the thermostat's measurements (docs/thermostat.md).
 
-    symprk nvt cost [--quick] [--scenes water,villin] [--threads 2]   # time per step vs LangevinMiddleIntegrator
+    symprk nvt cost [--quick] [--scenes water,villin] [--threads 2] [--no-forces]  # time per step vs LangevinMiddle
     symprk nvt drift [--quick] [--replicas 3] [--length-ps 20] [--chart docs/img/nvt_work_precision.png]
 
 ``--quick`` runs in seconds (small box, few steps: a check of the pipeline, not a measurement).
@@ -48,6 +48,8 @@ def build_parser():
     c.add_argument("--steps", type=_positive_int, default=None, help="steps per timed block")
     c.add_argument("--rounds", type=_positive_int, default=None, help="rounds of blocks (each row keeps its fastest)")
     c.add_argument("--threads", type=_positive_int, default=2, help="CPU platform threads (default 2)")
+    c.add_argument("--no-forces", action="store_true",
+                   help="remove every force (constraints stay): time the integrators' own work, the thermostat's cost")
     c.add_argument("--json", default=None, help="also write the tables as JSON to this file")
     d = sub.add_parser("drift", help="effective-energy drift (kT/ns/DOF), NVT next to NVE, and its chart")
     d.add_argument("--quick", action="store_true", help="two rows, 0.2-ps runs, one replica (seconds)")
@@ -71,7 +73,8 @@ def main(argv=None) -> int:
         from .cost import run
 
         scenes = args.scenes or (["water"] if args.quick else ["water", "villin"])
-        tables = run(scenes, quick=args.quick, steps=args.steps, rounds=args.rounds, threads=args.threads)
+        tables = run(scenes, quick=args.quick, steps=args.steps, rounds=args.rounds, threads=args.threads,
+                     no_forces=args.no_forces)
         if args.json:
             _write_json(args.json, tables)
         return 0

@@ -10,12 +10,14 @@ rows without it: (t[verlet + thermostat] - t[verlet NVE]) / 2 per event (two hal
 Scenes: the periodic rigid TIP3P water box of the bench (``water-box-pme``, about 5,800 atoms, PME 0.9 nm) and
 the solvated villin headpiece (``villin-pme``, 8,867 atoms, HBonds, rigid water; equilibrated only briefly: a
 timing needs no equilibrium), the PME reciprocal space in force group 1 for the MTS rows.
-Not a test: nothing is asserted on the times.
+``--no-forces`` removes every force (constraints stay): what is left is the integrators' own work, where the
+thermostat event's cost shows.  Not a test: nothing is asserted on the times.
 """
 from __future__ import annotations
 
 import os
 
+import numpy as np
 import openmm as mm
 
 from ..timing import interleaved
@@ -56,9 +58,12 @@ def scene(name: str, quick: bool):
     return f"{sc.name}: {sc.description}", sc.system, sc.positions, sc.velocities
 
 
-def measure(system, positions, velocities, rows, steps: int, rounds: int, threads: int = 2,
+def measure(system, positions, velocities, rows, steps, rounds: int, threads: int = 2,
             platform: str = "CPU") -> dict:
-    """{row name: (seconds per step of the fastest block, force evaluations per step)}; rows take turns."""
+    """{row name: (seconds per step of the fastest block, force evaluations per step)}; rows take turns.
+    ``steps``: steps per block (an int), or a float number of seconds: each row's block is sized to last about
+    that long (from a timed warm-up block), so a 17x slower row does not take 17x the run's time and every row
+    gets equally many short blocks, the likelier to catch a quiet moment of a shared machine."""
     plat = mm.Platform.getPlatformByName(platform)
     props = {"Threads": str(threads)} if platform == "CPU" else {}
     contexts, evals = {}, {}
@@ -69,6 +74,9 @@ def measure(system, positions, velocities, rows, steps: int, rounds: int, thread
         ctx.setVelocities(velocities)
         ig.step(3)  # warm-up: neighbour lists, kernels, caches
         contexts[row.name] = (ctx, ig)
+    if isinstance(steps, float):
+        per_step = interleaved({k: lambda n, ig=ig: ig.step(n) for k, (_, ig) in contexts.items()}, 2, rounds=1)
+        steps = {k: int(min(400, max(2, round(steps / t.best)))) for k, t in per_step.items()}
 
     def stepper(ctx, ig):
         def advance(n):
@@ -77,19 +85,30 @@ def measure(system, positions, velocities, rows, steps: int, rounds: int, thread
         return advance
 
     timings = interleaved({k: stepper(*v) for k, v in contexts.items()}, steps, rounds=rounds)
-    return {k: (t.best, evals[k]) for k, t in timings.items()}
+    return {k: (t, evals[k]) for k, t in timings.items()}
 
 
-def ratios(best: dict, rows) -> list:
-    """One dict per row: seconds per step, ratio per step and per ps to the baseline, ratio to its peer."""
-    base = best[BASELINE][0]
+def paired_ratio(row, base) -> tuple:
+    """(median, 25th, 75th percentile) over rounds of the row's block time over the baseline's block time of the
+    same round: blocks run moments apart see about the same load, so the round-by-round ratio is steadier than
+    either time; the quartiles say how steady."""
+    r = np.asarray(row.blocks) / np.asarray(base.blocks)
+    return tuple(float(q) for q in np.percentile(r, [50, 25, 75]))
+
+
+def ratios(measured: dict, rows) -> list:
+    """One dict per row: seconds per step (fastest block), the ratio to the baseline (median of the round-by-round
+    ratios, with quartiles, and fastest over fastest), per ps simulated, and the ratio to its peer."""
+    base = measured[BASELINE][0]
     base_dt = next(r.step_fs for r in rows if r.name == BASELINE)
     out = []
     for r in rows:
-        t, evals = best[r.name]
-        out.append({"row": r.name, "step_fs": r.step_fs, "evals": evals, "s_per_step": t, "ratio": t / base,
-                    "ratio_per_ps": (t / r.step_fs) / (base / base_dt),
-                    "peer": r.peer, "peer_ratio": t / best[r.peer][0] if r.peer else None})
+        t, evals = measured[r.name]
+        median, q25, q75 = paired_ratio(t, base)
+        out.append({"row": r.name, "step_fs": r.step_fs, "evals": evals, "s_per_step": t.best, "ratio": median,
+                    "ratio_q25": q25, "ratio_q75": q75, "ratio_best": t.best / base.best,
+                    "ratio_per_ps": median * base_dt / r.step_fs, "peer": r.peer,
+                    "peer_ratio": paired_ratio(t, measured[r.peer][0])[0] if r.peer else None})
     return out
 
 
@@ -104,37 +123,44 @@ def event_cost(table: list) -> float | None:
 
 def format_table(title: str, table: list) -> str:
     lines = [title, f"  {'integrator':34s} {'dt fs':>5s} {'f/step':>6s} {'ms/step':>8s} {'/ Langevin':>10s} "
-                    f"{'per ps':>7s} {'/ peer':>7s}"]
+                    f"{'quartiles':>13s} {'best/best':>9s} {'per ps':>7s} {'/ peer':>7s}"]
     for r in table:
         peer = f"{r['peer_ratio']:7.3f}" if r["peer_ratio"] is not None else f"{'':7s}"
         lines.append(f"  {r['row']:34s} {r['step_fs']:5.1f} {r['evals']:6d} {r['s_per_step'] * 1e3:8.3f} "
-                     f"{r['ratio']:10.3f} {r['ratio_per_ps']:7.3f} {peer}")
+                     f"{r['ratio']:10.3f} {r['ratio_q25']:6.3f}-{r['ratio_q75']:.3f} {r['ratio_best']:9.3f} "
+                     f"{r['ratio_per_ps']:7.3f} {peer}")
     e = event_cost(table)
     if e is not None:
-        lines.append(f"  one half thermostat event: {e:+.3f} LangevinMiddle steps "
-                     f"((verlet + thermostat - verlet NVE) / 2)")
-    lines.append(f"  / Langevin: time per step over {BASELINE}Integrator's (2 fs) in the same run; per ps: the same per "
-                 f"ps simulated; / peer: over the OpenMM row it replaces")
+        lines.append(f"  one half thermostat event: {e:+.3f} LangevinMiddle steps ((verlet + thermostat - verlet NVE) / 2)")
+    lines.append(f"  ms/step: fastest block; / Langevin: median over rounds of the time per step over {BASELINE}"
+                 f"Integrator's (2 fs)\n  in the same round (quartiles beside it); best/best: fastest over fastest; "
+                 f"per ps: / Langevin per ps simulated;\n  / peer: the same median over the OpenMM row it replaces")
     return "\n".join(lines)
 
 
-def run(scenes=("water", "villin"), quick: bool = False, steps: int | None = None, rounds: int | None = None,
-        threads: int = 2, log=print) -> dict:
-    """Measure and print the cost table of every scene; returns {scene: table}."""
+def run(scenes=("water", "villin"), quick: bool = False, steps=None, rounds: int | None = None,
+        threads: int = 2, no_forces: bool = False, log=print) -> dict:
+    """Measure and print the cost table of every scene; returns {scene: table}.  ``no_forces``: every force
+    removed (constraints stay), so the table times the integrators' own work: the thermostat event's cost."""
     from ... import plugin
 
     if not plugin.available():
         raise RuntimeError(f"the native backend is unavailable: {plugin.unavailable_reason()}")
     log(f"openmm {mm.version.full_version}, platform CPU, {threads} threads, load average before "
         f"{os.getloadavg()[0]:.2f} (other processes slow some blocks; each row keeps its fastest)")
-    rows = default_rows()
+    rows = [r for r in default_rows() if not (no_forces and (r.mts or r.kind == "openmm-mtslangevin"))]  # no groups
     out = {}
     for name in scenes:
         title, system, x, v = scene(name, quick)
-        n = steps or (4 if quick else (40 if name == "water" else 25))
-        k = rounds or (2 if quick else 5)
+        if no_forces:
+            while system.getNumForces():
+                system.removeForce(0)
+            title += ", no forces (the integrators' own work)"
+        n = steps or (0.01 if quick else 0.3)
+        k = rounds or (2 if quick else 15)
         best = measure(system, x, v, rows, n, k, threads)
         out[name] = ratios(best, rows)
-        log(format_table(f"{title}: {k} rounds of {n} steps, fastest block", out[name]))
+        blocks = f"{n} steps" if isinstance(n, int) else f"blocks of ~{n:g} s"
+        log(format_table(f"{title}: {k} rounds, {blocks}, fastest block per row", out[name]))
     log(f"load average after: {os.getloadavg()[0]:.2f}")
     return out
