@@ -89,3 +89,20 @@ def test_bad_options_are_refused_with_their_value(capsys):
     with pytest.raises(SystemExit):
         symprk(["nvt", "drift", "--replicas", "0"])
     assert "must be >= 1, got 0" in capsys.readouterr().err
+
+
+@needs_native
+def test_every_drift_row_gives_a_full_finite_series():
+    """The full run's rows (NoseHoover and OpenMM's Verlet included) on a small cluster: one sample per block from
+    the end of the first block to the run's end, every effective energy finite, and the thermostat's heat-bath
+    energy in it (NVT and NVE series of the same method differ)."""
+    from openmm_symprk.systems.scenes import water_cluster
+
+    sc = water_cluster(8, temperature=300.0)
+    series = {}
+    for nvt, nve in drift.default_pairs():
+        for row in (nvt, nve):
+            t, e = drift.energy_series(row, sc.system, sc.positions, sc.velocities, 0.048, 12.0, seed=1, threads=1)
+            assert len(t) >= 3 and t[-1] == pytest.approx(0.048, abs=row.step_fs * 1e-3) and all(map(math.isfinite, e))
+            series[row.name] = e
+    assert not (series["verlet 2 fs"] == series["verlet 2 fs NVE"]).all()
