@@ -89,6 +89,12 @@ def test_bad_options_are_refused_with_their_value(capsys):
     with pytest.raises(SystemExit):
         symprk(["nvt", "drift", "--replicas", "0"])
     assert "must be >= 1, got 0" in capsys.readouterr().err
+    for bad, said in (("omelyan-2", "'omelyan-2': write method@step_fs"), ("verlet@-1", "'verlet@-1'"),
+                      ("no-such-method@2", "no-such-method")):
+        with pytest.raises(SystemExit):
+            symprk(["nvt", "drift", "--rows", bad])
+        assert said in capsys.readouterr().err
+    assert [p[0].name for p in drift.pairs_from("omelyan-4@4, nosehoover@2")] == ["pefrl 4 fs", "NoseHoover 2 fs"]
 
 
 @needs_native

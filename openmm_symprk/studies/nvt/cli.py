@@ -1,7 +1,7 @@
 """``symprk nvt cost`` and ``symprk nvt drift``: the thermostat's measurements (docs/thermostat.md).
 
     symprk nvt cost [--quick] [--scenes water,villin] [--threads 2] [--no-forces]  # time per step vs LangevinMiddle
-    symprk nvt drift [--quick] [--replicas 3] [--length-ps 20] [--chart docs/img/nvt_work_precision.png]
+    symprk nvt drift [--quick] [--replicas 3] [--length-ps 20] [--rows omelyan-2@4,...] [--chart PNG]
 
 ``--quick`` runs in seconds (small box, few steps: a check of the pipeline, not a measurement).
 """
@@ -56,6 +56,8 @@ def build_parser():
     d.add_argument("--replicas", type=_positive_int, default=None, help="independent replicas (default 3)")
     d.add_argument("--length-ps", type=_positive_float, default=None, help="length of each run (default 20 ps)")
     d.add_argument("--threads", type=_positive_int, default=2, help="CPU platform threads (default 2)")
+    d.add_argument("--rows", default=None, metavar="METHOD@FS,...",
+                   help="only these rows, e.g. omelyan-2@4,nosehoover@2 (default: the full set)")
     d.add_argument("--chart", default=None, help="write the work-precision chart (PNG) here")
     d.add_argument("--json", default=None, help="also write the table as JSON to this file")
     return p
@@ -80,7 +82,14 @@ def main(argv=None) -> int:
         return 0
     from .drift import run
 
-    result = run(quick=args.quick, replicas=args.replicas, length_ps=args.length_ps, threads=args.threads)
+    from .drift import pairs_from
+
+    try:
+        pairs = pairs_from(args.rows) if args.rows else None
+    except Exception as exc:  # a bad row: one line, exit status 2
+        build_parser().error(str(exc))
+    result = run(quick=args.quick, replicas=args.replicas, length_ps=args.length_ps, threads=args.threads,
+                 pairs=pairs)
     if args.chart:
         from .chart import work_precision
 

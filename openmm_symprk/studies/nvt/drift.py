@@ -33,14 +33,40 @@ KJ = unit.kilojoule_per_mole
 
 def default_pairs(quick: bool = False) -> list:
     """[(NVT row, NVE row of the same method and step)]."""
-    def ours(method, step):
-        return (Row(f"{method} {step:g} fs", "symprk", step, method),
-                Row(f"{method} {step:g} fs NVE", "symprk", step, method, nvt=False))
-
     if quick:
-        return [ours("verlet", 2.0), ours("omelyan-2", 4.0)]
-    return [ours("verlet", 1.0), ours("verlet", 2.0), ours("verlet", 3.0), ours("omelyan-2", 4.0), ours("pefrl", 4.0),
-            (Row("NoseHoover 2 fs", "openmm-nosehoover", 2.0), Row("OpenMM Verlet 2 fs", "openmm-verlet", 2.0))]
+        return [_ours("verlet", 2.0), _ours("omelyan-2", 4.0)]
+    return [_ours("verlet", 1.0), _ours("verlet", 2.0), _ours("verlet", 3.0), _ours("omelyan-2", 4.0),
+            _ours("pefrl", 4.0), _nose_hoover(2.0)]
+
+
+def _ours(method, step):
+    return (Row(f"{method} {step:g} fs", "symprk", step, method),
+            Row(f"{method} {step:g} fs NVE", "symprk", step, method, nvt=False))
+
+
+def _nose_hoover(step):
+    return (Row(f"NoseHoover {step:g} fs", "openmm-nosehoover", step),
+            Row(f"OpenMM Verlet {step:g} fs", "openmm-verlet", step))
+
+
+def pairs_from(text: str) -> list:
+    """Pairs from "method@step_fs,..." (catalogue names; ``nosehoover`` for OpenMM's NoseHooverIntegrator next to
+    its VerletIntegrator); ValueError naming a bad entry."""
+    from ...methods.catalogue import get_method
+
+    out = []
+    for item in (s.strip() for s in text.split(",") if s.strip()):
+        method, _, step = item.partition("@")
+        try:
+            step_fs = float(step)
+        except ValueError:
+            step_fs = float("nan")
+        if not step_fs > 0:
+            raise ValueError(f"row {item!r}: write method@step_fs, e.g. omelyan-2@4 or nosehoover@2")
+        out.append(_nose_hoover(step_fs) if method == "nosehoover" else _ours(get_method(method).name, step_fs))
+    if not out:
+        raise ValueError(f"no rows in {text!r}: write method@step_fs,..., e.g. verlet@2,omelyan-2@4")
+    return out
 
 
 def water_box_scene(equilibrate_ps: float, threads: int):
@@ -83,7 +109,7 @@ def energy_series(row: Row, system, x, v, length_ps: float, sample_fs: float, se
 
 
 def run(quick: bool = False, replicas: int | None = None, length_ps: float | None = None, threads: int = 2,
-        log=print) -> dict:
+        pairs=None, log=print) -> dict:
     """Measure every pair over ``replicas`` replicas; prints the table and returns it as JSON-ready data."""
     from ...systems.prepare import equilibrate
     from ...systems.properties import thermostat_degrees_of_freedom
@@ -91,7 +117,7 @@ def run(quick: bool = False, replicas: int | None = None, length_ps: float | Non
     replicas = replicas or (1 if quick else 3)
     length_ps = length_ps or (0.2 if quick else 20.0)
     sample_fs = 8.0 if quick else 20.0
-    pairs = default_pairs(quick)
+    pairs = pairs or default_pairs(quick)
     system, x, v = water_box_scene(0.1 if quick else 2.0, threads)
     dof = thermostat_degrees_of_freedom(system, isolated=False)
     per_dof = 1000.0 / (R_KJ * TEMPERATURE * dof)  # kJ/mol/ps -> kT/ns/DOF
