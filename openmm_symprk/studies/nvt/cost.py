@@ -1,11 +1,12 @@
 """Time per step of NVT integrators against OpenMM's LangevinMiddleIntegrator, in the same run (``symprk nvt cost``).
 
-Every row is timed with :func:`openmm_symprk.studies.timing.interleaved` (the rows take turns, round after round,
-and each keeps its fastest block), on the CPU platform with a fixed thread count, from one shared state.  The
-ratio of a row is its time per step over LangevinMiddleIntegrator's (2 fs) in the same run; rows that replace
-another OpenMM integrator (MTSLangevinIntegrator, VerletIntegrator) also get the ratio to it.  "per ps" divides
-by the step size, for rows whose method is run at a longer step.  The thermostat's own cost follows from the
-rows without it: (t[verlet + thermostat] - t[verlet NVE]) / 2 per event (two half events per step).
+Every row is timed with :func:`openmm_symprk.studies.timing.interleaved` (the rows take turns in blocks of about
+the same duration, round after round), on the CPU platform with a fixed thread count, from one shared state.  The
+ratio of a row is the median over rounds of its time per step over LangevinMiddleIntegrator's (2 fs) in the same
+round, with the quartiles (blocks run moments apart share the machine's load); rows that replace another OpenMM
+integrator (MTSLangevinIntegrator, VerletIntegrator) also get the ratio to it.  "per ps" divides by the step
+size, for rows whose method is run at a longer step.  The thermostat's own cost follows from the rows without
+it: (t[verlet + thermostat] - t[verlet NVE]) / 2 per event (two half events per step).
 
 Scenes: the periodic rigid TIP3P water box of the bench (``water-box-pme``, about 5,800 atoms, PME 0.9 nm) and
 the solvated villin headpiece (``villin-pme``, 8,867 atoms, HBonds, rigid water; equilibrated only briefly: a
