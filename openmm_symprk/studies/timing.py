@@ -2,14 +2,15 @@
 
 Wall-time ratios between integrators are only meaningful when they are measured in the same run under the
 same load.  :func:`interleaved` runs every stepper for a block of steps in turn, round after round, and
-keeps each one's fastest block (load from other processes only ever slows a block down) and its total.
+keeps each one's fastest block (load from other processes only ever slows a block down), its total and every
+block's time (so that a ratio can be taken round by round, between blocks run moments apart).
 Used by ``symprk demo``, the bench (each run against OpenMM's VerletIntegrator), the conservation table
 (projection on/off) and the native speed study.
 """
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 __all__ = ["Timing", "interleaved"]
 
@@ -19,6 +20,7 @@ class Timing:
     best: float  # seconds per step of the fastest block
     total: float  # seconds over all blocks
     steps: int  # steps timed in all
+    blocks: list = field(default_factory=list)  # seconds per step of each block, in round order
 
     @property
     def mean(self) -> float:
@@ -43,6 +45,7 @@ def interleaved(steppers: dict, steps: int, rounds: int = 3, after=None) -> dict
             dt = time.perf_counter() - t0
             rec = out[name]
             rec.best = min(rec.best, dt / n)
+            rec.blocks.append(dt / n)
             rec.total += dt
             rec.steps += n
             if after is not None:

@@ -1,0 +1,46 @@
+"""The NVT work-precision chart: the effective-energy drift (kT/ns/DOF, signed, one standard error) against force
+evaluations per ps, NVT rows filled, the NVE drift of the same method and step hollow beside it (matplotlib, Agg
+backend, PNG).  The y axis is symmetric-logarithmic: linear within +-0.01 kT/ns/DOF, so a drift consistent with
+zero shows as such and the sign is kept."""
+from __future__ import annotations
+
+import os
+
+from ...support import require
+
+
+def work_precision(result: dict, path: str) -> str:
+    require("matplotlib", "studies", "openmm_symprk.studies.nvt.chart").use("Agg")
+    plt = require("matplotlib.pyplot", "studies", "openmm_symprk.studies.nvt.chart")
+    fig, ax = plt.subplots(figsize=(7.0, 4.6))
+    colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    xs = [r["evals_per_ps"] for r in result["rows"]]
+    for i, r in enumerate(result["rows"]):
+        c = colours[i % len(colours)]
+        x = xs[i]
+        same = [j for j, y in enumerate(xs) if y == x]  # rows of one cost side by side
+        x *= 1.1 ** (same.index(i) - (len(same) - 1) / 2)
+        for key, fill, dx in (("nvt", c, 0.98), ("nve", "white", 1.02)):
+            d = r[key]
+            if d:
+                ax.errorbar([x * dx], [d["mean"]], yerr=[d["se"]], fmt="o", mfc=fill, mec=c, ecolor=c, capsize=3,
+                            label=r["nvt_row"] if key == "nvt" else None)
+    ax.axhline(0.0, color="grey", lw=0.8)
+    ax.set_xscale("log")
+    ax.set_yscale("symlog", linthresh=0.01)
+    ticker = require("matplotlib.ticker", "studies", "openmm_symprk.studies.nvt.chart")
+    ax.xaxis.set_major_formatter(ticker.ScalarFormatter())
+    ax.xaxis.set_minor_formatter(ticker.NullFormatter())
+    ax.set_xticks(sorted(set(xs)))
+    ax.set_xlim(min(xs) / 1.4, max(xs) * 1.4)
+    ax.set_xlabel("force evaluations per ps (cost)")
+    ax.set_ylabel("drift of the (effective) energy, kT/ns/DOF")
+    ax.set_title(f"NVT (filled: total + heat-bath energy) and NVE (hollow), {result['replicas']} x "
+                 f"{result['length_ps']:g} ps\n{result['scene']}, {result['platform']}", fontsize=9)
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path

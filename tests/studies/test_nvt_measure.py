@@ -1,0 +1,114 @@
+"""``symprk nvt cost`` and ``symprk nvt drift`` end to end in their --quick modes (seconds): every row measured,
+ratios positive and finite, drift estimates with an error bar, the tables print, the chart is written.  Nothing
+here asserts a timing (the figures are in docs/thermostat.md, from the full commands)."""
+import json
+import math
+
+import openmm as mm
+import pytest
+
+from openmm_symprk import plugin
+from openmm_symprk.cli import main as symprk
+from openmm_symprk.studies.nvt import cost, drift, rows
+
+needs_native = pytest.mark.skipif(not plugin.available(), reason="native plugin not built")
+
+
+def test_every_row_kind_builds_its_integrator():
+    from openmm_symprk.systems.scenes import water_cluster
+
+    system = water_cluster(4).system
+    expected = {"openmm-langevin": mm.LangevinMiddleIntegrator, "openmm-nosehoover": mm.NoseHooverIntegrator,
+                "openmm-dpd": mm.DPDIntegrator, "openmm-mtslangevin": mm.MTSLangevinIntegrator,
+                "openmm-verlet": mm.VerletIntegrator}
+    for kind, cls in expected.items():
+        ig, evals = rows.build(rows.Row(kind, kind, 2.0), system)
+        assert isinstance(ig, cls) and evals == (3 if kind == "openmm-mtslangevin" else 1)
+    ig, evals = rows.build(rows.Row("v", "symprk", 2.0, "omelyan-2", interval=10), system, backend="custom")
+    assert evals == 2 and ig.getThermostatInterval() == 10
+    assert ig.getTemperature().value_in_unit(mm.unit.kelvin) == rows.TEMPERATURE
+    nve, _ = rows.build(rows.Row("v", "symprk", 2.0, "verlet", nvt=False), system, backend="custom")
+    assert nve.thermostat is None
+    with pytest.raises(ValueError, match="'bogus'.*openmm-langevin"):
+        rows.build(rows.Row("x", "bogus", 2.0), system)
+
+
+@needs_native
+def test_cost_quick_measures_every_row(capsys):
+    out = cost.run(scenes=("water",), quick=True, steps=2, rounds=3)
+    table = out["water"]
+    names = [r.name for r in cost.default_rows()]
+    assert [r["row"] for r in table] == names
+    for r in table:
+        assert r["s_per_step"] > 0 and math.isfinite(r["ratio"]) and r["ratio"] > 0, r
+        assert 0 < r["ratio_q25"] <= r["ratio"] <= r["ratio_q75"] and math.isfinite(r["ratio_q75"])
+        assert r["ratio_best"] > 0 and math.isfinite(r["ratio_best"])
+        assert math.isfinite(r["ratio_per_ps"]) and r["ratio_per_ps"] > 0
+        assert (r["peer_ratio"] is None) == (not r["peer"]) and (r["peer_ratio"] is None or r["peer_ratio"] > 0)
+    by = {r["row"]: r for r in table}
+    assert by[cost.BASELINE]["ratio"] == 1.0 == by[cost.BASELINE]["ratio_q75"]  # block by block against itself
+    assert by["omelyan-2 + thermostat"]["ratio_per_ps"] == pytest.approx(by["omelyan-2 + thermostat"]["ratio"] / 2)
+    assert math.isfinite(cost.event_cost(table))
+    printed = capsys.readouterr().out
+    assert all(n in printed for n in names) and "one half thermostat event" in printed
+
+
+def test_interleaved_keeps_every_block():
+    from openmm_symprk.studies.timing import interleaved
+
+    done = []
+    out = interleaved({"a": done.append, "b": done.append}, {"a": 2, "b": 3}, rounds=4)
+    assert done == [2, 3] * 4
+    for t in out.values():
+        assert len(t.blocks) == 4 and t.best == min(t.blocks)
+        assert t.total == pytest.approx(sum(b * (t.steps // 4) for b in t.blocks))
+
+
+@needs_native
+def test_drift_quick_gives_estimates_with_errors_and_a_chart(tmp_path, capsys):
+    chart, data = tmp_path / "img" / "nvt.png", tmp_path / "nvt.json"
+    assert symprk(["nvt", "drift", "--quick", "--chart", str(chart), "--json", str(data)]) == 0
+    result = json.loads(data.read_text())
+    assert result["replicas"] == 1 and result["dof"] == 3 * 648 - 3 * 216 - 3
+    assert [r["nvt_row"] for r in result["rows"]] == [p[0].name for p in drift.default_pairs(quick=True)]
+    for r in result["rows"]:
+        for key in ("nvt", "nve", "difference"):
+            est = r[key]
+            assert est is not None and math.isfinite(est["mean"]) and est["se"] > 0 and math.isfinite(est["se"]), r
+        # the paired difference is the difference of the two rows (one replica)
+        assert r["difference"]["mean"] == pytest.approx(r["nvt"]["mean"] - r["nve"]["mean"])
+    printed = capsys.readouterr().out
+    assert "NVT - NVE (paired)" in printed and all(r["nvt_row"] in printed for r in result["rows"])
+    assert chart.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_bad_options_are_refused_with_their_value(capsys):
+    with pytest.raises(SystemExit) as exc:
+        symprk(["nvt", "cost", "--scenes", "water,protein"])
+    assert exc.value.code == 2 and "protein" in capsys.readouterr().err
+    with pytest.raises(SystemExit):
+        symprk(["nvt", "drift", "--replicas", "0"])
+    assert "must be >= 1, got 0" in capsys.readouterr().err
+    for bad, said in (("omelyan-2", "'omelyan-2': write method@step_fs"), ("verlet@-1", "'verlet@-1'"),
+                      ("no-such-method@2", "no-such-method")):
+        with pytest.raises(SystemExit):
+            symprk(["nvt", "drift", "--rows", bad])
+        assert said in capsys.readouterr().err
+    assert [p[0].name for p in drift.pairs_from("omelyan-4@4, nosehoover@2")] == ["pefrl 4 fs", "NoseHoover 2 fs"]
+
+
+@needs_native
+def test_every_drift_row_gives_a_full_finite_series():
+    """The full run's rows (NoseHoover and OpenMM's Verlet included) on a small cluster: one sample per block from
+    the end of the first block to the run's end, every effective energy finite, and the thermostat's heat-bath
+    energy in it (NVT and NVE series of the same method differ)."""
+    from openmm_symprk.systems.scenes import water_cluster
+
+    sc = water_cluster(8, temperature=300.0)
+    series = {}
+    for nvt, nve in drift.default_pairs():
+        for row in (nvt, nve):
+            t, e = drift.energy_series(row, sc.system, sc.positions, sc.velocities, 0.048, 12.0, seed=1, threads=1)
+            assert len(t) >= 3 and t[-1] == pytest.approx(0.048, abs=row.step_fs * 1e-3) and all(map(math.isfinite, e))
+            series[row.name] = e
+    assert not (series["verlet 2 fs"] == series["verlet 2 fs NVE"]).all()
