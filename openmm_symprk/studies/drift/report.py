@@ -54,10 +54,8 @@ def summarise(cfg: dict, found: dict, skipped=()) -> dict:
             "openmm_published": OPENMM_PUBLISHED if cfg.get("study") == "exact-momentum" else None}
 
 
-def _pm(d, spec=".2e"):
-    if not d:
-        return "-"
-    return f"{d['mean']:+{spec}} ± {d['se']:{spec[1:] if spec.startswith('+') else spec}}"
+def _pm(d):
+    return f"{d['mean']:+.2e} ± {d['se']:.2e}" if d else "-"
 
 
 def format_summary(s: dict) -> str:

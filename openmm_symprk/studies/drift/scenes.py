@@ -25,7 +25,7 @@ __all__ = ["SCENES", "build", "replica_states", "state_key", "STATE_VERSION"]
 
 #: Version of the stored scenes and replica states (a change never reuses stale ones).
 STATE_VERSION = 1
-#: name -> (periodic?, description)
+#: The scenes: name -> what it is.
 SCENES = {
     "villin-pme": "solvated villin (8,867 atoms), PME, HBonds, rigid water (the bench's production scene)",
     "villin-pme-hmr": "the same with HMR 1.5 Da (the bench's production scene)",
