@@ -1,5 +1,5 @@
 """The ``symprk`` command: demo, methods, check, info, and the studies (bench, conservation, speed,
-equipartition, fidelity).
+equipartition, fidelity, drift).
 
 Every error the user can cause (a bad name, file, platform, value, a blow-up) ends in one line on stderr
 and a non-zero exit status; only a bug shows a traceback.
@@ -161,7 +161,7 @@ def build_parser():
 DELEGATED = {"bench": "openmm_symprk.studies.bench.cli", "conservation": "openmm_symprk.studies.conservation_table",
              "speed": "openmm_symprk.studies.native_speed", "gpucheck": "openmm_symprk.studies.gpucheck",
              "equipartition": "openmm_symprk.studies.equipartition.cli", "fidelity": "openmm_symprk.studies.fidelity.cli",
-             "nvt": "openmm_symprk.studies.nvt.cli"}
+             "nvt": "openmm_symprk.studies.nvt.cli", "drift": "openmm_symprk.studies.drift.cli"}
 DELEGATED_HELP = {"bench": "work-precision and stability sweeps (symprk bench --help)",
                   "conservation": "conservation table: platform x method x projection (symprk conservation --help)",
                   "speed": "native backend vs OpenMM's VerletIntegrator, time per step (symprk speed --help)",
@@ -169,7 +169,9 @@ DELEGATED_HELP = {"bench": "work-precision and stability sweeps (symprk bench --
                   "equipartition": "rigid water: T_rot - T_trans per method and step (symprk equipartition --help)",
                   "fidelity": "rigid water: diffusion, reorientation, omega ACF, g(r), energies per integrator, step and "
                               "thermostat (symprk fidelity --help)",
-                  "nvt": "thermostat: cost vs LangevinMiddleIntegrator, effective-energy drift (symprk nvt --help)"}
+                  "nvt": "thermostat: cost vs LangevinMiddleIntegrator, effective-energy drift (symprk nvt --help)",
+                  "drift": "NVE energy drift over replicas, paired rows, verdict at 3 SE: hmr, exact-momentum "
+                           "(symprk drift --help)"}
 
 
 def _user_errors():

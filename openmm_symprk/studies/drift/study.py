@@ -1,0 +1,141 @@
+"""The drift study on the studies' skeleton: replica states per scene, one stored NVE run per (row, replica).
+
+``<out>/states/`` holds the scenes and their replica states (:mod:`.scenes`), ``<out>/runs/<key>.json`` + ``.npz``
+one finished run each.  A run's key hashes everything it depends on (the row, the replica, the run length, the
+sampling, the constraint tolerance, the threads and the key of its replica states), so calling the study again
+reuses every finished run, and a changed setting never reuses a stale one.  ``summary.txt`` and ``results.json``
+are rewritten from the stored runs at every call.
+"""
+from __future__ import annotations
+
+import os
+
+from ..core import Run, Study, run_key as hash_key, write_json, write_text
+from .scenes import replica_states, state_key
+
+__all__ = ["DriftStudy", "run_study", "run_key", "check"]
+
+#: Version of what a run stores (a change never reuses stale runs).
+RUN_VERSION = 1
+_RUN_KEYS = ("length_ps", "sample_ps", "constraint_tolerance", "threads", "temperature")
+_ROW_KEYS = ("scene", "integrator", "step_fs", "platform", "precision", "exact_momentum")
+
+
+def run_key(cfg: dict, row: dict, replica: int) -> str:
+    return hash_key({"cfg": {k: cfg[k] for k in _RUN_KEYS}, "row": {k: row.get(k) for k in _ROW_KEYS},
+                     "replica": int(replica), "states": state_key(cfg, row["scene"]), "version": RUN_VERSION})
+
+
+def check(cfg: dict):
+    """ValueError naming the bad value and what is accepted."""
+    from .scenes import SCENES
+
+    if int(cfg["replicas"]) < 1:
+        raise ValueError(f"replicas must be >= 1, got {cfg['replicas']!r}")
+    for k in ("length_ps", "sample_ps", "temperature", "constraint_tolerance"):
+        if not float(cfg[k]) > 0:
+            raise ValueError(f"{k} must be positive, got {cfg[k]!r}")
+    if float(cfg["decorrelate_ps"]) < 0:
+        raise ValueError(f"decorrelate_ps must be >= 0, got {cfg['decorrelate_ps']!r}")
+    names = [r["name"] for r in cfg["rows"]]
+    if len(set(names)) != len(names):
+        raise ValueError(f"row names must be unique, got {names}")
+    for row in cfg["rows"]:
+        if row["scene"] not in SCENES:
+            raise ValueError(f"row {row['name']}: unknown scene {row['scene']!r}; known: {', '.join(SCENES)}")
+        if not float(row["step_fs"]) > 0:
+            raise ValueError(f"row {row['name']}: step_fs must be positive, got {row['step_fs']!r}")
+        if row["integrator"] != "openmm-verlet":
+            from ...methods.catalogue import get_method
+
+            get_method(row["integrator"])  # UnknownMethodError names the catalogue
+        n = float(cfg["length_ps"]) * 1e3 / float(row["step_fs"])
+        if round(n) < 3:
+            raise ValueError(f"row {row['name']}: {cfg['length_ps']} ps is under 3 steps of {row['step_fs']} fs")
+    for c in cfg["comparisons"]:
+        for k in ("row", "ref"):
+            if c[k] not in names:
+                raise ValueError(f"comparison {c}: no row named {c[k]!r} (rows: {', '.join(names)})")
+
+
+def available(platform: str) -> bool:
+    import openmm as mm
+
+    try:
+        mm.Platform.getPlatformByName(platform)
+        return True
+    except Exception:
+        return False
+
+
+_systems: dict = {}
+
+
+def work(shared: dict, row: dict, replica: int, cfg: dict):
+    """One NVE run in whatever process executes it (each scene's System deserialised once per process)."""
+    import openmm as mm
+
+    from .runs import run_nve
+
+    key = (row["scene"], len(shared["xml"]), hash(shared["xml"]))
+    if key not in _systems:
+        _systems[key] = mm.XmlSerializer.deserialize(shared["xml"])
+    return run_nve(_systems[key], shared["x"][replica], shared["v"][replica], row, cfg)
+
+
+class DriftStudy(Study):
+    """Rows x replicas of NVE runs, summarised as drifts with error bars and paired verdicts."""
+
+    command = "symprk drift"
+    work = work
+
+    def __init__(self, cfg: dict, out: str, workers: int = 1, progress: bool = True, log=print,
+                 scheduler: str | None = None):
+        check(cfg)
+        super().__init__(out, workers, scheduler, progress, log)
+        self.cfg = cfg
+        self.states: dict = {}
+        self.skipped: list = []
+
+    def rows(self) -> list:
+        """The rows whose platform this installation has."""
+        rows, self.skipped = [], []
+        for row in self.cfg["rows"]:
+            (rows if available(row["platform"]) else self.skipped).append(row)
+        for row in self.skipped:
+            self.log(f"skipping row {row['name']}: no OpenMM platform {row['platform']} here")
+        return rows
+
+    def plan(self) -> list:
+        cfg = self.cfg
+        rows = self.rows()
+        self.states = {s: replica_states(cfg, s, self.out, self.log) for s in dict.fromkeys(r["scene"] for r in rows)}
+        runs = []
+        for row in rows:
+            cost = float(cfg["length_ps"]) / float(row["step_fs"]) * (10.0 if "pme" in row["scene"] else 1.0)
+            for r in range(int(cfg["replicas"])):
+                runs.append(Run(run_key(cfg, row, r), row["scene"], (row, r, cfg),
+                                {"row": row["name"], "replica": r, "scene": row["scene"]}, cost))
+        return runs
+
+    def shared(self, runs) -> dict:
+        return {s: {"xml": st["xml"], "x": st["x"], "v": st["v"]} for s, st in self.states.items()}
+
+    def stored(self, run, info):
+        if info["status"] != "ok":
+            self.log(f"{info['row']} replica {info['replica']}: {info['status']} ({info.get('failure')})")
+
+    def summarise(self, runs) -> dict:
+        from .report import format_summary, summarise
+
+        found = self.results(runs, ("row",))
+        summary = summarise(self.cfg, {k[0]: v for k, v in found.items()}, skipped=[r["name"] for r in self.skipped])
+        write_json(os.path.join(self.out, "results.json"), summary)
+        write_text(os.path.join(self.out, "summary.txt"), format_summary(summary) + "\n")
+        return summary
+
+
+def run_study(cfg: dict, out: str, workers: int = 1, progress: bool = True, log=print,
+              scheduler: str | None = None) -> dict:
+    """Run (or finish, or only re-summarise) the study in ``out``; returns the summary (:func:`.report.summarise`)."""
+    return DriftStudy(cfg, out, workers, progress, log, scheduler).run()
