@@ -9,21 +9,11 @@ from __future__ import annotations
 import argparse
 import sys
 
+from .studies.core.cli import positive
+
 
 class CommandError(Exception):
     """A user-facing error of a sub-command: printed as one line, exit status 2."""
-
-
-def _positive(kind):
-    def parse(text):
-        try:
-            value = kind(text)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
-        if not value > 0:
-            raise argparse.ArgumentTypeError(f"must be positive, got {text}")
-        return value
-    return parse
 
 
 def _platform_name(name: str) -> str:
@@ -132,9 +122,9 @@ def build_parser():
 
     d = sub.add_parser("demo", help="spinning rigid-water cluster: conservation vs OpenMM's Verlet")
     d.add_argument("--method", nargs="+", default=["verlet", "yoshida-4"], help="catalogue names")
-    d.add_argument("--waters", type=_positive(int), default=64)
-    d.add_argument("--steps", type=_positive(int), default=2000)
-    d.add_argument("--step-fs", type=_positive(float), default=2.0)
+    d.add_argument("--waters", type=positive(int), default=64)
+    d.add_argument("--steps", type=positive(int), default=2000)
+    d.add_argument("--step-fs", type=positive(float), default=2.0)
     d.add_argument("--platform", default="Reference")
     d.add_argument("--backend", default="auto", choices=("auto", "native", "custom"))
     d.set_defaults(func=_cmd_demo)

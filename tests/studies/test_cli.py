@@ -46,7 +46,8 @@ def test_errors_are_one_line_and_exit_2(argv, message, capsys):
 
 @pytest.mark.parametrize("argv,message", [(["demo", "--steps", "0"], "must be positive, got 0"),
                                           (["demo", "--step-fs", "-1"], "must be positive, got -1"),
-                                          (["demo", "--waters", "x"], "'x' is not a number")])
+                                          (["demo", "--waters", "x"], "'x' is not an integer"),
+                                          (["demo", "--step-fs", "x"], "'x' is not a number")])
 def test_bad_numbers_are_refused_by_the_parser(argv, message, capsys):
     with pytest.raises(SystemExit) as exc:
         main(argv)

@@ -88,7 +88,7 @@ def test_bad_options_are_refused_with_their_value(capsys):
     assert exc.value.code == 2 and "protein" in capsys.readouterr().err
     with pytest.raises(SystemExit):
         symprk(["nvt", "drift", "--replicas", "0"])
-    assert "must be >= 1, got 0" in capsys.readouterr().err
+    assert "must be positive, got 0" in capsys.readouterr().err
     for bad, said in (("omelyan-2", "'omelyan-2': write method@step_fs"), ("verlet@-1", "'verlet@-1'"),
                       ("no-such-method@2", "no-such-method")):
         with pytest.raises(SystemExit):

@@ -17,6 +17,8 @@ import json
 import os
 import sys
 
+from ..core.cli import positive
+
 
 def _list(values):
     """Accept both ``--x a b`` and ``--x a,b``."""
@@ -26,16 +28,6 @@ def _list(values):
     for v in values:
         out += [s for s in v.split(",") if s]
     return out
-
-
-def _positive_float(text):
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
-    if not value > 0:
-        raise argparse.ArgumentTypeError(f"must be positive, got {text}")
-    return value
 
 
 def _check_platform(name):
@@ -74,7 +66,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--methods", nargs="+", metavar="NAME",
                    help="rows: catalogue names (symprk methods) and/or openmm-verlet, openmm-langevin")
     p.add_argument("--steps-fs", nargs="+", metavar="H", help="step sizes (fs) for every selected scene")
-    p.add_argument("--length-ps", type=_positive_float, help="run length (ps) for every selected scene")
+    p.add_argument("--length-ps", type=positive(float), help="run length (ps) for every selected scene")
     p.add_argument("--no-stability", action="store_true", help="skip the stability searches")
     p.add_argument("--workers", type=int, default=2, help="local worker processes (<= 1: in this process)")
     p.add_argument("--scheduler", metavar="ADDRESS",

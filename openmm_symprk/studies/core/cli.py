@@ -2,11 +2,27 @@
 checked before anything runs, finished runs kept on Ctrl-C, one-line errors with exit status 2)."""
 from __future__ import annotations
 
+import argparse
 import os
 import sys
 from importlib import import_module
 
-__all__ = ["add_study_arguments", "run_study_command"]
+__all__ = ["positive", "add_study_arguments", "run_study_command"]
+
+
+def positive(kind=float):
+    """An argparse type: a number of type ``kind`` (int or float) that is > 0, refused with the value given."""
+    noun = "an integer" if kind is int else "a number"
+
+    def parse(text):
+        try:
+            value = kind(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{text!r} is not {noun}") from None
+        if not value > 0:
+            raise argparse.ArgumentTypeError(f"must be positive, got {text}")
+        return value
+    return parse
 
 
 def add_study_arguments(ap, *, quick: str, out: str, workers: str, length: str) -> None:

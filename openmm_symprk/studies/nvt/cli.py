@@ -10,25 +10,7 @@ from __future__ import annotations
 import argparse
 import json
 
-
-def _positive_int(text):
-    try:
-        n = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not an integer") from None
-    if n < 1:
-        raise argparse.ArgumentTypeError(f"must be >= 1, got {text}")
-    return n
-
-
-def _positive_float(text):
-    try:
-        x = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
-    if not x > 0:
-        raise argparse.ArgumentTypeError(f"must be positive, got {text}")
-    return x
+from ..core.cli import positive
 
 
 def _scenes(text):
@@ -45,17 +27,17 @@ def build_parser():
     c = sub.add_parser("cost", help="time per step against OpenMM's LangevinMiddleIntegrator (CPU platform)")
     c.add_argument("--quick", action="store_true", help="small water box, few steps (seconds)")
     c.add_argument("--scenes", type=_scenes, default=None, help="water,villin (default both; --quick: water)")
-    c.add_argument("--steps", type=_positive_int, default=None, help="steps per timed block")
-    c.add_argument("--rounds", type=_positive_int, default=None, help="rounds of blocks (each row keeps its fastest)")
-    c.add_argument("--threads", type=_positive_int, default=2, help="CPU platform threads (default 2)")
+    c.add_argument("--steps", type=positive(int), default=None, help="steps per timed block")
+    c.add_argument("--rounds", type=positive(int), default=None, help="rounds of blocks (each row keeps its fastest)")
+    c.add_argument("--threads", type=positive(int), default=2, help="CPU platform threads (default 2)")
     c.add_argument("--no-forces", action="store_true",
                    help="remove every force (constraints stay): time the integrators' own work, the thermostat's cost")
     c.add_argument("--json", default=None, help="also write the tables as JSON to this file")
     d = sub.add_parser("drift", help="effective-energy drift (kT/ns/DOF), NVT next to NVE, and its chart")
     d.add_argument("--quick", action="store_true", help="two rows, 0.2-ps runs, one replica (seconds)")
-    d.add_argument("--replicas", type=_positive_int, default=None, help="independent replicas (default 3)")
-    d.add_argument("--length-ps", type=_positive_float, default=None, help="length of each run (default 20 ps)")
-    d.add_argument("--threads", type=_positive_int, default=2, help="CPU platform threads (default 2)")
+    d.add_argument("--replicas", type=positive(int), default=None, help="independent replicas (default 3)")
+    d.add_argument("--length-ps", type=positive(float), default=None, help="length of each run (default 20 ps)")
+    d.add_argument("--threads", type=positive(int), default=2, help="CPU platform threads (default 2)")
     d.add_argument("--rows", default=None, metavar="METHOD@FS,...",
                    help="only these rows, e.g. omelyan-2@4,nosehoover@2 (default: the full set)")
     d.add_argument("--chart", default=None, help="write the work-precision chart (PNG) here")
