@@ -182,44 +182,61 @@ def _emit_mass(ig):
     ig.addComputePerDof(mass, f"select(step({MASS_TOLERANCE!r}*m - abs({mass} - m)), {mass}, m)")
 
 
+def emit_second_moments(ig, name, mass: str) -> None:
+    """The sums name('mx<a>') = sum mass x_a and name('q<ab>') = sum mass x_a x_b (the pairs of _PAIRS), on the
+    scalar path: ``name('e<a>')`` are the unit vectors and ``name('xp')`` the per-DOF cyclic permutation
+    (x_y, x_z, x_x) of x, both already set.  ``name`` maps a short name to the program's variable."""
+    e = {a: name(f"e{a}") for a in _AXES}
+    for a in _AXES:
+        ig.addComputeSum(name(f"mx{a}"), f"{mass}*x*{e[a]}")
+    for a in _AXES:
+        ig.addComputeSum(name(f"q{a}{a}"), f"{mass}*x*x*{e[a]}")
+    for a, p in zip(_AXES, ("xy", "yz", "zx")):  # x * xp = (x_x x_y, x_y x_z, x_z x_x)
+        ig.addComputeSum(name(f"q{p}"), f"{mass}*x*{name('xp')}*{e[a]}")
+
+
+def emit_inertia(ig, name, M: str, centre: dict, shift: str | None = None) -> None:
+    """From the second moments of :func:`emit_second_moments`, the total mass ``M`` and the point ``centre``
+    (axis -> variable): the inertia tensor about the centre, name('I<ab>'), and the adjugate name('adj<ab>') and
+    determinant name('det') of I (plus ``shift`` on its diagonal, a regularisation, when given).  With the
+    second moments about the centre C_ab = sum m x_a x_b - M c_a c_b, I = tr(C) 1 - C."""
+    C = {p: f"({name(f'q{p}')} - {M}*{centre[p[0]]}*{centre[p[1]]})" for p in _PAIRS}
+    ig.addComputeGlobal(name("Ixx"), f"{C['yy']} + {C['zz']}")
+    ig.addComputeGlobal(name("Iyy"), f"{C['xx']} + {C['zz']}")
+    ig.addComputeGlobal(name("Izz"), f"{C['xx']} + {C['yy']}")
+    for p in ("xy", "yz", "zx"):
+        ig.addComputeGlobal(name(f"I{p}"), f"-{C[p]}")
+    if shift is None:
+        A, B, Z = (name(f"I{p}") for p in ("xx", "yy", "zz"))
+    else:
+        A, B, Z = (f"({name(f'I{p}')} + {shift})" for p in ("xx", "yy", "zz"))
+    D, E, Fy = name("Ixy"), name("Izx"), name("Iyz")
+    ig.addComputeGlobal(name("adjxx"), f"{B}*{Z} - {Fy}*{Fy}")
+    ig.addComputeGlobal(name("adjyy"), f"{A}*{Z} - {E}*{E}")
+    ig.addComputeGlobal(name("adjzz"), f"{A}*{B} - {D}*{D}")
+    ig.addComputeGlobal(name("adjxy"), f"{E}*{Fy} - {Z}*{D}")
+    ig.addComputeGlobal(name("adjzx"), f"{D}*{Fy} - {B}*{E}")
+    ig.addComputeGlobal(name("adjyz"), f"{D}*{E} - {A}*{Fy}")
+    ig.addComputeGlobal(name("det"), f"{A}*{name('adjxx')} + {D}*{name('adjxy')} + {E}*{name('adjzx')}")
+
+
 def _emit_geometry(ig):
     """Centre of mass, inertia tensor about it and its regularised adjugate/determinant, at x."""
     g = _g
     mass = g("mass")
-    e = {a: g(f"e{a}") for a in _AXES}
     # cyclic permutations (y, z, x) and (z, x, y): the only vector-function passes of a correction
     ig.addComputePerDof(g("xp"), "vector(_y(x), _z(x), _x(x))")
     ig.addComputePerDof(g("xpp"), "vector(_z(x), _x(x), _y(x))")
     ig.addComputeSum(g("M3"), mass)  # 3M: the scalar mass counts once per component
-    for a in _AXES:
-        ig.addComputeSum(g(f"mx{a}"), f"{mass}*x*{e[a]}")
-    for a in _AXES:
-        ig.addComputeSum(g(f"q{a}{a}"), f"{mass}*x*x*{e[a]}")
-    for a, p in zip(_AXES, ("xy", "yz", "zx")):  # x * xp = (x_x x_y, x_y x_z, x_z x_x)
-        ig.addComputeSum(g(f"q{p}"), f"{mass}*x*{g('xp')}*{e[a]}")
+    emit_second_moments(ig, g, mass)
     M = g("M")
     ig.addComputeGlobal(M, f"{g('M3')}/3")
     inv = f"select({M}, 1/{M}, 0)"
     for a in _AXES:
         ig.addComputeGlobal(g(f"c{a}"), f"{g(f'mx{a}')}*{inv}")
     c = {a: g(f"c{a}") for a in _AXES}
-    # second moments about the centre of mass C_ab = sum m x_a x_b - M c_a c_b; I = tr(C) 1 - C
-    C = {p: f"({g(f'q{p}')} - {M}*{c[p[0]]}*{c[p[1]]})" for p in _PAIRS}
-    ig.addComputeGlobal(g("Ixx"), f"{C['yy']} + {C['zz']}")
-    ig.addComputeGlobal(g("Iyy"), f"{C['xx']} + {C['zz']}")
-    ig.addComputeGlobal(g("Izz"), f"{C['xx']} + {C['yy']}")
-    for p in ("xy", "yz", "zx"):
-        ig.addComputeGlobal(g(f"I{p}"), f"-{C[p]}")
     shift = f"{REGULARISATION!r}*({g('Ixx')} + {g('Iyy')} + {g('Izz')})"
-    A, B, Z = (f"({g(f'I{p}')} + {shift})" for p in ("xx", "yy", "zz"))
-    D, E, Fy = g("Ixy"), g("Izx"), g("Iyz")
-    ig.addComputeGlobal(g("adjxx"), f"{B}*{Z} - {Fy}*{Fy}")
-    ig.addComputeGlobal(g("adjyy"), f"{A}*{Z} - {E}*{E}")
-    ig.addComputeGlobal(g("adjzz"), f"{A}*{B} - {D}*{D}")
-    ig.addComputeGlobal(g("adjxy"), f"{E}*{Fy} - {Z}*{D}")
-    ig.addComputeGlobal(g("adjzx"), f"{D}*{Fy} - {B}*{E}")
-    ig.addComputeGlobal(g("adjyz"), f"{D}*{E} - {A}*{Fy}")
-    ig.addComputeGlobal(g("det"), f"{A}*{g('adjxx')} + {D}*{g('adjxy')} + {E}*{g('adjzx')}")
+    emit_inertia(ig, g, M, c, shift)
 
 
 def _emit_solve(ig, scale: str = "1"):

@@ -23,6 +23,7 @@ from __future__ import annotations
 import openmm as mm
 
 from ..physics.temperature import R_KJ
+from .projection import emit_inertia, emit_second_moments
 from .thermostat import ThermostatSettings
 
 __all__ = ["PREFIX", "LOST_MASK_VAR", "TEMPERATURE_VAR", "COLLISION_TIME_VAR", "HEAT_BATH_VAR", "MASK_VAR", "ALPHA_VAR",
@@ -119,12 +120,7 @@ def _emit_sums(ig, keep_rotation: bool):
     xp, xpp = v("xp"), v("xpp")
     ig.addComputePerDof(xp, "vector(_y(x), _z(x), _x(x))")
     ig.addComputePerDof(xpp, "vector(_z(x), _x(x), _y(x))")
-    for a in _AXES:
-        ig.addComputeSum(v(f"mx{a}"), f"m*x*{e[a]}")
-    for a in _AXES:
-        ig.addComputeSum(v(f"q{a}{a}"), f"m*x*x*{e[a]}")
-    for a, p in zip(_AXES, ("xy", "yz", "zx")):  # x * xp = (x y, y z, z x)
-        ig.addComputeSum(v(f"q{p}"), f"m*x*{xp}*{e[a]}")
+    emit_second_moments(ig, v, "m")
     # L about the origin: (x X v)_x = [xpp v]_z - [xp v]_y and cyclically
     for a, b, d in (("x", "z", "y"), ("y", "x", "z"), ("z", "y", "x")):
         ig.addComputeSum(v(f"L{a}"), f"m*v*({xpp}*{e[b]} - {xp}*{e[d]})")
@@ -139,20 +135,7 @@ def _emit_rotation(ig):
     for a in _AXES:
         ig.addComputeGlobal(v(f"R{a}"), f"{v(f'mx{a}')}*{inv}")
     R = {a: v(f"R{a}") for a in _AXES}
-    C = {p: f"({v(f'q{p}')} - {M}*{R[p[0]]}*{R[p[1]]})" for p in _PAIRS}
-    ig.addComputeGlobal(v("Ixx"), f"{C['yy']} + {C['zz']}")
-    ig.addComputeGlobal(v("Iyy"), f"{C['xx']} + {C['zz']}")
-    ig.addComputeGlobal(v("Izz"), f"{C['xx']} + {C['yy']}")
-    for p in ("xy", "yz", "zx"):
-        ig.addComputeGlobal(v(f"I{p}"), f"-{C[p]}")
-    A, B, Z, D, E, F = (v(f"I{p}") for p in ("xx", "yy", "zz", "xy", "zx", "yz"))
-    ig.addComputeGlobal(v("adjxx"), f"{B}*{Z} - {F}*{F}")
-    ig.addComputeGlobal(v("adjyy"), f"{A}*{Z} - {E}*{E}")
-    ig.addComputeGlobal(v("adjzz"), f"{A}*{B} - {D}*{D}")
-    ig.addComputeGlobal(v("adjxy"), f"{E}*{F} - {Z}*{D}")
-    ig.addComputeGlobal(v("adjzx"), f"{D}*{F} - {B}*{E}")
-    ig.addComputeGlobal(v("adjyz"), f"{D}*{E} - {A}*{F}")
-    ig.addComputeGlobal(v("det"), f"{A}*{v('adjxx')} + {D}*{v('adjxy')} + {E}*{v('adjzx')}")
+    emit_inertia(ig, v, M, R)
     P = {a: v(f"P{a}") for a in _AXES}
     for a, b, d in (("x", "y", "z"), ("y", "z", "x"), ("z", "x", "y")):  # Lc = L - R x P
         ig.addComputeGlobal(v(f"Lc{a}"), f"{v(f'L{a}')} - ({R[b]}*{P[d]} - {R[d]}*{P[b]})")
