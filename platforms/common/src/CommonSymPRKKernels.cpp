@@ -23,6 +23,11 @@ void CommonIntegrateSymPRKStepKernel::initialize(const System& system, const Sym
     projectionBlockSize = 1;
     while (projectionBlockSize*2 <= min(128, cc.getMaxThreadBlockSize()))
         projectionBlockSize *= 2;
+    // The thermostat's reduction leaves its 17 sums in the first 17 threads' slots (kernels/symprk.cc).
+    if (integrator.hasThermostat() && projectionBlockSize < 32)
+        throw OpenMMException("SymPRKIntegrator: the thermostat's device reduction needs work groups of at least 32 "
+                              "threads; this device allows " + cc.intToString(cc.getMaxThreadBlockSize()) +
+                              ". Use the Reference or CPU platform, or backend='custom'.");
     map<string, string> defines;
     defines["NUM_ATOMS"] = cc.intToString(cc.getNumAtoms());
     defines["PADDED_NUM_ATOMS"] = cc.intToString(cc.getPaddedNumAtoms());
