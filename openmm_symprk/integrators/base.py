@@ -207,7 +207,8 @@ class IntegratorBase:
         return self._require_thermostat("getCollisionTime()").collision_time * unit.picoseconds
 
     def setCollisionTime(self, collision_time):
-        """Set the collision time tau (a time Quantity or a number of ps); allowed while the integrator runs."""
+        """Set the collision time tau (a time Quantity or a number of ps): while the integrator runs on the custom
+        backend; on the native backend only before its Context exists (tau is part of the checkpoint signature)."""
         settings = self._require_thermostat("setCollisionTime()").with_collision_time(collision_time)
         self._apply_thermostat(settings)
         self.thermostat = settings

@@ -220,6 +220,29 @@ def emit_inertia(ig, name, M: str, centre: dict, shift: str | None = None) -> No
     ig.addComputeGlobal(name("det"), f"{A}*{name('adjxx')} + {D}*{name('adjxy')} + {E}*{name('adjzx')}")
 
 
+def emit_rigid_solve(ig, name, centre: dict, *, linear: str, moment: str, about: str, angular: str, base: str,
+                     scale: str | None = None) -> None:
+    """The rigid-body field base + angular x (x - centre) = k + angular x x, from the inertia tensor of
+    :func:`emit_inertia` (its adjugate and determinant): the moment about the centre
+    name(about) = name(moment) - centre x name(linear) (a moment taken about the origin), angular = I^-1 of it
+    (times ``scale`` when given; 0 for a singular I), and k = name(base) - angular x centre."""
+    cyclic = (("x", "y", "z"), ("y", "z", "x"), ("z", "x", "y"))
+    lin = {a: name(f"{linear}{a}") for a in _AXES}
+    for a, b, d in cyclic:
+        ig.addComputeGlobal(name(f"{about}{a}"),
+                            f"{name(f'{moment}{a}')} - ({centre[b]}*{lin[d]} - {centre[d]}*{lin[b]})")
+    adj = {p: name(f"adj{p}") for p in _PAIRS}
+    adj.update({"yx": adj["xy"], "xz": adj["zx"], "zy": adj["yz"]})
+    det = name("det")
+    for a in _AXES:
+        row = " + ".join(f"{adj[a + b]}*{name(f'{about}{b}')}" for b in _AXES)
+        solved = f"({row})/{det}" if scale is None else f"{scale}*({row})/{det}"
+        ig.addComputeGlobal(name(f"{angular}{a}"), f"select({det}, {solved}, 0)")
+    w = {a: name(f"{angular}{a}") for a in _AXES}
+    for a, b, d in cyclic:
+        ig.addComputeGlobal(name(f"k{a}"), f"{name(f'{base}{a}')} - ({w[b]}*{centre[d]} - {w[d]}*{centre[b]})")
+
+
 def _emit_geometry(ig):
     """Centre of mass, inertia tensor about it and its regularised adjugate/determinant, at x."""
     g = _g
@@ -249,17 +272,7 @@ def _emit_solve(ig, scale: str = "1"):
     F = {a: g(f"f{a}") for a in _AXES}
     for a in _AXES:
         ig.addComputeGlobal(g(f"acm{a}"), f"{scale}*{F[a]}*{inv}")
-    for a, b, d in (("x", "y", "z"), ("y", "z", "x"), ("z", "x", "y")):
-        ig.addComputeGlobal(g(f"tau{a}"), f"{g(f't{a}')} - ({c[b]}*{F[d]} - {c[d]}*{F[b]})")
-    adj = {p: g(f"adj{p}") for p in _PAIRS}
-    adj.update({"yx": adj["xy"], "xz": adj["zx"], "zy": adj["yz"]})
-    det = g("det")
-    for a in _AXES:
-        row = " + ".join(f"{adj[a + b]}*{g(f'tau{b}')}" for b in _AXES)
-        ig.addComputeGlobal(g(f"al{a}"), f"select({det}, {scale}*({row})/{det}, 0)")
-    al = {a: g(f"al{a}") for a in _AXES}
-    for a, b, d in (("x", "y", "z"), ("y", "z", "x"), ("z", "x", "y")):  # k = acm - al x c
-        ig.addComputeGlobal(g(f"k{a}"), f"{g(f'acm{a}')} - ({al[b]}*{c[d]} - {al[d]}*{c[b]})")
+    emit_rigid_solve(ig, g, c, linear="f", moment="t", about="tau", angular="al", base="acm", scale=scale)
 
 
 def _rigid():

@@ -23,7 +23,7 @@ from __future__ import annotations
 import openmm as mm
 
 from ..physics.temperature import R_KJ
-from .projection import emit_inertia, emit_second_moments
+from .projection import emit_inertia, emit_rigid_solve, emit_second_moments
 from .thermostat import ThermostatSettings
 
 __all__ = ["PREFIX", "LOST_MASK_VAR", "TEMPERATURE_VAR", "COLLISION_TIME_VAR", "HEAT_BATH_VAR", "MASK_VAR", "ALPHA_VAR",
@@ -136,18 +136,8 @@ def _emit_rotation(ig):
         ig.addComputeGlobal(v(f"R{a}"), f"{v(f'mx{a}')}*{inv}")
     R = {a: v(f"R{a}") for a in _AXES}
     emit_inertia(ig, v, M, R)
-    P = {a: v(f"P{a}") for a in _AXES}
-    for a, b, d in (("x", "y", "z"), ("y", "z", "x"), ("z", "x", "y")):  # Lc = L - R x P
-        ig.addComputeGlobal(v(f"Lc{a}"), f"{v(f'L{a}')} - ({R[b]}*{P[d]} - {R[d]}*{P[b]})")
-    adj = {p: v(f"adj{p}") for p in _PAIRS}
-    adj.update({"yx": adj["xy"], "xz": adj["zx"], "zy": adj["yz"]})
-    det = v("det")
-    for a in _AXES:
-        row = " + ".join(f"{adj[a + b]}*{v(f'Lc{b}')}" for b in _AXES)
-        ig.addComputeGlobal(v(f"w{a}"), f"select({det}, ({row})/{det}, 0)")
-    w = {a: v(f"w{a}") for a in _AXES}
-    for a, b, d in (("x", "y", "z"), ("y", "z", "x"), ("z", "x", "y")):  # k = V - w x R
-        ig.addComputeGlobal(v(f"k{a}"), f"{v(f'V{a}')} - ({w[b]}*{R[d]} - {w[d]}*{R[b]})")
+    # w = I^-1 (L - R x P) and k = V - w x R
+    emit_rigid_solve(ig, v, R, linear="P", moment="L", about="Lc", angular="w", base="V")
 
 
 def emit_half_event(integrator: mm.CustomIntegrator, settings: ThermostatSettings) -> None:
