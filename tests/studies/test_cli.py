@@ -1,5 +1,6 @@
 """The ``symprk`` command: what it prints, and one clear line and a non-zero exit for every bad input."""
 import json
+import os
 import subprocess
 import sys
 
@@ -38,10 +39,13 @@ def test_demo_custom_backend(capsys):
     (["demo", "--waters", "2", "--steps", "50", "--step-fs", "100", "--method", "verlet"], "blew up at integrator step"),
     (["demo", "--method", "verlett"], "Did you mean 'verlet'"),
     (["methods", "pefrll"], "Did you mean 'pefrl'"),
+    (["fidelity", "--report-only", "--out", "no-such-symprk-study"], "no finished runs in no-such-symprk-study"),
+    (["drift", "hmr", "--report-only", "--out", "no-such-symprk-study"], "no finished runs in no-such-symprk-study"),
 ])
 def test_errors_are_one_line_and_exit_2(argv, message, capsys):
     rc, _, err = _run(argv, capsys)
     assert rc == 2 and message in err and len(err.strip().splitlines()) == 1 and "Traceback" not in err
+    assert not os.path.exists("no-such-symprk-study")  # a report of nothing creates no folder
 
 
 @pytest.mark.parametrize("argv,message", [(["demo", "--steps", "0"], "must be positive, got 0"),

@@ -82,6 +82,25 @@ def test_the_folder_is_locked_while_a_study_runs(tmp_path):
         ToyStudy(str(tmp_path), ["ref"], workers=0)
 
 
+def test_report_only_summarises_what_is_stored_runs_nothing_and_ignores_the_lock(tmp_path):
+    out = str(tmp_path / "toy")
+    with pytest.raises(ValueError, match="no finished runs in .*without --report-only"):
+        ToyStudy(out, ["ref", "b"]).run(report_only=True)
+    ToyStudy(out, ["ref", "b"], replicas=2).run()
+    logged = []
+    study = ToyStudy(out, ["ref", "b"], replicas=5)
+    study.log = logged.append
+    lock = FolderLock(out, "symprk toy")  # a study still running in another process
+    try:
+        res = study.run(report_only=True)
+    finally:
+        lock.release()
+    assert study.calls == 0 and len(RunStore(out)) == 4 and res["b"].replicas == 2
+    assert logged == ["report only: 6 of 10 planned runs are not finished and are left out"]
+    with pytest.raises(ValueError, match="none of the 4 planned runs is stored"):
+        ToyStudy(out, ["a", "c"], replicas=2).run(report_only=True)
+
+
 def test_json_is_written_atomically_and_plainly(tmp_path):
     path = str(tmp_path / "x.json")
     write_json(path, {"a": np.arange(3), "b": np.float32(0.5), "c": float("nan"), "d": (1, 2)})

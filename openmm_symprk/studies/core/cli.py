@@ -26,7 +26,7 @@ def positive(kind=float):
 
 
 def add_study_arguments(ap, *, quick: str, out: str, workers: str, length: str) -> None:
-    """--quick, --out, --workers, --scheduler, --replicas, --length-ps, --no-timing and --no-progress."""
+    """--quick, --out, --workers, --scheduler, --replicas, --length-ps, --no-timing, --no-progress and --report-only."""
     ap.add_argument("--quick", action="store_true", help=quick)
     ap.add_argument("--out", default=out, help="output folder (finished runs are reused)")
     ap.add_argument("--workers", type=int, default=2, help=workers)
@@ -37,6 +37,9 @@ def add_study_arguments(ap, *, quick: str, out: str, workers: str, length: str) 
     ap.add_argument("--length-ps", type=float, default=None, help=length)
     ap.add_argument("--no-timing", action="store_true", help="skip the wall-time measurement in turns")
     ap.add_argument("--no-progress", action="store_true")
+    ap.add_argument("--report-only", action="store_true",
+                    help="run nothing: summarise the finished runs in --out (a study still running, or rows run "
+                         "with fewer replicas); the planned runs not finished are left out and counted")
 
 
 def run_study_command(prog: str, args, cfg: dict, configure, study: str, report: str) -> int:
@@ -54,7 +57,8 @@ def run_study_command(prog: str, args, cfg: dict, configure, study: str, report:
         if os.path.isfile(args.out):
             raise ValueError(f"--out {args.out} is a file; give a folder")
         summary = import_module(study).run_study(cfg, args.out, workers=args.workers, timing=not args.no_timing,
-                                  progress=not args.no_progress, scheduler=args.scheduler)
+                                  progress=not args.no_progress, scheduler=args.scheduler,
+                                                                  report_only=args.report_only)
     except KeyboardInterrupt:
         print(f"{prog}: interrupted (finished runs are kept; run again to continue)", file=sys.stderr)
         return 130

@@ -25,10 +25,11 @@ def run_key(obj, length: int = 16) -> str:
 class RunStore:
     """``<out>/<folder>/<key>.json`` (+ ``<key>.npz``)."""
 
-    def __init__(self, out: str, folder: str = "runs"):
+    def __init__(self, out: str, folder: str = "runs", create: bool = True):
         self.out = out
         self.folder = os.path.join(out, folder)
-        os.makedirs(self.folder, exist_ok=True)
+        if create:
+            os.makedirs(self.folder, exist_ok=True)
 
     def path(self, key: str, ext: str) -> str:
         return os.path.join(self.folder, f"{key}.{ext}")
@@ -57,6 +58,8 @@ class RunStore:
         return os.path.exists(self.path(key, "json"))
 
     def keys(self) -> set:
+        if not os.path.isdir(self.folder):
+            return set()
         return {f[:-5] for f in os.listdir(self.folder) if f.endswith(".json")}
 
     def __len__(self):

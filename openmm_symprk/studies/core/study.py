@@ -74,8 +74,21 @@ class Study:
         """Called in this process after each run is stored (e.g. to log a failed run)."""
 
     # -- the skeleton ---------------------------------------------------------------------------------------------
-    def run(self):
-        """Run what is missing and return :meth:`summarise` of every planned run."""
+    def run(self, report_only: bool = False):
+        """Run what is missing and return :meth:`summarise` of every planned run.  ``report_only``: run nothing and
+        summarise the planned runs already stored (a study still running in another process, or rows given
+        fewer replicas than the others); the folder is not locked, and ValueError says when nothing is stored."""
+        if report_only:
+            self.store = RunStore(self.out, create=False)
+            if not len(self.store):
+                raise ValueError(f"no finished runs in {self.out}: run the study without --report-only first")
+            runs = self.plan()
+            missing = sum(r.key not in self.store for r in runs)
+            if missing == len(runs):
+                raise ValueError(f"none of the {len(runs)} planned runs is stored in {self.out} (other settings?)")
+            if missing:
+                self.log(f"report only: {missing} of {len(runs)} planned runs are not finished and are left out")
+            return self.summarise(runs)
         os.makedirs(self.out, exist_ok=True)
         lock = FolderLock(self.out, self.command)
         try:

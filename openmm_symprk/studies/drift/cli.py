@@ -37,6 +37,8 @@ def build_parser():
                     help="worker processes (default 1: runs use --threads each; 2 cores take one run at a time)")
     ap.add_argument("--scheduler", metavar="ADDRESS", help="Dask scheduler address instead of local workers")
     ap.add_argument("--no-progress", action="store_true")
+    ap.add_argument("--report-only", action="store_true",
+                    help="run nothing: summarise the finished runs in --out (unfinished ones are left out)")
     return ap
 
 
@@ -76,7 +78,7 @@ def main(argv=None) -> int:
         from .study import run_study
 
         summary = run_study(cfg, out, workers=args.workers, progress=not args.no_progress,
-                            scheduler=args.scheduler)
+                            scheduler=args.scheduler, report_only=args.report_only)
     except KeyboardInterrupt:
         print("symprk drift: interrupted (finished runs are kept; run the same command again to continue)",
               file=sys.stderr)

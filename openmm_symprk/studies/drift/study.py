@@ -136,6 +136,6 @@ class DriftStudy(Study):
 
 
 def run_study(cfg: dict, out: str, workers: int = 1, progress: bool = True, log=print,
-              scheduler: str | None = None) -> dict:
-    """Run (or finish, or only re-summarise) the study in ``out``; returns the summary (:func:`.report.summarise`)."""
-    return DriftStudy(cfg, out, workers, progress, log, scheduler).run()
+              scheduler: str | None = None, report_only: bool = False) -> dict:
+    """Run (or finish, or only re-summarise: ``report_only``, see :meth:`~openmm_symprk.studies.core.study.Study.run`) the study in ``out``; returns the summary (:func:`.report.summarise`)."""
+    return DriftStudy(cfg, out, workers, progress, log, scheduler).run(report_only)

@@ -177,10 +177,10 @@ class EquipartitionStudy(Study):
 
 
 def run_study(cfg: dict, out: str, workers: int = 2, timing: bool = True, progress: bool = True, log=print,
-              scheduler: str | None = None) -> dict:
-    """Run (or finish, or only re-summarise) the study in ``out``; returns the summary (see
+              scheduler: str | None = None, report_only: bool = False) -> dict:
+    """Run (or finish, or only re-summarise: ``report_only``, see :meth:`~openmm_symprk.studies.core.study.Study.run`) the study in ``out``; returns the summary (see
     :func:`.report.summarise`) and writes ``summary.txt``, ``results.json`` and ``equipartition.png`` there."""
-    return EquipartitionStudy(cfg, out, workers, timing, progress, log, scheduler).run()
+    return EquipartitionStudy(cfg, out, workers, timing, progress, log, scheduler).run(report_only)
 
 
 def force_cost(row, cfg) -> float:

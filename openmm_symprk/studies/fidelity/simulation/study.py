@@ -193,8 +193,8 @@ def temperature_view(cfg: dict, rows: list, grouped: dict, timings: dict) -> dic
 
 
 def run_study(cfg: dict, out: str, workers: int = 2, timing: bool = True, progress: bool = True, log=print,
-              scheduler: str | None = None) -> dict:
-    """Run (or finish, or only re-summarise) the study in ``out``; returns the summary (:func:`..report.summarise`)
+              scheduler: str | None = None, report_only: bool = False) -> dict:
+    """Run (or finish, or only re-summarise: ``report_only``, see :meth:`~openmm_symprk.studies.core.study.Study.run`) the study in ``out``; returns the summary (:func:`..report.summarise`)
     and writes ``summary.txt``, ``equipartition.txt`` (:func:`temperature_view`), ``results.json``, ``fidelity.png`` (bias against force evaluations per ps) and,
     with timing, ``fidelity-wall.png`` (against wall time per simulated ps) there."""
-    return FidelityStudy(cfg, out, workers, timing, progress, log, scheduler).run()
+    return FidelityStudy(cfg, out, workers, timing, progress, log, scheduler).run(report_only)
