@@ -33,7 +33,6 @@ import os
 import sys
 
 import numpy as np
-import openmm as mm
 import openmm.app as app
 import openmm.unit as unit
 

@@ -26,7 +26,7 @@ from ..systems.checks import warn_once
 from ..systems.properties import masses
 from . import program, thermostat_program
 from .backend import CUSTOM_OPTIONS, NATIVE_OPTIONS, check_option_names, prepare
-from .base import CheckpointMismatchError, ConvergenceWarning, IntegratorBase, SystemMismatchError, step_size_in_ps
+from .base import CheckpointMismatchError, ConvergenceWarning, IntegratorBase, SystemMismatchError
 from .projection import set_masses
 from .symplectic import SymplecticIntegrator
 
