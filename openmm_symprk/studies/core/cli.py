@@ -45,20 +45,23 @@ def add_study_arguments(ap, *, quick: str, out: str, workers: str, length: str) 
 def run_study_command(prog: str, args, cfg: dict, configure, study: str, report: str) -> int:
     """Apply ``configure(cfg)`` (the study's own options; raises ValueError on a bad one) and the common options,
     run ``run_study`` of the module ``study`` and print ``format_summary`` of the module ``report`` (both imported
-    only then, so that ``--help`` and bad options answer at once)."""
+    only then, so that ``--help`` and bad options answer at once).  ``args`` needs ``out``, ``workers``,
+    ``scheduler``, ``no_progress`` and ``report_only``; ``replicas``, ``length_ps`` and ``no_timing`` apply where
+    the command has them (a study without a timing option is not passed ``timing``)."""
     try:
         configure(cfg)
-        if args.replicas is not None:
-            cfg["replicas"] = args.replicas
-        if args.length_ps is not None:
-            cfg["length_ps"] = args.length_ps
+        for key in ("replicas", "length_ps"):
+            if getattr(args, key, None) is not None:
+                cfg[key] = getattr(args, key)
         if args.workers < 1:
             raise ValueError(f"--workers must be >= 1, got {args.workers}")
         if os.path.isfile(args.out):
             raise ValueError(f"--out {args.out} is a file; give a folder")
-        summary = import_module(study).run_study(cfg, args.out, workers=args.workers, timing=not args.no_timing,
-                                  progress=not args.no_progress, scheduler=args.scheduler,
-                                                                  report_only=args.report_only)
+        options = {"workers": args.workers, "progress": not args.no_progress, "scheduler": args.scheduler,
+                   "report_only": args.report_only}
+        if hasattr(args, "no_timing"):
+            options["timing"] = not args.no_timing
+        summary = import_module(study).run_study(cfg, args.out, **options)
     except KeyboardInterrupt:
         print(f"{prog}: interrupted (finished runs are kept; run again to continue)", file=sys.stderr)
         return 130

@@ -14,6 +14,7 @@ import argparse
 import os
 import sys
 
+from ..core.cli import run_study_command
 from . import presets
 
 
@@ -55,11 +56,9 @@ def make_config(args) -> dict:
             raise ValueError(f"--platforms: {', '.join(bad)} not understood; give NAME or NAME:PRECISION, e.g. "
                              f"CPU,OpenCL:single,OpenCL:mixed,OpenCL:double")
         cfg = presets.exact_momentum(args.quick, platforms)
-    for opt, key in (("replicas", "replicas"), ("length_ps", "length_ps"), ("sample_ps", "sample_ps"),
-                     ("constraint_tolerance", "constraint_tolerance"), ("threads", "threads")):
-        value = getattr(args, opt)
-        if value is not None:
-            cfg[key] = value
+    for key in ("sample_ps", "constraint_tolerance", "threads"):
+        if getattr(args, key) is not None:
+            cfg[key] = getattr(args, key)
     if int(cfg["threads"]) < 1:
         raise ValueError(f"--threads must be >= 1, got {cfg['threads']}")
     return cfg
@@ -67,28 +66,10 @@ def make_config(args) -> dict:
 
 def main(argv=None) -> int:
     args = build_parser().parse_args(argv)
-    out = args.out or os.path.join("drift-results", args.study + ("-quick" if args.quick else ""))
-    try:
-        if args.workers < 1:
-            raise ValueError(f"--workers must be >= 1, got {args.workers}")
-        if os.path.isfile(out):
-            raise ValueError(f"--out {out} is a file; give a folder")
-        cfg = make_config(args)
-        from .report import format_summary
-        from .study import run_study
-
-        summary = run_study(cfg, out, workers=args.workers, progress=not args.no_progress,
-                            scheduler=args.scheduler, report_only=args.report_only)
-    except KeyboardInterrupt:
-        print("symprk drift: interrupted (finished runs are kept; run the same command again to continue)",
-              file=sys.stderr)
-        return 130
-    except (ValueError, KeyError, OSError, RuntimeError, ImportError) as exc:
-        print(f"symprk drift: error: {exc}", file=sys.stderr)
-        return 2
-    print(format_summary(summary))
-    print(f"\nwrote {os.path.join(out, 'summary.txt')} and results.json")
-    return 0
+    if not args.out:
+        args.out = os.path.join("drift-results", args.study + ("-quick" if args.quick else ""))
+    return run_study_command("symprk drift", args, {}, lambda cfg: cfg.update(make_config(args)),
+                             "openmm_symprk.studies.drift.study", "openmm_symprk.studies.drift.report")
 
 
 if __name__ == "__main__":
