@@ -16,7 +16,7 @@ from .base import (CheckpointMismatchError, ConvergenceWarning, IntegratorBase, 
                    SystemMismatchError, step_size_in_ps)
 from .custom import CustomSymplecticIntegrator, PRKIntegrator, TimeWarning
 from .native import NativeSymplecticIntegrator, native_available
-from .program import ConstraintSupportError
+from ..methods.resolved import ConstraintSupportError
 from .restore import deserialize, restore
 from .symplectic import SymplecticIntegrator
 

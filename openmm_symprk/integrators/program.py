@@ -38,7 +38,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import openmm as mm
 
-from ..methods.resolved import ConstraintSupportError, ResolvedMethod, SubstepKind
+from ..methods.resolved import ResolvedMethod, SubstepKind
 from ..methods.tableau import PRKTableau
 
 #: Global variables every compiled program has, in this order (read by the integrator classes).

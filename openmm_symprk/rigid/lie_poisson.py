@@ -453,8 +453,8 @@ def report(moments=(1.8, 0.7, 1.3), x0=(0.4, 1.1, -0.8), T=2.0) -> str:
     x0 = _check_x(x0)
     exact_end = exact_solution(x0, m, [T])[0]
     lines = [f"moments {m.tolist()}, x0 {x0.tolist()}; order: slope of log|x_N - x(T)| vs log h, T = {T}",
-             f"conservation: h = 0.05, 10^4 steps (t = 500): max relative |x|² and energy error, and the "
-             f"energy error's max over the first and last tenth",
+             "conservation: h = 0.05, 10^4 steps (t = 500): max relative |x|² and energy error, and the "
+             "energy error's max over the first and last tenth",
              f"{'method':14s} {'order':>5s} {'measured':>8s} {'|x|² drift':>11s} {'energy err':>11s} "
              f"{'1st tenth':>10s} {'last tenth':>10s}"]
     for name, ns in ladders.items():

@@ -622,5 +622,5 @@ def run_free_rigid_body(body: FreeRigidBody, method: str, step_ps: float, n_step
         integrator.step(k)
         done += k
         record()
-    del ctx
+    ctx = None  # released before returning (record() holds the name)
     return np.array(times), np.array(xs), np.array(Ls)

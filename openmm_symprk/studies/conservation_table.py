@@ -123,7 +123,7 @@ def failure_cases(steps=500):
     v = water.velocities + np.array([0.3, -0.2, 0.1])
     for about in ("com", "origin"):
         ig = SymplecticIntegrator(0.002, "verlet", system=system)
-        rows.append((f"verlet + CMMotionRemover, 8 waters drifting", about,
+        rows.append(("verlet + CMMotionRemover, 8 waters drifting", about,
                      *drift(water, ig, about=about, system=system, velocities=v),
                      "L about the centre of mass kept" if about == "com" else "L about the origin changes"))
     return rows

@@ -7,8 +7,6 @@ import openmm.app as app
 import openmm.unit as unit
 import pytest
 
-import openmm_symprk.conservation.reporters as reporters
-import openmm_symprk.systems.checks as systemcheck
 from openmm_symprk import SymplecticIntegrator
 from openmm_symprk.conservation.reporters import ConservationReporter, VelocityTRRReporter, write_topology
 from openmm_symprk.systems.checks import ConservationWarning

@@ -10,7 +10,7 @@ import pytest
 
 from conftest import platform_available
 from helpers import counted, drift_after
-from openmm_symprk import PRKIntegrator, SymplecticIntegrator, catalogue, resolve
+from openmm_symprk import SymplecticIntegrator, catalogue, resolve
 from openmm_symprk.integrators.convergence import measure_order
 
 SYMPLECTIC_SPLITTINGS = [m.name for m in catalogue.splittings()]

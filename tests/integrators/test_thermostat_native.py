@@ -262,7 +262,12 @@ def test_ideal_gas_kinetic_energy_is_gamma_distributed(platform, props, samples)
 
 
 def test_water_box_mean_temperature(tmp_path):
-    """<T> of the thermostatted degrees of freedom within 3 SE of the target: 64 rigid waters, PME, CPU."""
+    """<T> of the thermostatted degrees of freedom within 4 standard errors of the target: 64 rigid waters, PME,
+    CPU, 12 ps sampled every 20 fs, the error from 24 blocks of 0.5 ps (K's autocorrelation oscillates and then
+    has a slow tail of a few collision times, which the statistical inefficiency summed to its first zero misses).
+    4, not 3, standard errors: the CPU platform does not repeat a run bit for bit (PME), so the seed does not fix
+    this test's outcome; a correct thermostat fails it about once in 2000 runs (Student's t, 23 degrees of
+    freedom), one whose T is 4 % off (about 6 standard errors) nearly always."""
     from openmm_symprk.systems.scenes import water_box
 
     system, _, x = water_box(n_waters=64, cutoff_nm=0.55)
@@ -281,9 +286,10 @@ def test_water_box_mean_temperature(tmp_path):
         _, v = _xv(ctx)
         pec = v - (m[:, None] * v).sum(axis=0) / m.sum()
         temps.append(float(np.sum(m[:, None] * pec ** 2)) / (dof * R_KJ))
-    s = series_stats(temps)
-    assert abs(s.mean - 320) <= 3 * s.se, (s.mean, s.se)
-    assert s.se < 3.0  # the test has power: 1 % of the target (sd of T for these 381 DOF: 23 K)
+    blocks = np.asarray(temps).reshape(24, -1).mean(axis=1)
+    mean, se = blocks.mean(), blocks.std(ddof=1) / math.sqrt(24)
+    assert abs(mean - 320) <= 4 * se, (mean, se)
+    assert se < 2.5  # the test has power: under 1 % of the target (sd of T for these 381 DOF: 23 K)
 
 
 # -- checkpoints, XML, the NVE program ----------------------------------------------------------------------------

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import openmm_symprk
-from openmm_symprk.methods import (PRKTableau, ResolvedMethod, Splitting, SubstepFlag, SubstepKind, TableauError,
+from openmm_symprk.methods import (PRKTableau, Splitting, SubstepFlag, SubstepKind, TableauError,
                                    UnknownMethodError, methods, resolve)
 from openmm_symprk.methods.reference import harmonic_force, integrate
 from openmm_symprk.methods.resolved import ConstraintSupportError, projected_drifts

@@ -2,7 +2,6 @@
 cluster in vacuum: rigidity exact, momentum and angular momentum to round-off, energy error of order 2, and
 the same dynamics as RATTLE (SETTLE) Verlet inside OpenMM to O(h^2)."""
 import numpy as np
-import openmm as mm
 import openmm.unit as unit
 import pytest
 

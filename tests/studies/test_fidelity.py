@@ -87,7 +87,7 @@ def test_replica_states_are_at_the_stated_density_with_zero_momentum(quick):
     cfg = presets.quick()
     (path,) = glob.glob(os.path.join(out, "states", "spce-*.npz"))
     with np.load(path) as d:
-        x, v = d["x"], d["v"]
+        v = d["v"]
     box = build_box(cfg, "spce")
     m = box.masses()
     assert len(v) == cfg["replicas"]

@@ -3,7 +3,6 @@ equipartition across masses, constraints respected, a rigid spin added exactly),
 minimisation lowering the energy, Langevin equilibration."""
 import numpy as np
 import openmm as mm
-import pytest
 
 from openmm_symprk.physics.momenta import angular_momentum, centre_of_mass, inertia_tensor, kinetic_energy
 from openmm_symprk.systems.prepare import (R_KJ, constrain_velocities, equilibrate, maxwell_boltzmann, minimise)

@@ -7,7 +7,6 @@ import io
 import numpy as np
 import openmm as mm
 import openmm.app as app
-import openmm.unit as unit
 import pytest
 
 from openmm_symprk.systems.properties import (constraint_arrays, constraint_violation, degrees_of_freedom,

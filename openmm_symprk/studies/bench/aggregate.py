@@ -236,7 +236,7 @@ def format_production(results, scene) -> str:
                      f"{_fmt(row['speedup'], '7.2f'):>7s} {drift:>20s} {_fmt(row['fluctuation'], '11.2e'):>11s} "
                      f"{matches:>8s}  {row['status']}")
     best = summary["best"]
-    lines.append(f"fastest row at the baseline's drift and fluctuation: "
+    lines.append("fastest row at the baseline's drift and fluctuation: "
                  + (f"{label(best['method'])} at {best['step_fs']:g} fs, {best['speedup']:.2f}x the baseline"
                     if best else "none"))
     return "\n".join(lines)

@@ -94,4 +94,4 @@ def run_nve(system, x0, v0, row: dict, cfg: dict):
         info.update(steps=done, wall_s=wall, wall_per_ps=wall / max((done - timed_from) * h_ps, 1e-12), E0=es[0])
         return {"t": np.asarray(ts), "e": np.asarray(es)}, info
     finally:
-        del ctx
+        ctx = None  # the Context goes before the caller's next one (the closure above holds the name)
