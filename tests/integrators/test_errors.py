@@ -9,7 +9,7 @@ import pytest
 from helpers import stiff_diatomic
 from openmm_symprk import PRKIntegrator, PRKTableau, SimulationBlowUpError, SymplecticIntegrator, TableauError
 from openmm_symprk.methods.catalogue import UnknownMethodError
-from openmm_symprk.integrators.program import ConstraintSupportError
+from openmm_symprk.integrators import ConstraintSupportError
 from openmm_symprk.integrators import SystemMismatchError
 from openmm_symprk.systems.checks import ConservationWarning
 
