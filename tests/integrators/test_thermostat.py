@@ -19,7 +19,7 @@ from openmm_symprk.integrators import thermostat_program as tp
 from openmm_symprk.integrators.thermostat import thermostat_settings
 from openmm_symprk.physics.temperature import R_KJ
 from openmm_symprk.physics.velocity_rescaling import kept_velocities, rescaling_factor
-from openmm_symprk.stats import drift, series_stats
+from openmm_symprk.stats import block_stats, drift, series_stats
 from openmm_symprk.stats.timeseries import statistical_inefficiency
 from openmm_symprk.systems.prepare import equilibrate, maxwell_boltzmann, minimise
 from openmm_symprk.systems.properties import masses, thermostat_degrees_of_freedom
@@ -32,16 +32,6 @@ pytestmark = pytest.mark.filterwarnings("ignore::openmm_symprk.systems.checks.Co
 #: to the next (PME included), and the dynamics is chaotic: the statistical tests, and the fixtures they start from,
 #: run on Reference, so that their fixed seeds fix their outcome.
 CPU_PROPERTIES = {"Threads": "2", "DeterministicForces": "true"}
-
-
-def block_stats(x, n_blocks):
-    """(mean, standard error) of the series ``x`` from the spread of ``n_blocks`` block means.  For the kinetic
-    energy of a thermostatted liquid: its autocorrelation oscillates (librations) and then has a slow tail (the
-    total energy relaxing through the thermostat, over a few collision times), so the statistical inefficiency,
-    summed to the first zero, misses the tail; blocks many collision times long do not."""
-    x = np.asarray(x, dtype=np.float64)
-    blocks = x[:len(x) - len(x) % n_blocks].reshape(n_blocks, -1).mean(axis=1)
-    return float(x.mean()), float(blocks.std(ddof=1) / np.sqrt(n_blocks))
 
 
 # -- systems ---------------------------------------------------------------------------------------------
@@ -433,8 +423,8 @@ def test_water_box_temperature_and_kinetic_energy_are_canonical(backend, equilib
     dof = ig.thermostat_dof
     kT = R_KJ * 300.0
     K = np.array([peculiar_kinetic(xs, vs, m, False) for xs, vs in zip(rec.x, rec.v)])
-    T, T_se = block_stats(2 * K / (dof * R_KJ), 8)
-    assert abs(T - 300.0) < 3 * T_se and T_se < 4.0  # resolves 300 K to ~1 %
+    T = block_stats(2 * K / (dof * R_KJ), 8)  # blocks: K's slow tail (openmm_symprk.stats.block_stats)
+    assert abs(T.mean - 300.0) < 3 * T.se and T.se < 4.0  # resolves 300 K to ~1 %
     # the variance of K, also from the blocks (squared deviations are too heavy-tailed for the statistical
     # inefficiency)
     blocks = K.reshape(8, -1)
@@ -444,8 +434,8 @@ def test_water_box_temperature_and_kinetic_energy_are_canonical(backend, equilib
     # StateDataReporter divides the total kinetic energy by 3N - constraints (no CMMotionRemover): with P = 0
     # its temperature is T (N_f / (N_f + 3)) on average
     rows = [line.split(",") for line in sdr.splitlines()[1:]]
-    t_sdr, t_sdr_se = block_stats([float(r[1]) for r in rows], 8)
-    assert abs(t_sdr - 300.0 * dof / (dof + 3)) < 3 * t_sdr_se
+    t_sdr = block_stats([float(r[1]) for r in rows], 8)
+    assert abs(t_sdr.mean - 300.0 * dof / (dof + 3)) < 3 * t_sdr.se
     # ConservationReporter reports the effective energy (total + heat bath) and says so in its header
     assert cons.records[-1]["heat_bath"] == ig.final_heat_bath.value_in_unit(unit.kilojoule_per_mole) != 0
     assert '"Total + heat-bath energy (kJ/mol)"' in cons_text
@@ -469,9 +459,8 @@ def test_npt_with_monte_carlo_barostat(backend, npt_box):
     assert np.ptp(rec.volume) > 1e-3 * np.mean(rec.volume)
     m = masses(system)
     dof = ig.thermostat_dof
-    T, T_se = block_stats([2 * peculiar_kinetic(xs, vs, m, False) / (dof * R_KJ) for xs, vs in zip(rec.x, rec.v)],
-                          10)
-    assert abs(T - 300.0) < 3 * T_se and T_se < 4.0  # resolves 300 K to ~1 %
+    T = block_stats([2 * peculiar_kinetic(xs, vs, m, False) / (dof * R_KJ) for xs, vs in zip(rec.x, rec.v)], 10)
+    assert abs(T.mean - 300.0) < 3 * T.se and T.se < 4.0  # resolves 300 K to ~1 %
 
 
 # -- what the thermostat keeps -------------------------------------------------------------------------------------

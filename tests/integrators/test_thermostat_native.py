@@ -22,7 +22,7 @@ from openmm_symprk.integrators import NativeSymplecticIntegrator as N
 from openmm_symprk.integrators import deserialize
 from openmm_symprk.physics.temperature import R_KJ
 from openmm_symprk.physics.velocity_rescaling import kept_velocities, rescaling_factor
-from openmm_symprk.stats.timeseries import series_stats
+from openmm_symprk.stats.timeseries import block_stats, series_stats
 
 pytestmark = pytest.mark.skipif(not plugin.available(), reason=f"native plugin unavailable: {plugin.unavailable_reason()}")
 
@@ -286,10 +286,9 @@ def test_water_box_mean_temperature(tmp_path):
         _, v = _xv(ctx)
         pec = v - (m[:, None] * v).sum(axis=0) / m.sum()
         temps.append(float(np.sum(m[:, None] * pec ** 2)) / (dof * R_KJ))
-    blocks = np.asarray(temps).reshape(24, -1).mean(axis=1)
-    mean, se = blocks.mean(), blocks.std(ddof=1) / math.sqrt(24)
-    assert abs(mean - 320) <= 4 * se, (mean, se)
-    assert se < 2.5  # the test has power: under 1 % of the target (sd of T for these 381 DOF: 23 K)
+    s = block_stats(temps, 24)
+    assert abs(s.mean - 320) <= 4 * s.se, (s.mean, s.se)
+    assert s.se < 2.5  # the test has power: under 1 % of the target (sd of T for these 381 DOF: 23 K)
 
 
 # -- checkpoints, XML, the NVE program ----------------------------------------------------------------------------
