@@ -27,7 +27,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from openmm_symprk.rigid import lie_poisson as rb  # noqa: E402
-from openmm_symprk.rigid.molecules import (free_rigid_body, hydrogen_peroxide, rigid_water,  # noqa: E402
+from openmm_symprk.rigid.free_body import (free_rigid_body, hydrogen_peroxide, rigid_water,  # noqa: E402
                                            run_free_rigid_body)
 
 OMEGA = [6.0, -14.0, 9.0]  # body angular velocity at t = 0 (1/ps, principal axes, ascending moments)
@@ -55,7 +55,7 @@ def reduction_check(h=0.004, n=150):
     red = rb.integrate(body.x0, body.moments, h, n, "rattle-1")
     ex = rb.exact_solution(body.x0, body.moments, t)
     s = np.linalg.norm(body.x0)
-    return (f"Reduction (Theorem 5.1): rigid H2O2, OpenMM verlet/RATTLE vs rigidbody 'rattle-1', h = {1000 * h:g} fs, "
+    return (f"Reduction (Theorem 5.1): rigid H2O2, OpenMM verlet/RATTLE vs lie_poisson 'rattle-1', h = {1000 * h:g} fs, "
             f"{n} steps:\n  max |x_OpenMM - x_rattle-1| / |x0| = {np.abs(x - red).max() / s:.1e}   "
             f"(both vs exact: {np.abs(x - ex).max() / s:.1e})")
 

@@ -9,11 +9,13 @@ The package by layer (each imports only from the ones above it):
 * :mod:`.support` -- optional dependencies imported on first use (an error names the extra installing them);
 * :mod:`.methods` -- tableaux, splittings, the catalogue (``catalogue`` here), :func:`resolve`, pure-numpy
   reference integrators (no OpenMM);
-* :mod:`.physics` -- momenta and inertia on arrays, about a stated point (no OpenMM);
+* :mod:`.physics` -- momenta, inertia and rigid motion on arrays, about a stated point (no OpenMM);
 * :mod:`.systems` -- facts of an OpenMM System, conservation checks, initial states, minimal scenes;
 * :mod:`.plugin` -- the compiled OpenMM plugin and its loader;
-* :mod:`.integrators` -- the integrators (CustomIntegrator programs and the native plugin, one base);
-* :mod:`.conservation`, :mod:`.rigid` -- diagnostics, reporters, MDAnalysis analysis; rigid bodies;
+* :mod:`.integrators` -- the integrators on two backends, one base: CustomIntegrator programs
+  (:mod:`.integrators.custom_backend`) and the native plugin's integrator (:mod:`.integrators.native_backend`);
+* :mod:`.conservation`, :mod:`.rigid` -- diagnostics, reporters, MDAnalysis analysis; rigid bodies (Euler's
+  equations, rigid groups in a System);
 * :mod:`.studies` -- demo, bench, conservation table, speed; :mod:`.cli` -- the ``symprk`` command.
 
 Heavier parts (rigid bodies, diagnostics, reporters, MDAnalysis analysis, studies) load on first use.
@@ -30,12 +32,10 @@ __version__ = "0.2.0"
 
 # name -> module that defines it, imported lazily (keeps `import openmm_symprk` light)
 _LAZY = {
-    "rigidbody": ".rigid.lie_poisson",
-    "native": ".integrators.native",
-    "make_rigid": ".rigid.molecules",
-    "RigidGroup": ".rigid.molecules",
-    "RigidGroupError": ".rigid.molecules",
-    "RigidGroupWarning": ".rigid.molecules",
+    "make_rigid": ".rigid.groups",
+    "RigidGroup": ".rigid.groups",
+    "RigidGroupError": ".rigid.groups",
+    "RigidGroupWarning": ".rigid.groups",
     "linear_momentum": ".conservation.diagnostics",
     "angular_momentum": ".conservation.diagnostics",
     "diagnostics": ".conservation.diagnostics",
@@ -47,8 +47,7 @@ _LAZY = {
 
 def __getattr__(name):
     if name in _LAZY:
-        module = import_module(_LAZY[name], __name__)
-        return module if name in ("rigidbody", "native") else getattr(module, name)
+        return getattr(import_module(_LAZY[name], __name__), name)
     raise AttributeError(f"module 'openmm_symprk' has no attribute {name!r}")
 
 

@@ -3,6 +3,7 @@ import numpy as np
 import openmm.unit as unit
 
 from openmm_symprk.conservation import angular_momentum, linear_momentum
+from openmm_symprk.methods.orders import observed_orders
 
 
 class Counter:
@@ -56,3 +57,23 @@ def stiff_diatomic():
     bond.addBond(0, 1, 0.1, 1.0e5)
     system.addForce(bond)
     return system
+
+
+def final_state(scene, make_integrator, n_steps: int, T_ps: float, platform="Reference"):
+    """Positions and velocities after ``n_steps`` steps of size T/n from the scene's initial state."""
+    ig = make_integrator(T_ps / n_steps)
+    ctx = scene.context(ig, platform)
+    ig.step(n_steps)
+    st = ctx.getState(getPositions=True, getVelocities=True)
+    x = st.getPositions(asNumpy=True).value_in_unit(unit.nanometer)
+    v = st.getVelocities(asNumpy=True).value_in_unit(unit.nanometer / unit.picosecond)
+    del ctx
+    return np.concatenate([x.ravel(), v.ravel()])
+
+
+def measure_order(scene, make_integrator, T_ps: float, steps=(10, 20, 40, 80), platform="Reference"):
+    """Measured convergence order of a compiled integrator on an OpenMM scene: (orders, differences), one order
+    estimate per consecutive triple of step counts, from successive refinements
+    (:func:`openmm_symprk.methods.orders.observed_orders`: no reference solution needed).  ``make_integrator(h_ps)``
+    returns a fresh integrator at step size h."""
+    return observed_orders([final_state(scene, make_integrator, n, T_ps, platform) for n in steps], steps)

@@ -1,26 +1,29 @@
 """The OpenMM integrators, on two backends sharing one base (:mod:`.base`).
 
 * :class:`SymplecticIntegrator` -- a catalogue method by name; builds a :class:`NativeSymplecticIntegrator`
-  (the compiled plugin) or a :class:`CustomSymplecticIntegrator` (a CustomIntegrator program), see
-  :mod:`.backend`;
+  (:mod:`.native_backend`, the compiled plugin) or a :class:`CustomSymplecticIntegrator` (:mod:`.custom_backend`, a
+  CustomIntegrator program), see :mod:`.backend`;
 * :class:`PRKIntegrator` -- any PRK tableau pair or kick/drift splitting (CustomIntegrator program);
-* :mod:`.program` compiles the programs, :mod:`.projection` the exact-momentum kicks,
-  :mod:`.convergence` measures orders of compiled integrators, :mod:`.restore` gives an integrator read
-  from XML its class back.
+* :mod:`.options` checks the keyword options once; :mod:`.program` compiles the programs, :mod:`.projection` the
+  exact-momentum kicks, :mod:`.thermostat_program` the thermostat's events; :mod:`.metadata` is what a program
+  stores of itself and :mod:`.restore` gives an integrator read from XML its class back.
 
-Both backends take the method resolved once (:func:`openmm_symprk.methods.resolved.resolve`, called by
-:func:`.backend.prepare` together with the option checks they share) and keep it as ``integrator.resolved``.
+Both backends take the options checked once (:class:`.options.IntegratorOptions`, kept as ``integrator.options``)
+and the method resolved once for the System (:func:`.backend.resolve_for_system`, kept as ``integrator.resolved``);
+``integrator.program_info`` holds the facts of the compiled program.
 """
 from .backend import BackendWarning, NativeMethodError, NativeUnavailableError, choose_backend
 from .base import (CheckpointMismatchError, ConvergenceWarning, IntegratorBase, SimulationBlowUpError,
                    SystemMismatchError, step_size_in_ps)
-from .custom import CustomSymplecticIntegrator, PRKIntegrator, TimeWarning
-from .native import NativeSymplecticIntegrator, native_available
+from .custom_backend import CustomSymplecticIntegrator, PRKIntegrator, TimeWarning
+from .native_backend import NativeSymplecticIntegrator, native_available
 from ..methods.resolved import ConstraintSupportError
+from .options import IntegratorOptions
 from .restore import deserialize, restore
 from .symplectic import SymplecticIntegrator
 
 __all__ = ["SymplecticIntegrator", "PRKIntegrator", "CustomSymplecticIntegrator", "NativeSymplecticIntegrator",
            "IntegratorBase", "choose_backend", "native_available", "restore", "deserialize", "SimulationBlowUpError",
            "ConvergenceWarning", "SystemMismatchError", "CheckpointMismatchError", "ConstraintSupportError",
-           "BackendWarning", "NativeMethodError", "NativeUnavailableError", "TimeWarning", "step_size_in_ps"]
+           "BackendWarning", "NativeMethodError", "NativeUnavailableError", "TimeWarning", "step_size_in_ps",
+           "IntegratorOptions"]

@@ -1,14 +1,17 @@
 """What every integrator of the package shares, whichever backend runs it.
 
 :class:`IntegratorBase` is a mixin placed in front of an ``openmm.Integrator`` class (the CustomIntegrator
-program of :mod:`.custom` or the plugin's SymPRKIntegrator of :mod:`.native`).  It holds, once:
+program of :mod:`.custom_backend` or the plugin's SymPRKIntegrator of :mod:`.native_backend`).  It holds, once:
 
 * ``step(n)``: runs the steps and raises :class:`SimulationBlowUpError` naming the first step whose
   velocities stopped being finite (or exceeded ``max_speed``), the method, the step size and the method's
   stability limit; the record is cleared when it is reported, so reloading a good state and going on works;
 * ``setStepSize`` with the package's validation, ``describe()``, ``steps_taken``;
-* what the integrator was compiled for (:class:`~openmm_symprk.systems.properties.SystemSignature` of its
-  ``system=``), which each backend checks against the Context it is bound to;
+* what it runs: ``resolved`` (the :class:`~openmm_symprk.methods.resolved.ResolvedMethod`), ``options`` (the
+  checked :class:`~.options.IntegratorOptions`, read by ``check_finite``, ``max_speed``, ``exact_momentum`` and
+  ``compiled_for``, the :class:`~openmm_symprk.systems.properties.SystemSignature` of its ``system=``, which each
+  backend checks against the Context it is bound to) and ``program_info`` (the facts of the compiled program,
+  :class:`~.program.ProgramInfo`);
 * copies: ``pickle``, ``copy.copy`` and ``copy.deepcopy`` go through OpenMM's XML serialization (as for
   OpenMM's own integrators) and give back the same Python class with its conveniences.
 
@@ -31,12 +34,11 @@ import operator
 import openmm as mm
 import openmm.unit as unit
 
-from ..methods.catalogue import get_method
 from .quantities import positive_quantity
 from .thermostat import check_seed
 
 __all__ = ["IntegratorBase", "SimulationBlowUpError", "ConvergenceWarning", "SystemMismatchError",
-           "CheckpointMismatchError", "step_size_in_ps", "check_max_speed"]
+           "CheckpointMismatchError", "step_size_in_ps"]
 
 
 class SimulationBlowUpError(RuntimeError):
@@ -60,29 +62,10 @@ def step_size_in_ps(step_size) -> float:
     return positive_quantity(step_size, "step size", unit.picoseconds, "time", "2*unit.femtoseconds")
 
 
-def check_max_speed(max_speed) -> float:
-    """``max_speed`` in nm/ps as a float >= 0 (None or 0: only NaN and infinity count as a blow-up)."""
-    if max_speed is None:
-        return 0.0
-    if unit.is_quantity(max_speed):
-        max_speed = max_speed.value_in_unit(unit.nanometer / unit.picosecond)
-    try:
-        value = float(max_speed)
-    except (TypeError, ValueError):
-        raise TypeError(f"max_speed must be a speed in nm/ps (or None), got {max_speed!r}") from None
-    if not math.isfinite(value) or value < 0:
-        raise ValueError(f"max_speed must be a finite speed >= 0 nm/ps (None or 0: only NaN and infinity), "
-                         f"got {max_speed!r}")
-    return value
-
-
 def _restore(cls, xml: str, state: dict):
     """Rebuild an integrator of ``cls`` from its XML and Python state (pickle, copy, :func:`restore`)."""
     obj = object.__new__(cls)
     obj._adopt(mm.XmlSerializer.deserialize(xml))
-    state = dict(state)
-    if isinstance(state.get("method"), str):  # catalogue methods travel by name
-        state["method"] = get_method(state["method"])
     obj.__dict__.update(state)
     obj._reset_binding()
     return obj
@@ -92,15 +75,35 @@ class IntegratorBase:
     """Mixin of the package's integrators (see the module docstring)."""
 
     backend: str = ""
-    method_name: str = "user tableau"
-    method = None  # the catalogue Method, when there is one
-    check_finite: bool = True
-    max_speed: float = 0.0
-    compiled_for = None  # SystemSignature of system=, or None
-    resolved = None  # the ResolvedMethod it runs (openmm_symprk.methods.resolved), None if not known
-    thermostat = None  # ThermostatSettings, None without a thermostat (NVE)
+    resolved = None  # the ResolvedMethod it runs (openmm_symprk.methods.resolved)
+    options = None  # the IntegratorOptions it was built with (.options)
+    program_info = None  # the ProgramInfo of its compiled program (.program)
+    thermostat = None  # ThermostatSettings as the program runs them now, None without a thermostat (NVE)
     #: attributes a copy does not carry (the C++ object, per-Context handles)
     _transient: tuple = ("this", "thisown")
+
+    # -- what it runs -----------------------------------------------------------------------------------
+    @property
+    def method_name(self) -> str:
+        return self.resolved.name
+
+    @property
+    def check_finite(self) -> bool:
+        return self.options.check_finite
+
+    @property
+    def max_speed(self) -> float:
+        """nm/ps; 0: only NaN and infinity count as a blow-up."""
+        return self.options.max_speed
+
+    @property
+    def exact_momentum(self) -> bool:
+        return self.options.exact_momentum
+
+    @property
+    def compiled_for(self):
+        """The :class:`~openmm_symprk.systems.properties.SystemSignature` of ``system=``, None without one."""
+        return self.options.system
 
     # -- the step ---------------------------------------------------------------------------------
     def step(self, steps):
@@ -147,11 +150,10 @@ class IntegratorBase:
             f"call, and go on (the blow-up record is cleared).")
 
     def _stability(self) -> str:
-        try:
-            st = (self.resolved or self.method or get_method(self.method_name)).stability
-        except Exception:
-            return "unknown"
-        return "unbounded" if st is None or math.isinf(st) else f"{st:.4f}"
+        st = self.resolved.stability
+        if st is None:
+            return "unknown (not a catalogue method)"
+        return "unbounded" if math.isinf(st) else f"{st:.4f}"
 
     # -- OpenMM overrides ---------------------------------------------------------------------------
     def setStepSize(self, size):
@@ -242,11 +244,8 @@ class IntegratorBase:
 
     # -- copies ---------------------------------------------------------------------------------------
     def _python_state(self) -> dict:
-        """The Python attributes a copy needs (everything but the C++ object; catalogue methods by name)."""
-        state = {k: v for k, v in self.__dict__.items() if k not in self._transient}
-        if state.get("method") is not None:
-            state["method"] = state["method"].name
-        return state
+        """The Python attributes a copy needs (everything but the C++ object and per-Context handles)."""
+        return {k: v for k, v in self.__dict__.items() if k not in self._transient}
 
     def _adopt(self, other):
         """Take over the C++ object of ``other`` (an openmm.Integrator of the same C++ class)."""

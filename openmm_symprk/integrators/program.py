@@ -33,13 +33,13 @@ One compiler for everything (docs/openmm_notes.md explains each rule):
 from __future__ import annotations
 
 import hashlib
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 import openmm as mm
 
 from ..methods.resolved import ResolvedMethod, SubstepKind
-from ..methods.tableau import PRKTableau
+from .options import IntegratorOptions
 
 #: Global variables every compiled program has, in this order (read by the integrator classes).
 SIGNATURE_VAR = "symprk_signature"
@@ -56,18 +56,20 @@ ITER_VAR = "symprk_iterations"
 NONFINITE_LIMIT2 = "1e300"
 
 
-@dataclass
+@dataclass(frozen=True)
 class ProgramInfo:
-    """What the compiler emitted: used by tests, the CLI and the integrator classes."""
+    """The facts of a compiled program beyond the method it runs (the form of the step, its force evaluations, its
+    levels are the method's: :attr:`method`)."""
 
-    kind: str  # "splitting", "explicit" or "implicit"
-    constraints: bool  # RATTLE constraint steps emitted
-    force_evals: int | None  # per step in steady state (implicit: per fixed-point iteration)
-    stages: int
-    exact_momentum: bool
-    notes: list = field(default_factory=list)
-    signature: int = 0  # the value of global 0 (see the module docstring)
-    evals_per_group: dict | None = None  # multiple time stepping: {force groups: evaluations per step}
+    method: ResolvedMethod  # the method compiled
+    rattle: bool  # RATTLE steps emitted: the method keeps constraints, or the System has virtual sites (see below)
+    signature: int  # the value of global 0 (see the module docstring); the plugin's program signature (native)
+    notes: tuple = ()  # lines describe() prints
+
+    @property
+    def force_evals(self) -> int:
+        """The method's force evaluations per step (``method.force_evals``)."""
+        return self.method.force_evals
 
 
 def program_signature(integrator: mm.CustomIntegrator) -> int:
@@ -91,8 +93,7 @@ def _num(c) -> str:
 class _Emitter:
     """Appends computations to a CustomIntegrator, with the shared header, kick and drift rules."""
 
-    def __init__(self, integrator: mm.CustomIntegrator, constraints: bool, exact_momentum: bool,
-                 update_context_state: bool = True, thermostat=None):
+    def __init__(self, integrator: mm.CustomIntegrator, constraints: bool, exact_momentum: bool, thermostat=None):
         if integrator.getNumComputations() or integrator.getNumGlobalVariables() or integrator.getNumPerDofVariables():
             raise ValueError("compile into an empty CustomIntegrator: this one already has a program")
         self.ig = integrator
@@ -111,8 +112,7 @@ class _Emitter:
             from .thermostat_program import add_variables
 
             add_variables(integrator, thermostat)
-        if update_context_state:
-            integrator.addUpdateContextState()
+        integrator.addUpdateContextState()
         self._probe()
         self._thermostat_event(STEP_VAR)
 
@@ -223,13 +223,11 @@ class _Emitter:
         return signature
 
 
-def compile_splitting(integrator, method: ResolvedMethod, constraints: bool, exact_momentum=False,
-                      check_finite=True, update_context_state=True, max_speed=0.0, thermostat=None) -> ProgramInfo:
+def _compile_splitting(integrator, method: ResolvedMethod, constraints: bool, options: IntegratorOptions) -> ProgramInfo:
     """Emit the program of a resolved kick/drift method: its sub-steps as they run, with a velocity projection
     before every drift flagged for one.  ``constraints``: emit the RATTLE steps (the System has constraints, or
-    virtual sites that only ConstrainPositions places on the Common platforms); ``thermostat``: the
-    :class:`~.thermostat.ThermostatSettings` of a velocity-rescaling thermostat (None: NVE)."""
-    em = _Emitter(integrator, constraints, exact_momentum, update_context_state, thermostat)
+    virtual sites that only ConstrainPositions places on the Common platforms)."""
+    em = _Emitter(integrator, constraints, options.exact_momentum, options.thermostat)
     for sub in method.substeps:
         c = float(sub.coefficient)
         if sub.kind == SubstepKind.DRIFT:
@@ -238,9 +236,7 @@ def compile_splitting(integrator, method: ResolvedMethod, constraints: bool, exa
             em.drift(c)
         else:
             em.kick(c, sub.groups)
-    sig = em.finish(check_finite, max_speed)
-    return ProgramInfo("splitting", constraints, method.force_evals, len(method.substeps), exact_momentum,
-                       signature=sig, evals_per_group=method.evaluations or None)
+    return ProgramInfo(method, constraints, em.finish(options.check_finite, options.max_speed))
 
 
 def _lincomb(base: str, coeffs, names) -> str:
@@ -250,15 +246,16 @@ def _lincomb(base: str, coeffs, names) -> str:
     return f"{base} + dt*({' + '.join(terms)})"
 
 
-def compile_tableau(integrator, tab: PRKTableau, exact_momentum=False, check_finite=True,
-                    update_context_state=True, tolerance=1e-12, max_iterations=60, max_speed=0.0,
-                    place_virtual_sites=False, thermostat=None) -> ProgramInfo:
+def _compile_tableau(integrator, method: ResolvedMethod, options: IntegratorOptions,
+                     place_virtual_sites=False) -> ProgramInfo:
     """Emit the program of a general PRK pair (unconstrained systems only).
 
     Per-DOF variables: symprk_x0/v0 (start of step), symprk_k<i> (stage accelerations F(Q_i)/m),
     symprk_p<i> (stage velocities P_i), symprk_q<i> (implicit stage positions).  ``place_virtual_sites``
     ends the step with a ConstrainPositions (which only places virtual sites in an unconstrained System)."""
-    em = _Emitter(integrator, False, exact_momentum, update_context_state, thermostat)
+    em = _Emitter(integrator, False, options.exact_momentum, options.thermostat)
+    tab = method.tableau
+    tolerance, max_iterations = options.tolerance, options.max_iterations
     s = tab.stages
     A, Ah, b, bh = (np.asarray(m, dtype=np.float64) for m in (tab.A, tab.A_hat, tab.b, tab.b_hat))
     for v in ("symprk_x0", "symprk_v0"):
@@ -271,7 +268,7 @@ def compile_tableau(integrator, tab: PRKTableau, exact_momentum=False, check_fin
         em.per_dof(n)
     order = tab.explicit_order
     notes = []
-    need_k = [bool(np.any(Ah[:, i]) or bh[i]) for i in range(s)]
+    need_k = tab.evaluated_stages
     if order is not None:
         x_is_start = True  # x currently holds x_n (forces at x_n may still be cached)
         for i in range(s):
@@ -290,8 +287,6 @@ def compile_tableau(integrator, tab: PRKTableau, exact_momentum=False, check_fin
                 em.acceleration(k[i])
             if order == "q-first":
                 integrator.addComputePerDof(p[i], _lincomb("symprk_v0", Ah[i, :i + 1], k[:i + 1]))
-        kind = "explicit"
-        evals = int(sum(need_k))
     else:
         q = [f"symprk_q{i}" for i in range(s)]
         for n in q:
@@ -323,8 +318,6 @@ def compile_tableau(integrator, tab: PRKTableau, exact_momentum=False, check_fin
         integrator.endBlock()
         integrator.addComputeGlobal(
             NONCONV_VAR, f"{NONCONV_VAR} + step(symprk_err - {_num(tolerance ** 2)})")
-        kind = "implicit"
-        evals = s
         notes.append(f"implicit stages: fixed-point iteration to {tolerance:g} nm (sum over all degrees of "
                      f"freedom of the squared change), at most {max_iterations} iterations; "
                      f"{s} force evaluations per iteration")
@@ -332,19 +325,17 @@ def compile_tableau(integrator, tab: PRKTableau, exact_momentum=False, check_fin
     integrator.addComputePerDof("v", _lincomb("symprk_v0", bh, k))
     if place_virtual_sites:
         integrator.addConstrainPositions()
-    sig = em.finish(check_finite, max_speed)
-    return ProgramInfo(kind, False, evals, s, exact_momentum, notes, signature=sig)
+    return ProgramInfo(method, False, em.finish(options.check_finite, options.max_speed), tuple(notes))
 
 
-def compile_program(integrator, method: ResolvedMethod, virtual_sites: bool = False, **options) -> ProgramInfo:
-    """Compile a resolved method (:func:`openmm_symprk.methods.resolved.resolve`) into ``integrator``'s program.
+def compile_program(integrator, method: ResolvedMethod, options: IntegratorOptions,
+                    virtual_sites: bool = False) -> ProgramInfo:
+    """Compile a resolved method (:func:`openmm_symprk.methods.resolved.resolve`) with its ``options`` into
+    ``integrator``'s program.
 
     A kick/drift method gets RATTLE steps where it was resolved with constraints or the System has
     ``virtual_sites`` (whose ConstrainPositions places them); a general PRK pair (resolved without constraints)
     ends the step with a ConstrainPositions where there are virtual sites."""
-    common = ("exact_momentum", "check_finite", "update_context_state", "max_speed", "thermostat")
     if method.is_splitting:
-        keep = {k: v for k, v in options.items() if k in common}
-        return compile_splitting(integrator, method, method.constraints or virtual_sites, **keep)
-    keep = {k: v for k, v in options.items() if k in common + ("tolerance", "max_iterations")}
-    return compile_tableau(integrator, method.tableau, place_virtual_sites=virtual_sites, **keep)
+        return _compile_splitting(integrator, method, method.constraints or virtual_sites, options)
+    return _compile_tableau(integrator, method, options, place_virtual_sites=virtual_sites)

@@ -4,7 +4,10 @@
 class (see :class:`~.base.IntegratorBase`).  Plain ``openmm.XmlSerializer.deserialize`` cannot: it returns
 an ``openmm.CustomIntegrator`` (or, for the native plugin, a base ``openmm.Integrator``), without the
 blow-up check, the Context checks or ``describe()``.  :func:`restore` turns either into the package's class,
-from what the XML carries (the metadata of a CustomIntegrator program; the plugin's method and options).
+from what the XML carries.  A CustomIntegrator program carries its metadata (:mod:`.metadata`: class, method,
+options, System facts): the method is resolved and compiled again from it, into a scratch program whose signature
+must be the one read (global 0), so that the restored integrator's method and program facts are exact.  The plugin
+carries its sub-steps, method name and options: the method is resolved again and checked against the sub-steps.
 
     integrator = openmm_symprk.deserialize(xml)              # or restore(XmlSerializer.deserialize(xml))
 """
@@ -13,17 +16,19 @@ from __future__ import annotations
 from dataclasses import replace
 
 import openmm as mm
+import openmm.unit as unit
 
 from .. import plugin
 from ..methods.catalogue import methods as catalogue_methods
 from ..methods.resolved import resolve
 from ..methods.splitting import Splitting
-from ..systems.properties import SystemSignature
 from . import program
-from .custom import CustomSymplecticIntegrator, PRKIntegrator, read_metadata
-from .native import NativeSymplecticIntegrator, native_available
-from .program import ProgramInfo
-from .thermostat import ThermostatSettings
+from .backend import resolve_for_system
+from .base import IntegratorBase
+from .custom_backend import CustomSymplecticIntegrator, PRKIntegrator
+from .metadata import methods_of, options_of, read_metadata
+from .native_backend import NativeSymplecticIntegrator, native_available
+from .options import IntegratorOptions
 
 __all__ = ["restore", "deserialize"]
 
@@ -36,8 +41,6 @@ def deserialize(xml: str):
 def restore(integrator):
     """The package's integrator class around ``integrator`` (an OpenMM integrator from XML), which it takes
     over; an integrator that already is one is returned as it is."""
-    from .base import IntegratorBase
-
     if isinstance(integrator, IntegratorBase):
         return integrator
     if isinstance(integrator, mm.CustomIntegrator):
@@ -52,39 +55,26 @@ def restore(integrator):
 
 
 def _restore_custom(integrator: mm.CustomIntegrator):
+    """The class, method and options of the metadata; the method resolved and compiled again from them, into a
+    scratch CustomIntegrator whose signature must be the program's (global 0): the facts are then exact."""
     meta = read_metadata(integrator)
     if meta is None:
         raise TypeError("this CustomIntegrator was not compiled by openmm_symprk (its program carries no metadata)")
-    catalogue = meta.get("catalogue")
     cls = CustomSymplecticIntegrator if meta.get("class") == "CustomSymplecticIntegrator" else PRKIntegrator
+    method, inner = methods_of(meta)
+    options = options_of(meta, integrator.getStepSize().value_in_unit(unit.picosecond), inner)
+    resolved = resolve_for_system(cls.__name__, method, None, options, name=meta.get("method"))
+    has_sites = options.system.virtual_sites if options.system is not None else True
+    info = program.compile_program(mm.CustomIntegrator(options.step_size), resolved, options, has_sites)
+    stored = integrator.getGlobalVariable(0)
+    if stored != info.signature:
+        raise ValueError(f"this {cls.__name__}({resolved.name}) program is not the one its metadata compiles to (its "
+                         f"signature {stored:.0f}, recompiled {info.signature}): it was written by another version "
+                         f"of openmm_symprk or edited. Create the integrator again with the options it was built with")
     obj = object.__new__(cls)
     obj._adopt(integrator)
-    steps = [obj.getComputationStep(i) for i in range(obj.getNumComputations())]
-    names = {obj.getGlobalVariableName(i) for i in range(obj.getNumGlobalVariables())}
-    kind = "implicit" if program.NONCONV_VAR in names else (
-        "splitting" if not any(var.startswith("symprk_k") for _, var, _ in steps) else "explicit")
-    constraints = any(k == mm.CustomIntegrator.ConstrainPositions for k, _, _ in steps) and kind == "splitting"
-    options = meta.get("options", {})
-    system = meta.get("system")
-    catalogue = meta.get("catalogue")
-    # a catalogue method is resolved again as it was compiled (its sub-steps, orders, levels); a user tableau's
-    # program carries no description of it
-    groups = options.get("groups")
-    resolved = resolve(catalogue, constraints=constraints, groups=[tuple(g) for g in groups] if groups else None,
-                       inner_method=options.get("inner_method") if groups else None) if catalogue else None
-    obj.method_name = meta.get("method", "user tableau")
-    obj._set_resolved(resolved)
-    obj.__dict__.update(
-        check_finite=bool(options.get("check_finite", True)), max_speed=float(options.get("max_speed") or 0.0),
-        exact_momentum=bool(options.get("exact_momentum", False)),
-        compiled_for=SystemSignature(**system) if system else None, _masses=None,
-        thermostat=ThermostatSettings(**meta["thermostat"]) if meta.get("thermostat") else None,
-        _signature=obj.getGlobalVariable(0),
-        program_info=ProgramInfo(kind, constraints, resolved.force_evals if resolved is not None else None,
-                                 len(resolved.substeps) if resolved is not None else 0,
-                                 bool(options.get("exact_momentum", False)), ["restored from XML"],
-                                 signature=int(obj.getGlobalVariable(0)),
-                                 evals_per_group=(resolved.evaluations or None) if resolved is not None else None))
+    obj._set_program(resolved, options, replace(info, notes=(*info.notes, "restored from XML")))
+    obj.__dict__.update(_masses=None, thermostat=options.thermostat)
     obj._reset_binding()
     return obj
 
@@ -114,9 +104,9 @@ def _restore_native(integrator):
             entry = catalogue_methods[name]
             resolved = replace(resolved, entry=entry, order=entry.order, constrained_order=entry.constrained_order,
                                stability=entry.stability)
-    obj._set_resolved(resolved)
-    obj.__dict__.update(check_finite=True, max_speed=float(obj.getMaxSpeed()), exact_momentum=bool(obj.getExactMomentum()),
-                        compiled_for=None)
-    obj.program_info.notes.append("restored from XML")
+    options = IntegratorOptions(float(obj.getStepSize().value_in_unit(unit.picosecond)),
+                                exact_momentum=bool(obj.getExactMomentum()), max_speed=float(obj.getMaxSpeed()),
+                                groups=resolved.groups, thermostat=obj.thermostat)
+    obj._set_program(resolved, options, notes=("restored from XML",))
     obj._reset_binding()
     return obj

@@ -1,8 +1,8 @@
 """``SymplecticIntegrator``: a catalogue method by name, on the backend that suits this installation.
 
 ``SymplecticIntegrator(...)`` is a real class: calling it builds an instance of one of its backend
-subclasses (:class:`~openmm_symprk.integrators.custom.CustomSymplecticIntegrator`, a CustomIntegrator
-program, or :class:`~openmm_symprk.integrators.native.NativeSymplecticIntegrator`, the compiled plugin),
+subclasses (:class:`~openmm_symprk.integrators.custom_backend.CustomSymplecticIntegrator`, a CustomIntegrator
+program, or :class:`~openmm_symprk.integrators.native_backend.NativeSymplecticIntegrator`, the compiled plugin),
 chosen by :func:`~openmm_symprk.integrators.backend.choose_backend`; Python then runs that subclass's
 ``__init__`` as usual, and ``isinstance(integrator, SymplecticIntegrator)`` holds for both.  Backend
 subclasses register themselves with ``class X(SymplecticIntegrator, ..., backend="name")``.
@@ -33,7 +33,7 @@ class SymplecticIntegrator(IntegratorBase):
       needs ``system=``), ``check_finite`` (raise SimulationBlowUpError on NaN/inf velocities),
       ``max_speed`` (nm/ps: also count faster velocities as a blow-up); the CustomIntegrator backend also
       takes ``allow_nonsymplectic``, ``constraints``, ``tolerance`` and ``max_iterations``
-      (see :class:`~openmm_symprk.integrators.custom.PRKIntegrator`);
+      (see :class:`~openmm_symprk.integrators.custom_backend.PRKIntegrator`);
     * NVT: ``temperature`` (K, needs ``system=``), ``collision_time`` (ps, default 0.1), ``thermostat_interval``
       (default 1) and ``random_seed`` (default 0: fresh per Context) add stochastic velocity rescaling around
       the step, keeping total momentum (and angular momentum of an isolated System) exactly

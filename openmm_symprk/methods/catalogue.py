@@ -20,6 +20,9 @@ from .splitting import DRIFT, KICK, Splitting, compose
 from .tableau import PRKTableau
 
 FAMILIES = ("splitting", "composition", "implicit", "reference")
+#: The Hamiltonians a method's order holds for: any separable H = T(p) + V(q), or only those with a quadratic
+#: kinetic energy T = p.M^-1.p/2 (all of MD; Runge-Kutta-Nystrom order conditions).
+HAMILTONIANS = ("separable", "quadratic-kinetic")
 
 
 class UnknownMethodError(KeyError, ValueError):
@@ -35,9 +38,8 @@ class Method:
     title: str
     order: int
     constrained_order: int | None  # order measured under RATTLE constraints (None: not a splitting)
-    kind: str  # "PRK" (any separable H) or "RKN" (needs quadratic kinetic energy: all of MD)
-    family: str
-    force_evals: int  # per step in a long run, closing and opening kicks shared
+    hamiltonian: str  # the Hamiltonians its order holds for, one of HAMILTONIANS
+    family: str  # one of FAMILIES
     stability: float | None  # largest stable h*omega on the harmonic oscillator
     source: str
     aliases: tuple = ()
@@ -62,6 +64,14 @@ class Method:
         if self.family == "composition" and self.base != "verlet":
             return compose(methods["verlet"].splitting, self.weights)
         return self.splitting
+
+    @cached_property
+    def force_evals(self) -> int:
+        """Force evaluations per step in a long run (the closing and opening kicks of a splitting share one; an
+        implicit pair: per fixed-point iteration), derived from the sequence or the tableau."""
+        if self.splitting is not None:
+            return self.splitting.force_evaluations()
+        return self.tableau().force_evaluations
 
     @property
     def symplectic(self) -> bool:
@@ -94,9 +104,10 @@ def _load(filename: str) -> list:
     return tomllib.loads(text)["method"]
 
 
-def _build() -> dict:
+def _build(raw: list) -> dict:
+    """name -> Method from the data files' entries; ValueError for an unknown family or Hamiltonian, or a listed
+    force-evaluation count that is not the one the sequence or tableau gives."""
     entries: dict = {}
-    raw = _load("splittings.toml") + _load("tableaux.toml")
     by_name = {r["name"]: r for r in raw}
 
     def splitting_of(r):
@@ -112,14 +123,21 @@ def _build() -> dict:
             stab = math.inf if stab == "inf" else float(stab)
         m = Method(
             name=r["name"], title=r["title"], order=int(r["order"]),
-            constrained_order=r.get("constrained_order"), kind=r["kind"], family=r["family"],
-            force_evals=int(r["force_evals"]), stability=stab, source=r["source"],
+            constrained_order=r.get("constrained_order"), hamiltonian=r["hamiltonian"], family=r["family"],
+            stability=stab, source=r["source"],
             aliases=tuple(r.get("aliases", ())), splitting=splitting_of(r), base=r.get("base"),
             weights=tuple(r.get("weights", ())),
             _tableau_data={k: r[k] for k in ("A", "b", "A_hat", "b_hat")} if "A" in r else None,
         )
         if m.family not in FAMILIES:
-            raise ValueError(f"catalogue entry {m.name}: unknown family {m.family!r}")
+            raise ValueError(f"catalogue entry {m.name}: unknown family {m.family!r}; one of {', '.join(FAMILIES)}")
+        if m.hamiltonian not in HAMILTONIANS:
+            raise ValueError(f"catalogue entry {m.name}: unknown hamiltonian {m.hamiltonian!r}; one of "
+                             f"{', '.join(HAMILTONIANS)}")
+        if int(r["force_evals"]) != m.force_evals:
+            raise ValueError(f"catalogue entry {m.name}: force_evals = {r['force_evals']} is listed, but its "
+                             f"{'sequence' if m.is_splitting else 'tableau'} evaluates the forces {m.force_evals} "
+                             f"times per step")
         entries[m.name] = m
     return entries
 
@@ -132,22 +150,31 @@ class _Catalogue(Mapping):
         self._alias = {}
         for m in entries.values():
             for a in (m.name, *m.aliases):
-                self._alias[_norm(a)] = m.name
+                self._alias[normalise_name(a)] = m.name
 
     def __getitem__(self, name) -> Method:
         if isinstance(name, Method):
             return name
         if not isinstance(name, str):
             raise UnknownMethodError(f"a method name must be a string, got {name!r}")
-        key = self._alias.get(_norm(name))
+        key = self._alias.get(normalise_name(name))
         if key is None:
-            close = difflib.get_close_matches(_norm(name), list(self._alias), n=4, cutoff=0.5)
-            close = list(dict.fromkeys(self._alias[c] for c in close))
-            hint = f" Did you mean {', '.join(repr(c) for c in close)}?" if close else ""
             raise UnknownMethodError(
-                f"unknown method {name!r}.{hint} Known methods: {', '.join(self._entries)} "
+                f"unknown method {name!r}.{self.suggest(name)} Known methods: {', '.join(self._entries)} "
                 f"(or pass your own PRKTableau to PRKIntegrator).")
         return self._entries[key]
+
+    def suggest(self, name: str, among=None, extra=()) -> str:
+        """" Did you mean 'a', 'b'?" for the names close to ``name`` (aliases give their method's name), "" if none.
+
+        ``among``: the methods to suggest from (default: all); ``extra``: more names, outside the catalogue (the
+        rigid-body integrators of Euler's equations)."""
+        allowed = None if among is None else {m.name for m in among}
+        names = {a: m for a, m in self._alias.items() if allowed is None or m in allowed}
+        names.update({normalise_name(e): e for e in extra})
+        close = difflib.get_close_matches(normalise_name(str(name)), list(names), n=4, cutoff=0.5)
+        close = list(dict.fromkeys(names[c] for c in close))
+        return f" Did you mean {', '.join(repr(c) for c in close)}?" if close else ""
 
     def __iter__(self):
         return iter(self._entries)
@@ -156,7 +183,7 @@ class _Catalogue(Mapping):
         return len(self._entries)
 
     def __contains__(self, name):
-        return isinstance(name, str) and _norm(name) in self._alias
+        return isinstance(name, str) and normalise_name(name) in self._alias
 
     def by_family(self, family: str) -> list:
         return [m for m in self._entries.values() if m.family == family]
@@ -166,11 +193,12 @@ class _Catalogue(Mapping):
         return [m for m in self._entries.values() if m.is_splitting]
 
 
-def _norm(name: str) -> str:
+def normalise_name(name: str) -> str:
+    """A method name as the catalogue compares names: case, spaces and underscores do not matter."""
     return name.strip().lower().replace("_", "-").replace(" ", "-")
 
 
-methods = _Catalogue(_build())
+methods = _Catalogue(_build(_load("splittings.toml") + _load("tableaux.toml")))
 
 
 def get_method(name) -> Method:
@@ -181,14 +209,17 @@ def get_method(name) -> Method:
 def format_table(entries=None) -> str:
     """The catalogue as a plain-text table (what ``symprk methods`` prints)."""
     entries = list(entries or methods.values())
-    head = f"{'name':24s} {'order':>5s} {'family':12s} {'kind':4s} {'f/step':>6s} {'stab h*w':>9s} {'per eval':>8s}  title"
+    head = (f"{'name':24s} {'order':>5s} {'family':12s} {'hamiltonian':17s} {'f/step':>6s} {'stab h*w':>9s} "
+            f"{'per eval':>8s}  title")
     lines = [head, "-" * len(head)]
     for m in entries:
         stab = "-" if m.stability is None else ("inf" if math.isinf(m.stability) else f"{m.stability:.4f}")
         per = m.stability_per_force_eval
         per = "-" if per is None else ("inf" if math.isinf(per) else f"{per:.3f}")
-        lines.append(f"{m.name:24s} {m.order:5d} {m.family:12s} {m.kind:4s} {m.force_evals:6d} {stab:>9s} {per:>8s}  {m.title}")
+        lines.append(f"{m.name:24s} {m.order:5d} {m.family:12s} {m.hamiltonian:17s} {m.force_evals:6d} {stab:>9s} "
+                     f"{per:>8s}  {m.title}")
     return "\n".join(lines)
 
 
-__all__ = ["Method", "methods", "get_method", "format_table", "UnknownMethodError", "KICK", "DRIFT"]
+__all__ = ["Method", "methods", "get_method", "format_table", "normalise_name", "UnknownMethodError", "FAMILIES",
+           "HAMILTONIANS", "KICK", "DRIFT"]

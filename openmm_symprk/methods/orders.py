@@ -3,8 +3,8 @@
 Given final states y_N computed with N, 2N, 4N, ... steps over the same time, the differences
 d_k = |y_{N_k} - y_{N_{k+1}}| shrink like (T/N_k)^p, so p = log(d_k / d_{k+1}) / log(N_{k+1} / N_k).  No
 reference solution is needed, so a wrong coefficient cannot hide behind a wrong reference.  Used for the
-pure-numpy reference integrators (:func:`.reference.measure_order`) and for OpenMM programs
-(:mod:`openmm_symprk.integrators.convergence`).
+pure-numpy reference integrators (:func:`.reference.measure_order`) and, by the test-suite, for OpenMM programs
+(tests/helpers.py).
 """
 from __future__ import annotations
 

@@ -28,25 +28,6 @@ def henon_heiles_force(q):
     return np.stack([-x - 2 * x * y, -y - x * x + y * y], axis=-1)
 
 
-def henon_heiles_energy(q, p):
-    x, y = q[..., 0], q[..., 1]
-    return 0.5 * np.sum(p * p, axis=-1) + 0.5 * (x * x + y * y) + x * x * y - y ** 3 / 3
-
-
-def pendulum_force(q):
-    return -np.sin(q)
-
-
-def harmonic_force(q):
-    return -q
-
-
-def central_force(q, k=1.0):
-    """Anharmonic central potential V = k (|q|^2/2 + |q|^4/4) in 3-D: conserves L = q x p."""
-    r2 = np.sum(q * q, axis=-1, keepdims=True)
-    return -k * q * (1 + r2)
-
-
 # -- one step -----------------------------------------------------------------------------------
 def splitting_step(splitting: Splitting, force: Callable, q, p, h, dtype=None, coefficients=None):
     """One step of a kick/drift sequence (unit masses)."""

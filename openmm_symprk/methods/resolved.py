@@ -5,12 +5,12 @@ stability scan, restore) takes a :class:`ResolvedMethod` from :func:`resolve` in
 user's input itself::
 
     r = resolve("yoshida-4", constraints=True)            # or a Method, a Splitting, a PRKTableau
-    r.kind, r.order, r.force_evals, [s.label for s in r.substeps]
+    r.form, r.order, r.force_evals, [s.label for s in r.substeps]
 
 ``resolve`` takes the method (a catalogue name or alias, a catalogue :class:`~.catalogue.Method`, a
 :class:`~.splitting.Splitting` or a :class:`~.tableau.PRKTableau`), plain facts about the System (whether it
 has constraints; no OpenMM object, so this layer stays free of OpenMM) and the multiple-time-step groups, and
-derives, once: the kick/drift sequence as it will run (compositions taken over the RATTLE base under
+derives, once: the form of its step (:data:`FORMS`), the kick/drift sequence as it will run (compositions taken over the RATTLE base under
 constraints, the r-RESPA sequence of the groups), every sub-step's kind (:class:`SubstepKind`, the same
 numbers as the plugin's ``SymPRKIntegrator::SubstepKind``), its velocity projection and cached-force flags
 (:class:`SubstepFlag`, the plugin's ``SymPRKIntegrator::SubstepFlag``), the force evaluations per step, and
@@ -29,15 +29,17 @@ from fractions import Fraction
 import numpy as np
 
 from .catalogue import Method, get_method
-from .respa import MTSError, label_groups, levels, respa
+from .respa import MTSError, evaluations_per_step, label_groups, levels, mts_groups, respa
 from .splitting import DRIFT, KICK, Splitting
 from .tableau import PRKTableau, TableauError
 
 __all__ = ["resolve", "ResolvedMethod", "Substep", "SubstepKind", "SubstepFlag", "ConstraintSupportError",
-           "projected_drifts", "KINDS"]
+           "projected_drifts", "FORMS"]
 
-#: What a method is: a kick/drift sequence (splitting, or a composition of one), or a general PRK pair.
-KINDS = ("splitting", "composition", "explicit", "implicit")
+#: The form of a step, which decides how it runs: a kick/drift sequence (any splitting or composition, multiple time
+#: stepping included), an explicit general PRK pair, or an implicit one (stages solved by fixed-point iteration).
+#: (What a catalogue method is, splitting or composition, is its ``family``.)
+FORMS = ("splitting", "explicit", "implicit")
 
 
 class SubstepKind(IntEnum):
@@ -129,7 +131,7 @@ class ResolvedMethod:
     """One method as it will run (see the module docstring).  Build it with :func:`resolve`."""
 
     name: str
-    kind: str  # one of KINDS
+    form: str  # one of FORMS
     constraints: bool  # RATTLE steps (kick/drift methods only)
     stages: int | None  # PRK stages of the method's tableau (None: multiple time stepping)
     order: int | None  # catalogue order (None: not a catalogue method)
@@ -161,11 +163,6 @@ class ResolvedMethod:
         return bool(self.levels)
 
     @property
-    def program(self) -> str:
-        """What the backends compile: "splitting", "explicit" or "implicit"."""
-        return "splitting" if self.is_splitting else self.kind
-
-    @property
     def evaluations(self) -> dict:
         """{force groups (tuple, or None for all forces): evaluations per step} of a kick/drift method."""
         return dict(self.evals_per_group)
@@ -178,7 +175,7 @@ class ResolvedMethod:
             return self.tableau
         if self.entry is not None:
             return self.entry.tableau(dtype)
-        if self.kind in ("splitting", "composition") and set(self.splitting.labels) <= {KICK, DRIFT}:
+        if self.is_splitting and set(self.splitting.labels) <= {KICK, DRIFT}:
             return PRKTableau.from_splitting(self.splitting, name=self.name, dtype=dtype)
         t = self.tableau
         return PRKTableau(t.A, t.b, t.A_hat, t.b_hat, name=t.name, dtype=dtype)
@@ -215,20 +212,10 @@ def _normalise(method):
     raise TypeError(f"expected a method name, a catalogue Method, a Splitting or a PRKTableau, got {method!r}")
 
 
-def _kind(entry, splitting, tableau) -> str:
-    if entry is not None and entry.family in ("splitting", "composition"):
-        return entry.family
+def _form(splitting, tableau) -> str:
     if splitting is not None:
         return "splitting"
     return "explicit" if tableau.is_explicit else "implicit"
-
-
-def _tableau_evals(tab: PRKTableau) -> int:
-    """Force evaluations per step of a general PRK pair (implicit: per fixed-point iteration)."""
-    if not tab.is_explicit:
-        return tab.stages
-    Ah, bh = np.asarray(tab.A_hat, dtype=np.float64), np.asarray(tab.b_hat, dtype=np.float64)
-    return int(sum(bool(np.any(Ah[:, i]) or bh[i]) for i in range(tab.stages)))
 
 
 def resolve(method, constraints: bool | None = False, groups=None, inner_method=None,
@@ -242,7 +229,7 @@ def resolve(method, constraints: bool | None = False, groups=None, inner_method=
     close names), TypeError for something that is not a method, ConstraintSupportError for a general PRK pair
     under constraints and MTSError for a malformed ``groups``."""
     entry, splitting, tableau = _normalise(method)
-    kind = _kind(entry, splitting, tableau)
+    form = _form(splitting, tableau)
     name = name or (entry.name if entry is not None else None) or (
         tableau.name if tableau is not None else "user splitting")
     if tableau is None and set(splitting.labels) <= {KICK, DRIFT}:
@@ -256,16 +243,16 @@ def resolve(method, constraints: bool | None = False, groups=None, inner_method=
             f"system has constraints (rigid water, HBonds, ...). Use a kick/drift method instead, e.g. "
             f"'verlet' (RATTLE), 'yoshida-4' or 'blanes-moan-srkn6b-4', or create the system with "
             f"constraints=None and rigidWater=False.")
-    common = dict(name=name, kind=kind, constraints=constrained,
+    common = dict(name=name, form=form, constraints=constrained,
                   order=entry.order if entry is not None else None,
                   constrained_order=entry.constrained_order if entry is not None else None,
                   stability=entry.stability if entry is not None else None, entry=entry)
     if splitting is None:
         if groups is not None:
             raise MTSError(f"multiple time stepping needs kick/drift methods at every level; {name!r} is a general "
-                           f"({entry.family if entry is not None else kind}) PRK tableau")
+                           f"({entry.family if entry is not None else form}) PRK tableau")
         return ResolvedMethod(stages=tableau.stages, splitting=None, tableau=tableau,
-                              force_evals=_tableau_evals(tableau), **common)
+                              force_evals=tableau.force_evaluations, **common)
     run = entry.constrained_splitting if (entry is not None and constrained) else splitting
     lv, inner_name, given = (), None, None
     if groups is not None:
@@ -273,18 +260,16 @@ def resolve(method, constraints: bool | None = False, groups=None, inner_method=
         inner = resolve(inner_given)
         if not inner.is_splitting:
             raise MTSError(f"multiple time stepping needs kick/drift methods at every level; {inner.name!r} is a "
-                           f"general ({inner.family or inner.kind}) PRK tableau")
+                           f"general ({inner.family or inner.form}) PRK tableau")
         if constrained:
             inner = resolve(inner_given, constraints=True)
         lv = tuple(levels(groups, run, inner.splitting))
-        given = tuple((int(g), int(n)) for g, n in groups)
+        given = mts_groups(groups)
         inner_name = inner.name
         run = respa(list(lv))
         tableau = None
     substeps = _substeps(run, constrained)  # (refuses labels that are neither kicks nor drifts)
-    evals = {}
-    for label in dict.fromkeys(lab for lab in run.labels if lab != DRIFT):
-        evals[label_groups(label)] = run.force_evaluations(label)
+    evals = evaluations_per_step(run)
     return ResolvedMethod(stages=tableau.stages if tableau is not None else None, splitting=run, tableau=tableau,
                           substeps=substeps, force_evals=sum(evals.values()),
                           evals_per_group=tuple(evals.items()) if list(evals) != [None] else (),

@@ -20,7 +20,7 @@ from fractions import Fraction
 
 from .splitting import DRIFT, KICK, Splitting
 
-__all__ = ["Level", "MTSError", "kick_label", "label_groups", "levels", "respa", "evaluations_per_step"]
+__all__ = ["Level", "MTSError", "kick_label", "label_groups", "mts_groups", "levels", "respa", "evaluations_per_step"]
 
 KICK_PREFIX = KICK + ":"
 
@@ -50,9 +50,8 @@ class Level:
     splitting: Splitting  # this level's kick/drift method
 
 
-def levels(groups, outer: Splitting, inner: Splitting) -> list:
-    """Validated levels from ``[(force group, substeps), ...]``, slowest first; the outermost level runs
-    ``outer``, every other level ``inner``."""
+def mts_groups(groups) -> tuple:
+    """``[(force group, substeps), ...]`` checked and made a tuple of int pairs (MTSError naming the bad entry)."""
     try:
         entries = [(g, n) for g, n in groups]
     except (TypeError, ValueError):
@@ -69,8 +68,14 @@ def levels(groups, outer: Splitting, inner: Splitting) -> list:
         if g in seen:
             raise MTSError(f"force group {g} appears twice in {entries}")
         seen.add(g)
+    return tuple((int(g), int(n)) for g, n in entries)
+
+
+def levels(groups, outer: Splitting, inner: Splitting) -> list:
+    """Validated levels from ``[(force group, substeps), ...]`` (:func:`mts_groups`), slowest first; the outermost
+    level runs ``outer``, every other level ``inner``."""
     by_n: dict = {}
-    for g, n in entries:
+    for g, n in mts_groups(groups):
         by_n.setdefault(n, []).append(g)
     out, parent = [], 1
     for i, n in enumerate(sorted(by_n)):

@@ -89,10 +89,6 @@ class Splitting:
     def adjoint(self) -> "Splitting":
         return Splitting(self.steps[::-1])
 
-    def scaled(self, weight) -> "Splitting":
-        w = exact(weight)
-        return Splitting((label, w * c) for label, c in self.steps)
-
     @cached_property
     def evaluating_kicks(self) -> frozenset:
         """Indices (into ``steps``) of the sub-flows that need a fresh evaluation of their forces in a long run.
@@ -163,9 +159,3 @@ def compose(base: Splitting, weights: Sequence) -> Splitting:
         seq.extend((label, w * c) for label, c in base.steps)
     return Splitting(seq)
 
-
-def apply(splitting: Splitting, flows: dict, state, h, dtype=np.float64):
-    """Apply one step of ``splitting`` with sub-flow functions ``flows[label](state, c*h) -> state``."""
-    for label, c in splitting.coefficients(dtype):
-        state = flows[label](state, c * h)
-    return state

@@ -120,16 +120,17 @@ class PRKTableau:
         return self.b.size
 
     @cached_property
-    def c(self):
-        c = self.A.sum(axis=1)
-        c.setflags(write=False)
-        return c
+    def evaluated_stages(self) -> tuple:
+        """Per stage, whether its force is used: by a stage (A_hat column) or by the update (b_hat).  An explicit
+        pair evaluates only these; the compiler and :attr:`force_evaluations` read it."""
+        Ah, bh = np.asarray(self.A_hat, dtype=np.float64), np.asarray(self.b_hat, dtype=np.float64)
+        return tuple(bool(np.any(Ah[:, i]) or bh[i]) for i in range(self.stages))
 
-    @cached_property
-    def c_hat(self):
-        c = self.A_hat.sum(axis=1)
-        c.setflags(write=False)
-        return c
+    @property
+    def force_evaluations(self) -> int:
+        """Force evaluations per step: the evaluated stages of an explicit pair; every stage of an implicit one
+        (per fixed-point iteration)."""
+        return sum(self.evaluated_stages) if self.is_explicit else self.stages
 
     def symplectic_residual_matrix(self):
         """B A_hat + A^T B_hat - b b_hat^T (Reich's condition (6))."""

@@ -2,7 +2,7 @@
 
 This module knows where the build is, loads the kernel libraries for the platforms OpenMM has in this
 process, and says why the native backend is unavailable when it is, with the one command that fixes it.
-It imports nothing else of the package; :mod:`openmm_symprk.integrators.native` builds the integrator
+It imports nothing else of the package; :mod:`openmm_symprk.integrators.native_backend` builds the integrator
 class on the SWIG class it exposes.
 
 ``SYMPRK_NATIVE_PLATFORMS`` (comma-separated platform names, e.g. ``Reference,CPU``) limits the platforms

@@ -23,7 +23,13 @@ This module implements the integrators of section 5 of Reich (1994) (docs/theory
     symmetric: it is the discrete Moser-Veselov rigid body, of order 2, and it also conserves the
     energy to round-off.  Measured: order 2.0 (see the tests); hence ``METHODS['rattle-1'].order == 2``.
 ``rk4``
-    Classical Runge-Kutta, the non-Poisson reference: it does not stay on the sphere |x| = const.
+    Classical Runge-Kutta, the catalogue's tableau run on x' = f(x): the non-Poisson reference, it does not
+    stay on the sphere |x| = const.
+
+Names go through the catalogue (:func:`rigid_body_method`): ``splitting-1``, ``splitting-2`` and ``rattle-1`` are
+the integrators of Euler's equations only; every other name, alias, catalogue Method or resolved method is the
+catalogue's (``splitting-4``/``splitting-6`` are Reich's names for ``yoshida-4``/``yoshida-6``), and an unknown name
+gets the close ones.  :data:`METHODS` lists them all.
 
 All Lie-Poisson methods conserve the Casimir |x|² to round-off; every step is a composition of
 rotations of x.
@@ -33,101 +39,110 @@ Mechanics §37) in both energy regimes, with closed forms for symmetric and sphe
 """
 from __future__ import annotations
 
-import difflib
 import math
 from dataclasses import dataclass
 from functools import lru_cache
 
 import numpy as np
 
-from ..methods.catalogue import UnknownMethodError
+from ..methods.catalogue import UnknownMethodError, normalise_name
 from ..methods.catalogue import methods as catalogue_methods
 from ..methods.resolved import resolve
 from ..methods.splitting import Splitting, compose
 from ..support import require
 
 __all__ = [
-    "METHODS", "RigidBodyMethod", "euler_rhs", "energy", "casimir", "integrate", "step",
-    "exact_solution", "splitting_of", "rattle_step", "second_moments", "rotate_about_axis",
+    "METHODS", "RigidBodyMethod", "rigid_body_method", "euler_rhs", "energy", "casimir", "integrate", "step",
+    "exact_solution", "splitting_of", "rattle_step", "second_moments",
 ]
 
 
-# -- method table ---------------------------------------------------------------------------------
+# -- the methods ----------------------------------------------------------------------------------
 @dataclass(frozen=True)
 class RigidBodyMethod:
     name: str
     order: int
     lie_poisson: bool  # stays on the coadjoint orbit |x| = const and is a Poisson map
     description: str
-    composition: str | None = None  # catalogue composition whose weights are used, if any
+    catalogue: str | None = None  # the catalogue method it runs (compositions: their weights over splitting-2)
 
 
 #: Symmetric second-order base step: X1(h/2) X2(h/2) X3(h) X2(h/2) X1(h/2) (NO_SQUISH).
 SPLITTING_2 = Splitting([("X1", "1/2"), ("X2", "1/2"), ("X3", 1), ("X2", "1/2"), ("X1", "1/2")])
 SPLITTING_1 = Splitting([("X1", 1), ("X2", 1), ("X3", 1)])
 
-
-def _build_methods() -> dict:
-    out = {
-        "splitting-1": RigidBodyMethod("splitting-1", 1, True, "exp(hX1) exp(hX2) exp(hX3)"),
-        "splitting-2": RigidBodyMethod(
-            "splitting-2", 2, True, "X1(h/2) X2(h/2) X3(h) X2(h/2) X1(h/2) (NO_SQUISH sequence)"),
-        "splitting-4": RigidBodyMethod(
-            "splitting-4", catalogue_methods["yoshida-4"].order, True,
-            "splitting-2 composed with the yoshida-4 weights", "yoshida-4"),
-        "splitting-6": RigidBodyMethod(
-            "splitting-6", catalogue_methods["yoshida-6"].order, True,
-            "splitting-2 composed with the yoshida-6 weights", "yoshida-6"),
-    }
-    for m in catalogue_methods.by_family("composition"):
-        out[m.name] = RigidBodyMethod(
-            m.name, m.order, True, f"splitting-2 composed with the {m.name} weights", m.name)
-    # Reich's constrained symplectic Euler; with no potential it is RATTLE itself, hence order 2.
-    out["rattle-1"] = RigidBodyMethod(
-        "rattle-1", 2, True, "reduced RATTLE / constrained symplectic Euler on SO(3) (Example 5.3)")
-    out["rk4"] = RigidBodyMethod("rk4", 4, False, "classical Runge-Kutta (not Lie-Poisson)")
-    return out
+#: The integrators of Euler's equations that are not catalogue methods (Reich, section 5).  Reduced RATTLE is
+#: Reich's constrained symplectic Euler; with no potential it is RATTLE itself, hence order 2.
+EULER_METHODS = {
+    "splitting-1": RigidBodyMethod("splitting-1", 1, True, "exp(hX1) exp(hX2) exp(hX3)"),
+    "splitting-2": RigidBodyMethod("splitting-2", 2, True,
+                                   "X1(h/2) X2(h/2) X3(h) X2(h/2) X1(h/2) (NO_SQUISH sequence)"),
+    "rattle-1": RigidBodyMethod("rattle-1", 2, True,
+                                "reduced RATTLE / constrained symplectic Euler on SO(3) (Example 5.3)"),
+}
+#: Reich's names for two catalogue compositions over splitting-2.
+COMPOSITION_NAMES = {"splitting-4": "yoshida-4", "splitting-6": "yoshida-6"}
 
 
-#: name -> :class:`RigidBodyMethod` (order, whether Lie-Poisson, description).
-METHODS: dict = _build_methods()
+def _runs_on_euler(entry) -> bool:
+    """Catalogue methods with a rigid-body form: compositions (over splitting-2) and explicit reference tableaux
+    (stages on x' = f(x))."""
+    return entry.family == "composition" or (entry.family == "reference" and entry.tableau().is_explicit)
 
 
-def _resolve(method) -> RigidBodyMethod:
+def rigid_body_method(method) -> RigidBodyMethod:
+    """The rigid-body integrator of ``method``: a name of :data:`EULER_METHODS` or :data:`COMPOSITION_NAMES`, or a
+    catalogue composition or explicit reference method (a name or alias, a catalogue Method or a resolved one).
+    UnknownMethodError (a ValueError) with the close names for a name that is neither; ValueError for a catalogue
+    method without a rigid-body form."""
     if isinstance(method, RigidBodyMethod):
         return method
-    key = method.strip().lower().replace("_", "-").replace(" ", "-") if isinstance(method, str) else None
-    if key in METHODS:
-        return METHODS[key]
-    try:  # a catalogue composition by name or alias, as a Method or resolved: its weights over splitting-2
-        resolved = resolve(method)
-    except (UnknownMethodError, TypeError):
-        resolved = None
-    if resolved is not None and resolved.kind == "composition":
-        return METHODS[resolved.name]
-    if key is None:
-        raise ValueError(f"method must be a name (one of {', '.join(METHODS)}) or a catalogue composition, "
-                         f"got {method!r}")
-    close = difflib.get_close_matches(key, list(METHODS), n=3, cutoff=0.5)
-    hint = f" Did you mean {', '.join(repr(c) for c in close)}?" if close else ""
-    raise ValueError(f"unknown rigid-body method {method!r}.{hint} Known methods: {', '.join(METHODS)}.")
+    key = normalise_name(method) if isinstance(method, str) else None
+    if key in EULER_METHODS:
+        return EULER_METHODS[key]
+    shown = key if key in COMPOSITION_NAMES else None
+    try:
+        entry = resolve(COMPOSITION_NAMES.get(key, method)).entry
+    except UnknownMethodError:
+        raise UnknownMethodError(
+            f"unknown rigid-body method {method!r}."
+            f"{catalogue_methods.suggest(method, among=_EULER_CATALOGUE, extra=[*EULER_METHODS, *COMPOSITION_NAMES])}"
+            f" Known methods: {', '.join(METHODS)}.") from None
+    except TypeError:
+        raise ValueError(f"method must be a name (one of {', '.join(METHODS)}) or a catalogue method, got "
+                         f"{method!r}") from None
+    if entry is None or not _runs_on_euler(entry):
+        what = "a user method" if entry is None else f"the catalogue's {entry.name!r} ({entry.family})"
+        raise ValueError(f"{what} has no rigid-body form: Euler's equations run {', '.join(EULER_METHODS)}, the "
+                         f"catalogue's compositions (over splitting-2) and explicit reference methods (rk4)")
+    if entry.family == "composition":
+        return RigidBodyMethod(shown or entry.name, entry.order, True,
+                               f"splitting-2 composed with the {entry.name} weights", entry.name)
+    return RigidBodyMethod(entry.name, entry.order, False, f"the catalogue's {entry.name} tableau on x' = x × M⁻¹x "
+                                                           f"(not Lie-Poisson)", entry.name)
+
+
+_EULER_CATALOGUE = [m for m in catalogue_methods.values() if _runs_on_euler(m)]
+#: name -> :class:`RigidBodyMethod` of every method (order, whether Lie-Poisson, description): a listing built from
+#: :data:`EULER_METHODS`, :data:`COMPOSITION_NAMES` and the catalogue.
+METHODS: dict = {name: rigid_body_method(name) for name in
+                 [*EULER_METHODS, *COMPOSITION_NAMES, *(m.name for m in _EULER_CATALOGUE)]}
 
 
 @lru_cache(maxsize=None)
-def _splitting_by_name(name: str) -> Splitting:
-    info = METHODS[name]
-    if name == "splitting-1":
+def _splitting(info: RigidBodyMethod) -> Splitting:
+    if info.name == "splitting-1":
         return SPLITTING_1
-    if name == "splitting-2":
+    if info.name == "splitting-2":
         return SPLITTING_2
-    if info.composition is None:
-        raise ValueError(f"method {name!r} is not a splitting of Euler's equations")
-    return compose(SPLITTING_2, catalogue_methods[info.composition].weights)
+    if not info.lie_poisson or info.catalogue is None:
+        raise ValueError(f"method {info.name!r} is not a splitting of Euler's equations")
+    return compose(SPLITTING_2, catalogue_methods[info.catalogue].weights)
 
 
 def splitting_of(method) -> Splitting:
     """The X1/X2/X3 sub-flow sequence of a splitting method (a :class:`Splitting`)."""
-    return _splitting_by_name(_resolve(method).name)
+    return _splitting(rigid_body_method(method))
 
 
 # -- input checks --------------------------------------------------------------------------------
@@ -170,16 +185,6 @@ def casimir(x):
 
 # -- exact sub-flows -----------------------------------------------------------------------------
 _NEXT = ((1, 2), (2, 0), (0, 1))  # (j, k) with (i, j, k) cyclic
-
-
-def rotate_about_axis(x, axis: int, angle: float) -> np.ndarray:
-    """x rotated by ``angle`` (right-handed) about body axis ``axis`` (0, 1 or 2)."""
-    j, k = _NEXT[axis]
-    c, s = math.cos(angle), math.sin(angle)
-    out = np.array(x, dtype=float)
-    out[j] = c * x[j] - s * x[k]
-    out[k] = s * x[j] + c * x[k]
-    return out
 
 
 def _run_splitting(x0, inv_m, h, n_steps, splitting: Splitting):
@@ -300,22 +305,22 @@ def _run_rattle(x0, moments, h, n_steps):
     return out
 
 
-# -- rk4 ------------------------------------------------------------------------------------------
-def _run_rk4(x0, inv_m, h, n_steps):
-    out = np.empty((n_steps + 1, 3))
-    out[0] = x0
-    x = np.array(x0, dtype=float)
-
+# -- explicit Runge-Kutta (the catalogue's reference methods) ---------------------------------------------------
+def _run_explicit(x0, inv_m, h, n_steps, A, b):
+    """An explicit Runge-Kutta tableau (A strictly lower triangular, weights b) on x' = x × M⁻¹x."""
     def f(y):
         w = y * inv_m
         return np.array([y[1] * w[2] - y[2] * w[1], y[2] * w[0] - y[0] * w[2], y[0] * w[1] - y[1] * w[0]])
 
+    out = np.empty((n_steps + 1, 3))
+    out[0] = x0
+    x = np.array(x0, dtype=float)
+    s = len(b)
     for n in range(1, n_steps + 1):
-        k1 = f(x)
-        k2 = f(x + 0.5 * h * k1)
-        k3 = f(x + 0.5 * h * k2)
-        k4 = f(x + h * k3)
-        x = x + (h / 6) * (k1 + 2 * k2 + 2 * k3 + k4)
+        k = np.empty((s, 3))
+        for i in range(s):
+            k[i] = f(x + h * (A[i, :i] @ k[:i]))
+        x = x + h * (b @ k)
         out[n] = x
     return out
 
@@ -331,12 +336,13 @@ def integrate(x0, moments, h, n_steps, method="splitting-2") -> np.ndarray:
     if isinstance(n_steps, bool) or int(n_steps) != n_steps or n_steps < 0:
         raise ValueError(f"n_steps must be a non-negative integer, got {n_steps!r}")
     n_steps = int(n_steps)
-    info = _resolve(method)
-    if info.name == "rk4":
-        return _run_rk4(x0, 1.0 / m, h, n_steps)
+    info = rigid_body_method(method)
     if info.name == "rattle-1":
         return _run_rattle(x0, m, h, n_steps)
-    return _run_splitting(x0, 1.0 / m, h, n_steps, _splitting_by_name(info.name))
+    if not info.lie_poisson:  # an explicit reference tableau of the catalogue (its positions part: x' = f(x))
+        tab = catalogue_methods[info.catalogue].tableau()
+        return _run_explicit(x0, 1.0 / m, h, n_steps, tab.A, tab.b)
+    return _run_splitting(x0, 1.0 / m, h, n_steps, _splitting(info))
 
 
 def step(x, moments, h, method="splitting-2") -> np.ndarray:

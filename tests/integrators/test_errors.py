@@ -72,7 +72,7 @@ def test_user_splitting_tableau_runs_with_constraints(water8):
     """A user tableau in splitting form compiles to RATTLE like the catalogue methods."""
     tab = PRKTableau([[0, 0], [1, 0]], [1, 0], [[0.5, 0], [0.5, 0.5]], [0.5, 0.5], name="my-verlet")
     ig = PRKIntegrator(2 * unit.femtoseconds, tab, system=water8.system)
-    assert ig.program_info.kind == "splitting" and ig.program_info.constraints
+    assert ig.resolved.form == "splitting" and ig.program_info.rattle
     ctx = water8.context(ig)
     ig.step(10)
 

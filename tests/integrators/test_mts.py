@@ -9,9 +9,8 @@ import openmm.unit as unit
 import pytest
 from openmm.mtsintegrator import MTSIntegrator
 
-from helpers import Counter, drift_after
+from helpers import Counter, drift_after, measure_order
 from openmm_symprk import SymplecticIntegrator, plugin
-from openmm_symprk.integrators.convergence import measure_order
 from openmm_symprk.methods.respa import MTSError
 from openmm_symprk.systems.forcegroups import check_groups, force_groups, split_forces
 
@@ -104,7 +103,7 @@ def test_force_evaluations_per_group_are_counted(backend, water8):
     group is evaluated once more per step, as in OpenMM's own MTSIntegrator."""
     system, groups, counters = _counted(water8, 4)
     ig = SymplecticIntegrator(2 * unit.femtoseconds, "verlet", system=system, groups=groups, backend=backend)
-    assert ig.program_info.evals_per_group == {(1,): 1, (0,): 4}
+    assert ig.resolved.evaluations == {(1,): 1, (0,): 4} and ig.program_info.method is ig.resolved
     ctx = mm.Context(system, ig, mm.Platform.getPlatformByName("Reference"))
     ctx.setPositions(water8.positions)
     ctx.setVelocities(water8.velocities)

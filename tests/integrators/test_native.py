@@ -361,7 +361,7 @@ def test_errors(water8):
 
 @needs_native
 def test_unavailable_reason_is_reported(monkeypatch):
-    import openmm_symprk.integrators.native as native_module
+    import openmm_symprk.integrators.native_backend as native_module
 
     monkeypatch.setattr(plugin._State, "swig", None)
     monkeypatch.setattr(plugin._State, "reason", "test: no plugin")

@@ -9,9 +9,8 @@ import openmm.unit as unit
 import pytest
 
 from conftest import platform_available
-from helpers import counted, drift_after
+from helpers import counted, drift_after, measure_order
 from openmm_symprk import SymplecticIntegrator, catalogue, resolve
-from openmm_symprk.integrators.convergence import measure_order
 
 SYMPLECTIC_SPLITTINGS = [m.name for m in catalogue.splittings()]
 

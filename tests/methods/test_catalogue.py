@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from openmm_symprk import Splitting, UnknownMethodError, get_method, catalogue
+from openmm_symprk.methods import catalogue as catalogue_module
 from openmm_symprk.methods.catalogue import format_table
 from openmm_symprk.methods.reference import measure_order
 from openmm_symprk.methods.stability import stability_interval
@@ -46,11 +47,27 @@ def test_splitting_consistency_and_cost(m):
     s = m.splitting
     # consistency: kicks and drifts each sum to 1 (exact up to the 22 published digits)
     assert abs(float(s.total("kick") - 1)) < 1e-15 and abs(float(s.total("drift") - 1)) < 1e-15
-    assert s.force_evaluations() == m.force_evals
-    assert m.constrained_splitting.force_evaluations() == m.force_evals
+    # the constrained sequence (compositions over velocity Verlet) costs what the catalogue's does
+    assert m.constrained_splitting.force_evaluations() == m.force_evals == s.force_evaluations()
     if m.family == "composition":
         assert s.is_symmetric(tol=1e-21)
         assert m.constrained_splitting.is_symmetric(tol=1e-21)
+
+
+def test_listed_force_evaluations_are_checked_against_the_coefficients():
+    """The data files list each method's force evaluations per step; the catalogue derives the count from the
+    sequence or tableau and refuses an entry that lists another."""
+    raw = catalogue_module._load("splittings.toml") + catalogue_module._load("tableaux.toml")
+    listed = {r["name"]: int(r["force_evals"]) for r in raw}
+    assert listed == {name: m.force_evals for name, m in catalogue.items()}
+    assert (listed["pefrl"], listed["yoshida-4"], listed["gauss-2"], listed["rk4"]) == (4, 3, 2, 4)
+    for name in ("pefrl", "gauss-2"):
+        wrong = [dict(r, force_evals=r["force_evals"] + 1) if r["name"] == name else r for r in raw]
+        with pytest.raises(ValueError, match=f"{name}: force_evals = {listed[name] + 1} is listed, but its "
+                                             f"(sequence|tableau) evaluates the forces {listed[name]} times"):
+            catalogue_module._build(wrong)
+    with pytest.raises(ValueError, match="unknown hamiltonian 'RKN'; one of separable, quadratic-kinetic"):
+        catalogue_module._build([dict(raw[0], hamiltonian="RKN")])
 
 
 def test_swapped_orientation_is_caught():
@@ -99,6 +116,11 @@ def test_families_and_table():
     for name in ALL:
         assert name in table
     assert not catalogue["rk4"].symplectic and catalogue["gauss-2"].symplectic
+    # which Hamiltonians the order holds for: the SRKN/RKN splittings need a quadratic kinetic energy
+    assert {m.hamiltonian for m in catalogue.values()} == {"separable", "quadratic-kinetic"}
+    assert catalogue["blanes-moan-srkn6b-4"].hamiltonian == "quadratic-kinetic" == catalogue["mclachlan-sb3a4"].hamiltonian
+    assert catalogue["blanes-moan-s6-4"].hamiltonian == "separable" == catalogue["gauss-2"].hamiltonian
+    assert "hamiltonian" in table.splitlines()[0] and "quadratic-kinetic" in table
 
 
 def test_narrow_instability_band_is_found():

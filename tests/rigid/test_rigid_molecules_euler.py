@@ -3,13 +3,13 @@
 Reich's section 5 (docs/theory.md, section 3) reduces RATTLE on SO(3) to a Lie-Poisson map of the body angular
 momentum.  Here the constrained Cartesian system is run by SymplecticIntegrator on the Reference platform,
 the body-frame angular momentum is read from positions and velocities, and compared with
-openmm_symprk.rigidbody.exact_solution (Jacobi elliptic functions).
+openmm_symprk.rigid.lie_poisson.exact_solution (Jacobi elliptic functions).
 """
 import numpy as np
 import pytest
 
 from openmm_symprk.rigid import lie_poisson as rb
-from openmm_symprk.rigid.molecules import free_rigid_body, hydrogen_peroxide, rigid_water, run_free_rigid_body
+from openmm_symprk.rigid.free_body import free_rigid_body, hydrogen_peroxide, rigid_water, run_free_rigid_body
 
 T = 0.5  # ps; the body spins at |ω| ~ 16-18 /ps, i.e. 1.3-1.4 turns
 STEPS = [100, 200, 400, 800]  # h = 5 .. 0.625 fs
@@ -54,7 +54,7 @@ def test_rigid_water_follows_the_exact_euler_solution(omega, regime, method, ord
 def test_cartesian_rattle_reduces_to_the_lie_poisson_rattle():
     """Theorem 5.1 in practice: for 4 non-coplanar atoms the Cartesian space is exactly R³ x GL(3), so
     OpenMM's RATTLE (verlet with constraints, no forces) and the reduced RATTLE of Example 5.3
-    (rigidbody 'rattle-1', with J the body's second moments) are the same map, step by step."""
+    (lie_poisson 'rattle-1', with J the body's second moments) are the same map, step by step."""
     body = free_rigid_body(*hydrogen_peroxide(), [6.0, -14.0, 9.0])
     assert body.group.kind == "framework" and body.group.n_constraints == 6
     h, n = 0.004, 150  # a coarse step: both are far from the exact solution, but equal to each other

@@ -1,4 +1,4 @@
-"""Lie-Poisson integrators for Euler's equations (openmm_symprk.rigidbody), pure numpy/scipy."""
+"""Lie-Poisson integrators for Euler's equations (openmm_symprk.rigid.lie_poisson), pure numpy/scipy."""
 import itertools
 import math
 
@@ -7,6 +7,7 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from openmm_symprk.rigid import lie_poisson as rb
+from openmm_symprk.methods.catalogue import UnknownMethodError
 from openmm_symprk.methods.catalogue import methods as catalogue
 from openmm_symprk.methods.resolved import resolve
 from openmm_symprk.methods.splitting import Splitting, compose
@@ -63,8 +64,22 @@ def test_compositions_go_through_the_catalogue_compose_path():
         rb.splitting_of("kahan-li-8")
     with pytest.raises(ValueError, match="unknown rigid-body method 'yoshida-5'.*Did you mean"):
         rb.splitting_of("yoshida-5")
-    with pytest.raises(ValueError, match="a catalogue composition, got 42"):
+    with pytest.raises(ValueError, match="or a catalogue method, got 42"):
         rb.splitting_of(42)
+
+
+def test_names_go_through_the_catalogue():
+    """Every name but Reich's three integrators of Euler's equations is the catalogue's: aliases work, a misspelt
+    name gets the close names of the methods that run on Euler's equations, an MD-only method is refused."""
+    assert rb.rigid_body_method("Forest_Ruth").name == "forest-ruth-4-position"
+    assert rb.rigid_body_method("SPLITTING_4") == rb.METHODS["splitting-4"]
+    assert rb.rigid_body_method(catalogue["rk4"]) == rb.METHODS["rk4"] and not rb.METHODS["rk4"].lie_poisson
+    assert set(rb.METHODS) == {"splitting-1", "splitting-2", "splitting-4", "splitting-6", "rattle-1", "rk4",
+                               *(m.name for m in catalogue.by_family("composition"))}
+    with pytest.raises(UnknownMethodError, match=r"unknown rigid-body method 'splittng-2'\. Did you mean 'splitting-2'"):
+        rb.integrate(X0, MOMENTS, 0.1, 1, "splittng-2")
+    with pytest.raises(ValueError, match="'pefrl' .splitting. has no rigid-body form"):
+        rb.integrate(X0, MOMENTS, 0.1, 1, "pefrl")
 
 
 # -- the sub-flows: exact, and in the right direction ---------------------------------------------

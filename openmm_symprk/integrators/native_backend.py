@@ -23,8 +23,9 @@ import openmm as mm
 
 from .. import plugin
 from ..methods.resolved import Substep, SubstepKind
-from .backend import NATIVE_OPTIONS, check_option_names, prepare
+from .backend import resolve_for_system
 from .base import IntegratorBase
+from .options import NATIVE_OPTIONS, IntegratorOptions
 from .program import ProgramInfo
 from .symplectic import SymplecticIntegrator
 from .thermostat import ThermostatSettings
@@ -35,8 +36,6 @@ _swig = plugin.swig_module()
 #: The plugin's SWIG class (openmm.Integrator when the plugin is unavailable: the class below then exists,
 #: for isinstance checks and documentation, but cannot be instantiated).
 _PluginIntegrator = _swig.SymPRKIntegrator if _swig is not None else mm.Integrator
-#: The keyword options of NativeSymplecticIntegrator (for the misspelt-keyword message).
-NATIVE_OPTIONS_ARGS = ("backend", *sorted(NATIVE_OPTIONS))
 
 
 def native_available() -> bool:
@@ -50,55 +49,41 @@ class NativeSymplecticIntegrator(SymplecticIntegrator, _PluginIntegrator, backen
     Parameters: those of :class:`~openmm_symprk.integrators.symplectic.SymplecticIntegrator` that apply to
     splittings: ``stepSize``, ``method``, ``system`` (decides the RATTLE sequence -- compositions are taken over
     velocity Verlet under constraints --, is checked for anything that breaks conservation, and is recorded:
-    a Context of another System is refused), ``exact_momentum`` (needs ``system=``), ``check_finite`` and
-    ``max_speed``, and the thermostat's ``temperature``, ``collision_time``, ``thermostat_interval`` and
-    ``random_seed`` (see :func:`~openmm_symprk.integrators.thermostat.thermostat_settings`; with groups= it wraps
-    the outer step).  Raises NativeUnavailableError (with the reason and the fix) when the plugin is unavailable
+    a Context of another System is refused), and the options both backends take (:mod:`.options`):
+    ``exact_momentum`` (needs ``system=``), ``check_finite``, ``max_speed``, ``groups`` and ``inner_method``, and the
+    thermostat's ``temperature``, ``collision_time``, ``thermostat_interval`` and ``random_seed`` (see
+    :func:`~openmm_symprk.integrators.thermostat.thermostat_settings`; with groups= it wraps the outer step).  Raises NativeUnavailableError (with the reason and the fix) when the plugin is unavailable
     and NativeMethodError for implicit and general tableaux, which only the CustomIntegrator backend runs."""
 
-    def __init__(self, stepSize, method="verlet", system=None, backend="native", exact_momentum=False,
-                 check_finite=True, max_speed=None, groups=None, inner_method=None, temperature=None,
-                 collision_time=None, thermostat_interval=None, random_seed=None, **unknown):
+    def __init__(self, stepSize, method="verlet", system=None, backend="native", **options):
         self._check_backend(backend)
-        check_option_names(unknown, NATIVE_OPTIONS_ARGS, type(self).__name__)
+        opts = IntegratorOptions.build(type(self).__name__, stepSize, system, NATIVE_OPTIONS, ("backend",), **options)
         if _swig is None:
             raise plugin.NativeUnavailableError(f"the native backend is unavailable: {plugin.unavailable_reason()}. "
                                                 f"To fix it, {plugin.fix_hint()}.")
         # the native kernels place virtual sites after every drift: no CustomIntegrator caveat
-        p = prepare(type(self).__name__, stepSize, method, system, exact_momentum=exact_momentum,
-                    check_finite=check_finite, max_speed=max_speed, groups=groups, inner_method=inner_method,
-                    temperature=temperature, collision_time=collision_time, thermostat_interval=thermostat_interval,
-                    random_seed=random_seed, splittings_only="the native backend runs kick/drift splittings and compositions only. Use "
-                                    "SymplecticIntegrator(..., backend='custom') for it.", skip_checks=("virtualsites",))
-        r = p.method
+        r = resolve_for_system(type(self).__name__, method, system, opts, skip_checks=("virtualsites",),
+                               splittings_only="the native backend runs kick/drift splittings and compositions only. "
+                                               "Use SymplecticIntegrator(..., backend='custom') for it.")
         subs = r.substeps
-        _PluginIntegrator.__init__(self, p.dt, [int(s.kind) for s in subs], [float(s.coefficient) for s in subs],
-                                   [s.group_mask for s in subs], [int(s.flags) for s in subs])
+        _PluginIntegrator.__init__(self, opts.step_size, [int(s.kind) for s in subs],
+                                   [float(s.coefficient) for s in subs], [s.group_mask for s in subs],
+                                   [int(s.flags) for s in subs])
         self.setMethodName(r.name)
-        self.setExactMomentum(p.exact_momentum)
-        self.setMaxSpeed(p.max_speed)
-        if p.system is not None:
-            self.setExpectedSystem(p.system.n_particles, r.constraints)
-        if p.thermostat is not None:
-            self.thermostat = p.thermostat  # the property below hands it to the plugin
-        self._set_resolved(r)
-        self.check_finite = p.check_finite
-        self.max_speed = p.max_speed
-        self.exact_momentum = p.exact_momentum
-        self.compiled_for = p.system
+        self.setExactMomentum(opts.exact_momentum)
+        self.setMaxSpeed(opts.max_speed)
+        if opts.system is not None:
+            self.setExpectedSystem(opts.system.n_particles, r.constraints)
+        if opts.thermostat is not None:
+            self.thermostat = opts.thermostat  # the property below hands it to the plugin
+        self._set_program(r, opts)
 
-    def _set_resolved(self, r):
-        """Record the resolved method and what the plugin reports of its program."""
+    def _set_program(self, r, options, notes=()):
+        """Record the resolved method, the options and what the plugin reports of its program."""
         self.resolved = r
-        self.method = r.entry
-        self.method_name = r.name
-        self.splitting = r.splitting
-        self.mts_levels = list(r.levels) or None
-        per_group = r.evaluations
-        self.program_info = ProgramInfo("splitting", r.constraints, int(self.getForceEvaluationsPerStep()),
-                                        self.getNumSubsteps(), bool(self.getExactMomentum()),
-                                        ["native SymPRKIntegrator plugin"], signature=int(self.getProgramSignature()),
-                                        evals_per_group=per_group or None)
+        self.options = options
+        self.program_info = ProgramInfo(r, r.constraints, int(self.getProgramSignature()),
+                                        ("native SymPRKIntegrator plugin", *notes))
 
     # -- backend hooks -------------------------------------------------------------------------------------
     def _blowup_step(self) -> int:
@@ -178,16 +163,16 @@ class NativeSymplecticIntegrator(SymplecticIntegrator, _PluginIntegrator, backen
         return (f"NativeSymplecticIntegrator: {self.method_name}, step {self.getStepSize()}, native backend "
                 f"(platforms: {', '.join(plugin.platforms())})\n"
                 f"  program: splitting, {self.getNumSubsteps()} kicks and drifts, constraints="
-                f"{'RATTLE' if self.program_info.constraints else 'none'}, force evaluations per step: "
+                f"{'RATTLE' if self.program_info.rattle else 'none'}, force evaluations per step: "
                 f"{self.force_evals}, exact momentum: {self.getExactMomentum()}"
-                + (f"\n  {self.resolved.describe_levels()}" if self.mts_levels else "")
+                + (f"\n  {self.resolved.describe_levels()}" if self.resolved.is_mts else "")
                 + self._describe_thermostat())
 
     def _describe_thermostat(self) -> str:
         settings = self.thermostat
         if settings is None:
             return ""
-        where = ", around the outer step" if self.mts_levels else ""
+        where = ", around the outer step" if self.resolved.is_mts else ""
         return f"\n  {settings.describe()}{where}"
 
 

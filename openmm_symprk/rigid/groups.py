@@ -34,9 +34,6 @@ closing the triangle; OpenMM's CCMA solver then needs the angle between them, wh
 HarmonicAngleForce, and without it the iteration diverges (measured: NaN after one step for a 5-atom
 group).  :func:`make_rigid` therefore adds one HarmonicAngleForce named ``RigidGroupConstraintAngles``
 whose terms all have zero force constant: no energy, no force, only the geometry for the solver.
-
-Also here: helpers to spin a rigid group and to read its body-frame angular momentum from positions
-and velocities (the cross-validation against :func:`openmm_symprk.rigid.lie_poisson.exact_solution`).
 """
 from __future__ import annotations
 
@@ -50,13 +47,8 @@ import openmm.unit as unit
 
 from ..physics import momenta
 
-__all__ = [
-    "RigidGroupError", "RigidGroupWarning", "RigidGroup", "make_rigid", "plan_rigid_group",
-    "principal_axes", "inertia_tensor", "rigid_body_velocities", "body_frame_rotation",
-    "angular_momentum", "body_angular_momentum", "rigid_water", "hydrogen_peroxide", "FreeRigidBody",
-    "free_rigid_body", "run_free_rigid_body", "ANGLE_FORCE_NAME",
-]
-
+__all__ = ["RigidGroupError", "RigidGroupWarning", "RigidGroup", "make_rigid", "plan_rigid_group", "positions_nm",
+           "ANGLE_FORCE_NAME"]
 
 #: Name of the zero-strength HarmonicAngleForce that tells OpenMM's constraint solver the geometry.
 ANGLE_FORCE_NAME = "RigidGroupConstraintAngles"
@@ -100,8 +92,8 @@ class RigidGroup:
                      np.linalg.norm(self.inertia_before))
 
 
-# -- geometry helpers -------------------------------------------------------------------------------
-def _as_nm(positions) -> np.ndarray:
+def positions_nm(positions) -> np.ndarray:
+    """Positions as a finite (N, 3) float array in nm (from an array of nm or a Quantity)."""
     if unit.is_quantity(positions):
         positions = positions.value_in_unit(unit.nanometer)
     try:
@@ -115,54 +107,6 @@ def _as_nm(positions) -> np.ndarray:
         raise ValueError(f"positions must be a finite (N, 3) array (nm), got shape {pos.shape}")
     return pos
 
-
-def inertia_tensor(positions, masses) -> np.ndarray:
-    """Inertia tensor about the centre of mass, sum m (|r|^2 I - r r^T)."""
-    return momenta.inertia_tensor(positions, masses, about="com")
-
-
-def principal_axes(positions, masses):
-    """(centre of mass, principal moments ascending, axes) with axes a proper rotation (columns)."""
-    r = np.asarray(positions, float)
-    m = np.asarray(masses, float)
-    com = momenta.centre_of_mass(r, m)
-    moments, axes = np.linalg.eigh(inertia_tensor(r, m))
-    if np.linalg.det(axes) < 0:
-        axes[:, 2] *= -1
-    return com, moments, axes
-
-
-def rigid_body_velocities(positions, masses, angular_velocity, com_velocity=(0.0, 0.0, 0.0)) -> np.ndarray:
-    """Velocities v_i = V + ω × (r_i - c) of a rigid motion (space-frame ω, nm/ps and 1/ps)."""
-    r = np.asarray(positions, float)
-    m = np.asarray(masses, float)
-    com = momenta.centre_of_mass(r, m)
-    return np.asarray(com_velocity, float) + np.cross(np.asarray(angular_velocity, float), r - com)
-
-
-def body_frame_rotation(body_coords, positions, masses) -> np.ndarray:
-    """The proper rotation R that best maps the body coordinates onto ``positions`` - com (mass-weighted
-    Kabsch), so that positions ≈ com + body_coords @ Rᵀ."""
-    m = np.asarray(masses, float)
-    r = np.asarray(positions, float)
-    r = r - momenta.centre_of_mass(r, m)
-    b = np.asarray(body_coords, float)
-    H = (m[:, None] * b).T @ r
-    U, _, Vt = np.linalg.svd(H)
-    d = np.sign(np.linalg.det(Vt.T @ U.T))
-    return Vt.T @ np.diag([1.0, 1.0, d]) @ U.T
-
-
-def angular_momentum(positions, velocities, masses) -> np.ndarray:
-    """Space-frame angular momentum about the centre of mass, sum m (r - c) x v."""
-    return momenta.angular_momentum(positions, velocities, masses, about="com")
-
-
-def body_angular_momentum(body_coords, positions, velocities, masses):
-    """(x, L, R): body-frame angular momentum x = RᵀL, space-frame L and the body rotation R."""
-    L = angular_momentum(positions, velocities, masses)
-    R = body_frame_rotation(body_coords, positions, masses)
-    return R.T @ L, L, R
 
 
 # -- planning ----------------------------------------------------------------------------------------
@@ -357,7 +301,7 @@ def make_rigid(system: mm.System, positions, groups, virtual_sites: bool = False
     do no work on a rigid group (remove them to save time if you like)."""
     if not isinstance(system, mm.System):
         raise TypeError(f"system must be an openmm.System, got {type(system).__name__}")
-    pos = _as_nm(positions)
+    pos = positions_nm(positions)
     n_part = system.getNumParticles()
     if len(pos) != n_part:
         raise ValueError(f"positions has {len(pos)} rows but the System has {n_part} particles")
@@ -452,7 +396,8 @@ def make_rigid(system: mm.System, positions, groups, virtual_sites: bool = False
             atoms=tuple(g), kind=plan.kind, constraints=tuple(cons),
             virtual_sites=tuple(g[k] for k, _ in plan.sites),
             masses_before=tuple(float(v) for v in m), masses_after=tuple(float(v) for v in new_m),
-            inertia_before=inertia_tensor(p, m), inertia_after=inertia_tensor(p[keep], new_m[keep]),
+            inertia_before=momenta.inertia_tensor(p, m, about="com"),
+            inertia_after=momenta.inertia_tensor(p[keep], new_m[keep], about="com"),
             com_before=momenta.centre_of_mass(p, m),
             com_after=(new_m[keep, None] * p[keep]).sum(0) / new_m.sum(),
             max_site_error=site_err,
@@ -529,98 +474,3 @@ def _open_angles(pos, constraints):
             cosang = float(u @ v / (np.linalg.norm(u) * np.linalg.norm(v)))
             out.append((a, b, c, float(np.arccos(np.clip(cosang, -1.0, 1.0)))))
     return out
-
-
-# -- a free rigid body in OpenMM (the cross-validation scene) ---------------------------------------
-def _f32(x: float) -> float:
-    return float(np.float32(x))
-
-
-def rigid_water(center=(0.0, 0.0, 0.0)):
-    """(positions nm, masses Da) of a TIP3P-geometry water, an asymmetric (planar) top.
-
-    OpenMM's Reference/CPU SETTLE stores the constraint distances in single precision, so the O-H and
-    H-H distances are chosen float32-exact: the geometry SETTLE keeps is then the input geometry."""
-    d_oh, d_hh = _f32(0.09572), _f32(0.15139)
-    c = 1.0 - d_hh * d_hh / (2.0 * d_oh * d_oh)
-    pos = np.array([[0.0, 0.0, 0.0], [d_oh, 0.0, 0.0], [d_oh * c, d_oh * np.sqrt(1.0 - c * c), 0.0]])
-    return pos + np.asarray(center, float), np.array([15.999, 1.008, 1.008])
-
-
-def hydrogen_peroxide(center=(0.0, 0.0, 0.0)):
-    """(positions nm, masses Da) of an H2O2-like molecule: 4 atoms, non-planar, asymmetric top."""
-    d_oo, d_oh = 0.1475, 0.0950
-    theta, phi = np.deg2rad(94.8), np.deg2rad(111.5)
-    o1, o2 = np.zeros(3), np.array([d_oo, 0.0, 0.0])
-    h1 = o1 + d_oh * np.array([-np.cos(theta), np.sin(theta), 0.0])
-    h2 = o2 + d_oh * np.array([np.cos(theta), np.sin(theta) * np.cos(phi), np.sin(theta) * np.sin(phi)])
-    return np.array([o1, o2, h1, h2]) + np.asarray(center, float), np.array([15.999, 15.999, 1.008, 1.008])
-
-
-@dataclass
-class FreeRigidBody:
-    """A single rigid molecule, torque-free in vacuum, spinning: the scene of the cross-validation."""
-
-    system: mm.System
-    positions: np.ndarray  # nm
-    velocities: np.ndarray  # nm/ps, a rigid rotation
-    masses: np.ndarray
-    body_coords: np.ndarray  # positions - com in the principal frame at t = 0
-    moments: np.ndarray  # principal moments (Da nm²), ascending
-    x0: np.ndarray  # body angular momentum at t = 0 (Da nm²/ps)
-    group: RigidGroup
-
-    def body_angular_momentum(self, positions, velocities):
-        """(x, L): body-frame and space-frame angular momentum of a state."""
-        x, L, _ = body_angular_momentum(self.body_coords, positions, velocities, self.masses)
-        return x, L
-
-
-def free_rigid_body(positions, masses, body_angular_velocity) -> FreeRigidBody:
-    """A System holding one rigid molecule (no forces) and a state spinning at ``body_angular_velocity``
-    (1/ps, along the principal axes, ascending moments), so that x0 = M ω."""
-    pos = _as_nm(positions)
-    m = np.asarray(masses, float)
-    system = mm.System()
-    for mi in m:
-        system.addParticle(float(mi))
-    (group,) = make_rigid(system, pos, [list(range(len(pos)))])
-    com, moments, axes = principal_axes(pos, m)
-    w = np.asarray(body_angular_velocity, float)
-    vel = rigid_body_velocities(pos, m, axes @ w)
-    return FreeRigidBody(system, pos, vel, m, (pos - com) @ axes, moments, moments * w, group)
-
-
-def run_free_rigid_body(body: FreeRigidBody, method: str, step_ps: float, n_steps: int, record_every: int = 0,
-                        platform: str = "Reference", constraint_tolerance: float = 1e-12):
-    """Integrate ``body`` with SymplecticIntegrator(method) through RATTLE.
-
-    Returns (times ps, x body-frame angular momenta, L space-frame angular momenta), recorded every
-    ``record_every`` steps (0: only the start and the end)."""
-    from ..integrators import SymplecticIntegrator
-
-    integrator = SymplecticIntegrator(step_ps, method, system=body.system)
-    integrator.setConstraintTolerance(constraint_tolerance)
-    ctx = mm.Context(body.system, integrator, mm.Platform.getPlatformByName(platform))
-    ctx.setPositions(body.positions)
-    ctx.setVelocities(body.velocities)
-    every = record_every if record_every > 0 else n_steps
-    times, xs, Ls = [], [], []
-    done = 0
-
-    def record():
-        st = ctx.getState(getPositions=True, getVelocities=True)
-        x, L = body.body_angular_momentum(st.getPositions(asNumpy=True).value_in_unit(unit.nanometer),
-                                          st.getVelocities(asNumpy=True).value_in_unit(unit.nanometer / unit.picosecond))
-        times.append(done * step_ps)
-        xs.append(x)
-        Ls.append(L)
-
-    record()
-    while done < n_steps:
-        k = min(every, n_steps - done)
-        integrator.step(k)
-        done += k
-        record()
-    ctx = None  # released before returning (record() holds the name)
-    return np.array(times), np.array(xs), np.array(Ls)

@@ -14,8 +14,6 @@ another program was loaded.
 """
 from __future__ import annotations
 
-import json
-import math
 import warnings
 from dataclasses import replace
 
@@ -25,37 +23,18 @@ import openmm.unit as unit
 from ..systems.checks import warn_once
 from ..systems.properties import masses
 from . import program, thermostat_program
-from .backend import CUSTOM_OPTIONS, NATIVE_OPTIONS, check_option_names, prepare
+from .backend import resolve_for_system
 from .base import CheckpointMismatchError, ConvergenceWarning, IntegratorBase, SystemMismatchError
+from .metadata import add_metadata, metadata
+from .options import OPTIONS, IntegratorOptions
 from .projection import set_masses
 from .symplectic import SymplecticIntegrator
 
-__all__ = ["PRKIntegrator", "CustomSymplecticIntegrator", "META_PREFIX", "read_metadata", "TimeWarning"]
-
-#: Prefix of the global variable whose name carries the integrator's Python metadata (hex JSON), so that
-#: :func:`openmm_symprk.integrators.restore.restore` can rebuild the class from plain XML.
-META_PREFIX = "symprk_meta_"
-
-
-#: The keyword options of PRKIntegrator and CustomSymplecticIntegrator (for the misspelt-keyword message).
-_PRK_ARGS = (*sorted(NATIVE_OPTIONS | CUSTOM_OPTIONS), "name")
-_CATALOGUE_ARGS = (*sorted(NATIVE_OPTIONS | CUSTOM_OPTIONS),)
+__all__ = ["PRKIntegrator", "CustomSymplecticIntegrator", "TimeWarning"]
 
 
 class TimeWarning(UserWarning):
     """OpenMM's CustomIntegrator keeps the Context's time on the old step size after setStepSize."""
-
-
-def read_metadata(integrator: mm.CustomIntegrator) -> dict | None:
-    """The metadata a program of this package carries in a global variable name, or None."""
-    for i in range(integrator.getNumGlobalVariables()):
-        name = integrator.getGlobalVariableName(i)
-        if name.startswith(META_PREFIX):
-            try:
-                return json.loads(bytes.fromhex(name[len(META_PREFIX):]).decode())
-            except ValueError:
-                return None
-    return None
 
 
 class PRKIntegrator(IntegratorBase, mm.CustomIntegrator):
@@ -91,65 +70,37 @@ class PRKIntegrator(IntegratorBase, mm.CustomIntegrator):
     temperature, collision_time, thermostat_interval, random_seed : the velocity-rescaling thermostat (NVT), see
         :func:`openmm_symprk.integrators.thermostat.thermostat_settings` and :mod:`.thermostat_program`;
         ``temperature`` needs ``system=``.  Without ``temperature`` the program is the NVE one, bit for bit.
+    name : str, optional
+        The method's name (default: its catalogue name, or the tableau's).
+
+    The options are checked once, into one :class:`~.options.IntegratorOptions` (``integrator.options``).
     """
 
     backend = "custom"
 
-    def __init__(self, stepSize, tableau, system: mm.System | None = None, constraints: bool | None = None,
-                 allow_nonsymplectic: bool = False, exact_momentum: bool = False, check_finite: bool = True,
-                 max_speed=None, groups=None, inner_method=None, tolerance: float = 1e-12, max_iterations: int = 60,
-                 name: str | None = None, temperature=None, collision_time=None, thermostat_interval=None,
-                 random_seed=None, **unknown):
-        check_option_names(unknown, _PRK_ARGS, type(self).__name__)
-        if constraints is not None and not isinstance(constraints, bool):
-            raise TypeError(f"constraints must be True, False or None (from system=), got {constraints!r}")
-        if not (isinstance(tolerance, (int, float)) and not isinstance(tolerance, bool) and tolerance > 0
-                and math.isfinite(tolerance)):
-            raise ValueError(f"tolerance must be a positive number of nm, got {tolerance!r}")
-        if isinstance(max_iterations, bool) or int(max_iterations) < 1:
-            raise ValueError(f"max_iterations must be at least 1, got {max_iterations!r}")
-        p = prepare(type(self).__name__, stepSize, tableau, system, exact_momentum=exact_momentum,
-                    check_finite=check_finite, max_speed=max_speed, groups=groups, inner_method=inner_method,
-                    constraints=constraints, name=name, temperature=temperature, collision_time=collision_time,
-                    thermostat_interval=thermostat_interval, random_seed=random_seed)
-        r = p.method
-        r.check_symplectic(allow_nonsymplectic)
-        has_sites = p.system.virtual_sites if p.system is not None else True
-        mm.CustomIntegrator.__init__(self, p.dt)
-        self._set_resolved(r)
-        self.program_info = program.compile_program(
-            self, r, has_sites, exact_momentum=p.exact_momentum, check_finite=p.check_finite, max_speed=p.max_speed,
-            tolerance=tolerance, max_iterations=int(max_iterations), thermostat=p.thermostat)
-        self.check_finite = p.check_finite
-        self.max_speed = p.max_speed
-        self.exact_momentum = p.exact_momentum
-        self.compiled_for = sig = p.system
-        self._masses = masses(system) if p.exact_momentum or p.thermostat is not None else None
-        self.thermostat = p.thermostat
-        if p.thermostat is not None:
-            mm.CustomIntegrator.setRandomNumberSeed(self, p.thermostat.seed)
+    def __init__(self, stepSize, tableau, system: mm.System | None = None, name: str | None = None, **options):
+        self._compile(tableau, system, IntegratorOptions.build(type(self).__name__, stepSize, system, OPTIONS,
+                                                                ("name",), **options), name)
 
-        self._signature = float(self.program_info.signature)
+    def _compile(self, method, system, options: IntegratorOptions, name: str | None = None):
+        """Resolve ``method`` for ``system``, compile its program with ``options`` and record its metadata."""
+        r = resolve_for_system(type(self).__name__, method, system, options, name=name)
+        r.check_symplectic(options.allow_nonsymplectic)
+        has_sites = options.system.virtual_sites if options.system is not None else True
+        mm.CustomIntegrator.__init__(self, options.step_size)
+        self._set_program(r, options, program.compile_program(self, r, options, has_sites))
+        self._masses = masses(system) if options.exact_momentum or options.thermostat is not None else None
+        self.thermostat = options.thermostat
+        if options.thermostat is not None:
+            mm.CustomIntegrator.setRandomNumberSeed(self, options.thermostat.seed)
         self._reset_binding()
-        meta = {"class": type(self).__name__, "method": self.method_name,
-                "catalogue": self.method.name if self.method is not None else None,
-                "options": {"exact_momentum": self.exact_momentum, "check_finite": self.check_finite,
-                            "max_speed": self.max_speed, "groups": None if r.groups is None else [list(g) for g in r.groups],
-                            "inner_method": r.inner_name},
-                "system": None if sig is None else {"n_particles": sig.n_particles, "constraints": sig.constraints,
-                                                    "virtual_sites": sig.virtual_sites,
-                                                    "total_mass": sig.total_mass, "masses_digest": sig.masses_digest}}
-        if p.thermostat is not None:  # (an NVE program's metadata stays as it was)
-            meta["thermostat"] = p.thermostat.as_dict()
-        self.addGlobalVariable(META_PREFIX + json.dumps(meta, separators=(",", ":")).encode().hex(), 0.0)
+        add_metadata(self, metadata(type(self).__name__, method, r, options))
 
-    def _set_resolved(self, r):
-        """Record the resolved method (None: a program restored from XML whose method is not in the catalogue)."""
+    def _set_program(self, r, options, info):
+        """Record the resolved method, the options and the facts of the compiled program."""
         self.resolved = r
-        self.method = r.entry if r is not None else None
-        self.method_name = r.name if r is not None else self.method_name
-        self.mts_levels = (list(r.levels) or None) if r is not None else None
-        self.tableau = r.tableau if r is not None else None
+        self.options = options
+        self.program_info = info
 
     # -- per-Context checks ----------------------------------------------------------------------------
     _transient = IntegratorBase._transient + ("_context_ref",)
@@ -166,10 +117,10 @@ class PRKIntegrator(IntegratorBase, mm.CustomIntegrator):
         if not self._checked_context:
             self._check_context()
         stored = self.getGlobalVariable(0)
-        if stored != self._signature:
+        if stored != self.program_info.signature:
             raise CheckpointMismatchError(
                 f"{type(self).__name__}({self.method_name}): the Context holds the state of another integrator "
-                f"program (its signature {stored:.0f} is not this program's {self._signature:.0f}): a checkpoint "
+                f"program (its signature {stored:.0f} is not this program's {self.program_info.signature}): a checkpoint "
                 f"saved with another method, other options (exact_momentum, constraints, max_speed) or the native "
                 f"backend was loaded. Create the integrator as it was when the checkpoint was saved (a native "
                 f"checkpoint needs backend='native'), load the checkpoint into that one, or load a State "
@@ -238,14 +189,14 @@ class PRKIntegrator(IntegratorBase, mm.CustomIntegrator):
                           f"without the thermostat; it is restored for the next steps.", RuntimeWarning, stacklevel=3)
         if not self._checked_probe:
             self._checked_probe = True
-            if self.getGlobalVariableByName(program.PROBE_CONSTRAINTS_VAR) > 0 and not self.program_info.constraints:
-                what = ("a general PRK tableau, which cannot keep constraints" if self.program_info.kind != "splitting"
+            if self.getGlobalVariableByName(program.PROBE_CONSTRAINTS_VAR) > 0 and not self.program_info.rattle:
+                what = ("a general PRK tableau, which cannot keep constraints" if not self.resolved.is_splitting
                         else "a System without constraints (system=, or constraints=False)")
                 raise SystemMismatchError(
                     f"{type(self).__name__}({self.method_name}) was compiled for {what}, but its Context's System "
                     f"has constraints: this first step did not keep them. Create the integrator with system= the "
                     f"System you simulate (a kick/drift method then compiles RATTLE steps).")
-        if self.program_info.kind == "implicit":
+        if self.resolved.form == "implicit":
             n = int(self.getGlobalVariableByName(program.NONCONV_VAR))
             if n > self._nonconverged_seen:
                 warnings.warn(
@@ -313,16 +264,15 @@ class PRKIntegrator(IntegratorBase, mm.CustomIntegrator):
         return context
 
     def describe(self) -> str:
-        info = self.program_info
+        info, r = self.program_info, self.resolved
+        size = f"{len(r.substeps)} kicks and drifts" if r.is_splitting else f"{r.stages} stages"
         lines = [f"{type(self).__name__}: {self.method_name}, step {self.getStepSize()}, CustomIntegrator backend",
-                 f"  program: {info.kind}, {info.stages} {'kicks and drifts' if info.kind == 'splitting' else 'stages'}, "
-                 f"constraints={'RATTLE' if info.constraints else 'none'}, force evaluations per step: "
-                 f"{info.force_evals}, exact momentum: {info.exact_momentum}",
-                 f"  {self.tableau.summary()}" if self.tableau is not None else
-                 ("  multiple time stepping" if self.mts_levels else "  (tableau not restored)")]
+                 f"  program: {r.form}, {size}, constraints={'RATTLE' if info.rattle else 'none'}, force evaluations "
+                 f"per step: {r.force_evals}, exact momentum: {self.exact_momentum}",
+                 f"  {r.tableau.summary()}" if r.tableau is not None else "  multiple time stepping"]
         lines += [f"  {n}" for n in info.notes]
-        if self.mts_levels:
-            lines.append("  " + self.resolved.describe_levels())
+        if r.is_mts:
+            lines.append("  " + r.describe_levels())
         if self.thermostat is not None:
             lines.append("  " + self._thermostat_values().describe())
         return "\n".join(lines)
@@ -336,5 +286,5 @@ class CustomSymplecticIntegrator(SymplecticIntegrator, PRKIntegrator, backend="c
     def __init__(self, stepSize, method="verlet", system: mm.System | None = None, backend: str = "custom",
                  **options):
         self._check_backend(backend)
-        check_option_names(options, _CATALOGUE_ARGS, type(self).__name__)
-        PRKIntegrator.__init__(self, stepSize, method, system=system, **options)
+        self._compile(method, system, IntegratorOptions.build(type(self).__name__, stepSize, system, OPTIONS,
+                                                               **options))
