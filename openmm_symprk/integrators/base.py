@@ -8,9 +8,9 @@ program of :mod:`.custom_backend` or the plugin's SymPRKIntegrator of :mod:`.nat
   stability limit; the record is cleared when it is reported, so reloading a good state and going on works;
 * ``setStepSize`` with the package's validation, ``describe()``, ``steps_taken``;
 * what it runs: ``resolved`` (the :class:`~openmm_symprk.methods.resolved.ResolvedMethod`), ``options`` (the
-  checked :class:`~.options.IntegratorOptions`, read by ``check_finite``, ``max_speed``, ``exact_momentum`` and
-  ``compiled_for``, the :class:`~openmm_symprk.systems.properties.SystemSignature` of its ``system=``, which each
-  backend checks against the Context it is bound to) and ``program_info`` (the facts of the compiled program,
+  checked :class:`~.options.IntegratorOptions`; ``options.system`` is the
+  :class:`~openmm_symprk.systems.properties.SystemSignature` of its ``system=``, which each backend checks against
+  the Context it is bound to) and ``program_info`` (the facts of the compiled program,
   :class:`~.program.ProgramInfo`);
 * copies: ``pickle``, ``copy.copy`` and ``copy.deepcopy`` go through OpenMM's XML serialization (as for
   OpenMM's own integrators) and give back the same Python class with its conveniences.
@@ -87,24 +87,6 @@ class IntegratorBase:
     def method_name(self) -> str:
         return self.resolved.name
 
-    @property
-    def check_finite(self) -> bool:
-        return self.options.check_finite
-
-    @property
-    def max_speed(self) -> float:
-        """nm/ps; 0: only NaN and infinity count as a blow-up."""
-        return self.options.max_speed
-
-    @property
-    def exact_momentum(self) -> bool:
-        return self.options.exact_momentum
-
-    @property
-    def compiled_for(self):
-        """The :class:`~openmm_symprk.systems.properties.SystemSignature` of ``system=``, None without one."""
-        return self.options.system
-
     # -- the step ---------------------------------------------------------------------------------
     def step(self, steps):
         """Advance ``steps`` steps; raise SimulationBlowUpError if the simulation blew up."""
@@ -122,7 +104,7 @@ class IntegratorBase:
                 raise
             self._clear_blowup()
             raise self._blow_up(self._raw_steps_taken() + 1, "positions became NaN") from exc
-        if self.check_finite:
+        if self.options.check_finite:
             bad = self._blowup_step()
             if bad:
                 self._clear_blowup()
@@ -137,8 +119,8 @@ class IntegratorBase:
         """Checks after stepping (a backend's warnings)."""
 
     def _blowup_what(self) -> str:
-        if self.max_speed:
-            return f"velocities became NaN, infinite or faster than {self.max_speed:g} nm/ps"
+        if self.options.max_speed:
+            return f"velocities became NaN, infinite or faster than {self.options.max_speed:g} nm/ps"
         return "velocities became NaN or infinite"
 
     def _blow_up(self, step: int, what: str) -> SimulationBlowUpError:

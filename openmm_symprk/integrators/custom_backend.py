@@ -130,14 +130,14 @@ class PRKIntegrator(IntegratorBase, mm.CustomIntegrator):
         """First step on a Context: its particle count against ``system=`` (read from a per-DOF variable the
         Context sized), then the exact masses for the projection."""
         n = len(self.getPerDofVariableByName(program.PROBE_PER_DOF))
-        expected = self.compiled_for.n_particles if self.compiled_for is not None else None
+        expected = self.options.system.n_particles if self.options.system is not None else None
         if n == 1 and expected not in (None, 1):
             super().step(0)  # raises "not bound to a context" if that is why only one value came back
         if expected is not None and n != expected:
             raise SystemMismatchError(
                 f"{type(self).__name__}({self.method_name}) was compiled for a System of {expected} particles, but "
                 f"its Context's System has {n}: create the integrator with system= the System you simulate")
-        if self._masses is not None and self.exact_momentum:
+        if self._masses is not None and self.options.exact_momentum:
             set_masses(self, self._masses)
         if self.thermostat is not None:
             self._set_thermostat_mask(n)
@@ -268,7 +268,7 @@ class PRKIntegrator(IntegratorBase, mm.CustomIntegrator):
         size = f"{len(r.substeps)} kicks and drifts" if r.is_splitting else f"{r.stages} stages"
         lines = [f"{type(self).__name__}: {self.method_name}, step {self.getStepSize()}, CustomIntegrator backend",
                  f"  program: {r.form}, {size}, constraints={'RATTLE' if info.rattle else 'none'}, force evaluations "
-                 f"per step: {r.force_evals}, exact momentum: {self.exact_momentum}",
+                 f"per step: {r.force_evals}, exact momentum: {self.options.exact_momentum}",
                  f"  {r.tableau.summary()}" if r.tableau is not None else "  multiple time stepping"]
         lines += [f"  {n}" for n in info.notes]
         if r.is_mts:

@@ -104,9 +104,10 @@ def _restore_native(integrator):
             entry = catalogue_methods[name]
             resolved = replace(resolved, entry=entry, order=entry.order, constrained_order=entry.constrained_order,
                                stability=entry.stability)
+    # the plugin holds these options; check_finite is Python's (True), system= is held as the expected particle count
     options = IntegratorOptions(float(obj.getStepSize().value_in_unit(unit.picosecond)),
                                 exact_momentum=bool(obj.getExactMomentum()), max_speed=float(obj.getMaxSpeed()),
-                                groups=resolved.groups, thermostat=obj.thermostat)
+                                thermostat=obj.thermostat)
     obj._set_program(resolved, options, notes=("restored from XML",))
     obj._reset_binding()
     return obj
