@@ -1,5 +1,6 @@
 """Small float64 measurements shared by the OpenMM tests (built on openmm_symprk.conservation)."""
 import numpy as np
+import openmm.app as app
 import openmm.unit as unit
 
 from openmm_symprk.conservation import angular_momentum, linear_momentum
@@ -27,6 +28,24 @@ def counted(scene):
     counter = Counter()
     system.addForce(mm.PythonForce(counter))
     return system, counter
+
+
+def reference_context(system, integrator, scene):
+    """A Reference Context of ``system`` (e.g. the scene's with a Counter) at the scene's initial state."""
+    import openmm as mm
+
+    ctx = mm.Context(system, integrator, mm.Platform.getPlatformByName("Reference"))
+    ctx.setPositions(scene.positions)
+    ctx.setVelocities(scene.velocities)
+    return ctx
+
+
+def evaluations(integrator, counters, steps: int) -> tuple:
+    """The evaluations each Counter of ``counters`` counts in ``steps`` steps of ``integrator``."""
+    for c in counters:
+        c.n = 0
+    integrator.step(steps)
+    return tuple(c.n for c in counters)
 
 
 def momenta(ctx, masses):
@@ -77,3 +96,27 @@ def measure_order(scene, make_integrator, T_ps: float, steps=(10, 20, 40, 80), p
     (:func:`openmm_symprk.methods.orders.observed_orders`: no reference solution needed).  ``make_integrator(h_ps)``
     returns a fresh integrator at step size h."""
     return observed_orders([final_state(scene, make_integrator, n, T_ps, platform) for n in steps], steps)
+
+
+def tip4p_waters(n: int, rigid: bool):
+    """(system, positions) of ``n`` TIP4P-Ew waters in vacuum, a massless virtual site each (not minimised)."""
+    from openmm_symprk.systems.scenes import water_cluster
+
+    base = water_cluster(n, minimize=False)
+    mod = app.Modeller(base.topology, base.positions * unit.nanometer)
+    ff = app.ForceField("tip4pew.xml")
+    mod.addExtraParticles(ff)
+    system = ff.createSystem(mod.topology, nonbondedMethod=app.NoCutoff, constraints=None, rigidWater=rigid,
+                             removeCMMotion=False)
+    return system, mod.positions
+
+
+def virtual_site_error(system, x) -> float:
+    """Largest distance (nm) between a virtual site's position in ``x`` and the one its rule gives."""
+    err = 0.0
+    for i in range(system.getNumParticles()):
+        if system.isVirtualSite(i):
+            vs = system.getVirtualSite(i)
+            expect = sum(vs.getWeight(k) * x[vs.getParticle(k)] for k in range(vs.getNumParticles()))
+            err = max(err, float(np.abs(x[i] - expect).max()))
+    return err

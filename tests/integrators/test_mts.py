@@ -9,7 +9,7 @@ import openmm.unit as unit
 import pytest
 from openmm.mtsintegrator import MTSIntegrator
 
-from helpers import Counter, drift_after, measure_order
+from helpers import Counter, drift_after, evaluations, measure_order, reference_context
 from openmm_symprk import SymplecticIntegrator, plugin
 from openmm_symprk.methods.respa import MTSError
 from openmm_symprk.systems.forcegroups import check_groups, force_groups, split_forces
@@ -104,25 +104,14 @@ def test_force_evaluations_per_group_are_counted(backend, water8):
     system, groups, counters = _counted(water8, 4)
     ig = SymplecticIntegrator(2 * unit.femtoseconds, "verlet", system=system, groups=groups, backend=backend)
     assert ig.resolved.evaluations == {(1,): 1, (0,): 4} and ig.program_info.method is ig.resolved
-    ctx = mm.Context(system, ig, mm.Platform.getPlatformByName("Reference"))
-    ctx.setPositions(water8.positions)
-    ctx.setVelocities(water8.velocities)
-    ig.step(2)
-    for c in counters.values():
-        c.n = 0
-    ig.step(10)
-    slow, fast = counters[1].n, counters[0].n
-    assert slow == 10
-    assert fast == (40 if backend == "native" else 50)
     ref = MTSIntegrator(2 * unit.femtoseconds, groups)
-    ctx2 = mm.Context(system, ref, mm.Platform.getPlatformByName("Reference"))
-    ctx2.setPositions(water8.positions)
-    ctx2.setVelocities(water8.velocities)
-    ref.step(2)
-    for c in counters.values():
-        c.n = 0
-    ref.step(10)
-    assert (counters[1].n, counters[0].n) == (10, 50)
+    counts = {}
+    for name, integrator in (("ours", ig), ("openmm", ref)):
+        ctx = reference_context(system, integrator, water8)  # noqa: F841 (kept alive while stepping)
+        integrator.step(2)
+        counts[name] = evaluations(integrator, (counters[1], counters[0]), 10)
+    assert counts["ours"] == (10, 40 if backend == "native" else 50)  # (slow, fast)
+    assert counts["openmm"] == (10, 50)
 
 
 def test_split_forces_and_group_checks(water8):

@@ -7,11 +7,11 @@ import copy
 
 import numpy as np
 import openmm as mm
-import openmm.app as app
 import openmm.unit as unit
 import pytest
 
-from helpers import counted, drift_after, stiff_diatomic
+from helpers import (counted, drift_after, evaluations, reference_context, stiff_diatomic, tip4p_waters,
+                     virtual_site_error)
 from openmm_symprk import SymplecticIntegrator, catalogue
 from openmm_symprk import plugin
 from openmm_symprk.integrators import (NativeMethodError, NativeSymplecticIntegrator, NativeUnavailableError,
@@ -104,13 +104,9 @@ def test_force_evaluations_per_step(name, scene_name, request):
     scene = request.getfixturevalue(scene_name)
     system, counter = counted(scene)
     ig = N(1 * unit.femtoseconds, name, system=system)
-    ctx = mm.Context(system, ig, mm.Platform.getPlatformByName("Reference"))
-    ctx.setPositions(scene.positions)
-    ctx.setVelocities(scene.velocities)
+    ctx = reference_context(system, ig, scene)
     ig.step(1)
-    counter.n = 0
-    ig.step(40)
-    assert counter.n == 40 * catalogue[name].force_evals
+    assert evaluations(ig, [counter], 40) == (40 * catalogue[name].force_evals,)
     assert ig.force_evals == catalogue[name].force_evals
     # Reference keeps the cached forces through an energy evaluation: one evaluation for the energy, none more.
     counter.n = 0
@@ -239,16 +235,9 @@ def test_checkpoint_continues_bitwise_on_reference(scene_name, request):
 # -- virtual sites, errors ------------------------------------------------------------------------------------------
 def _tip4p_cluster():
     """8 rigid TIP4P-Ew waters in vacuum (a massless virtual site each), minimized on Reference."""
-    from openmm_symprk.systems.scenes import water_cluster
-
-    base = water_cluster(8, minimize=False)
-    mod = app.Modeller(base.topology, base.positions * unit.nanometer)
-    ff = app.ForceField("tip4pew.xml")
-    mod.addExtraParticles(ff)
-    system = ff.createSystem(mod.topology, nonbondedMethod=app.NoCutoff, constraints=None, rigidWater=True,
-                             removeCMMotion=False)
+    system, positions = tip4p_waters(8, rigid=True)
     ctx = mm.Context(system, mm.VerletIntegrator(0.001), mm.Platform.getPlatformByName("Reference"))
-    ctx.setPositions(mod.positions)
+    ctx.setPositions(positions)
     ctx.applyConstraints(1e-10)
     mm.LocalEnergyMinimizer.minimize(ctx, 1.0, 100)
     ctx.setVelocitiesToTemperature(100, 1)
@@ -257,30 +246,27 @@ def _tip4p_cluster():
     return system, st.getPositions(), st.getVelocities()
 
 
-def _vsite_error(system, x):
-    err = 0.0
-    for i in range(system.getNumParticles()):
-        if system.isVirtualSite(i):
-            vs = system.getVirtualSite(i)
-            expect = sum(vs.getWeight(k) * x[vs.getParticle(k)] for k in range(3))
-            err = max(err, float(np.abs(x[i] - expect).max()))
-    return err
+def _run_tip4p(method, platform, properties, blocks):
+    """The TIP4P cluster run natively by ``method`` in ``blocks`` blocks of 40 steps of 1 fs, the virtual sites
+    checked after each (placed to 1e-12 nm): (integrator, context, total energy after each block)."""
+    system, pos, vel = _tip4p_cluster()
+    ig = N(1 * unit.femtoseconds, method, system=system)
+    ctx = mm.Context(system, ig, mm.Platform.getPlatformByName(platform), properties)
+    ctx.setPositions(pos)
+    ctx.setVelocities(vel)
+    energies = []
+    for _ in range(blocks):
+        ig.step(40)
+        st = ctx.getState(getPositions=True, getEnergy=True)
+        assert virtual_site_error(system, st.getPositions(asNumpy=True).value_in_unit(unit.nanometer)) < 1e-12
+        energies.append((st.getKineticEnergy() + st.getPotentialEnergy()).value_in_unit(unit.kilojoule_per_mole))
+    return ig, ctx, energies
 
 
 @needs_native
 @pytest.mark.skipif(not _opencl_ok(), reason="no native OpenCL kernel here (OpenCL platform or its build missing)")
 def test_opencl_virtual_sites_and_checkpoint():
-    system, pos, vel = _tip4p_cluster()
-    ig = N(1 * unit.femtoseconds, "yoshida-4", system=system)
-    ctx = mm.Context(system, ig, mm.Platform.getPlatformByName("OpenCL"), {"Precision": "double"})
-    ctx.setPositions(pos)
-    ctx.setVelocities(vel)
-    energies = []
-    for _ in range(3):
-        ig.step(40)
-        st = ctx.getState(getPositions=True, getEnergy=True)
-        assert _vsite_error(system, st.getPositions(asNumpy=True).value_in_unit(unit.nanometer)) < 1e-12
-        energies.append((st.getKineticEnergy() + st.getPotentialEnergy()).value_in_unit(unit.kilojoule_per_mole))
+    ig, ctx, energies = _run_tip4p("yoshida-4", "OpenCL", {"Precision": "double"}, 3)
     assert max(energies) - min(energies) < 0.05
     chk = ctx.createCheckpoint()
     ig.step(30)
@@ -292,22 +278,11 @@ def test_opencl_virtual_sites_and_checkpoint():
     assert ig.steps_taken == 150
 
 
-
 @needs_native
 def test_virtual_sites_follow_their_parents():
     """TIP4P-Ew waters: the site is placed after every step (and before each force evaluation inside the
     step: the energy is conserved, unlike the CustomIntegrator path's, which sees sites one drift behind)."""
-    system, pos, vel = _tip4p_cluster()
-    ig = N(1 * unit.femtoseconds, "verlet", system=system)
-    ctx = mm.Context(system, ig, mm.Platform.getPlatformByName("Reference"))
-    ctx.setPositions(pos)
-    ctx.setVelocities(vel)
-    energies = []
-    for _ in range(5):
-        ig.step(40)
-        st = ctx.getState(getPositions=True, getEnergy=True)
-        assert _vsite_error(system, st.getPositions(asNumpy=True).value_in_unit(unit.nanometer)) < 1e-12
-        energies.append((st.getKineticEnergy() + st.getPotentialEnergy()).value_in_unit(unit.kilojoule_per_mole))
+    _, _, energies = _run_tip4p("verlet", "Reference", {}, 5)
     assert max(energies) - min(energies) < 0.05
 
 

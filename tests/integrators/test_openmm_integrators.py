@@ -9,7 +9,7 @@ import openmm.unit as unit
 import pytest
 
 from conftest import platform_available
-from helpers import counted, drift_after, measure_order
+from helpers import counted, drift_after, evaluations, measure_order, reference_context
 from openmm_symprk import SymplecticIntegrator, catalogue, resolve
 
 SYMPLECTIC_SPLITTINGS = [m.name for m in catalogue.splittings()]
@@ -24,13 +24,9 @@ def test_force_evaluations_per_step(name, scene_name, request):
     scene = request.getfixturevalue(scene_name)
     system, counter = counted(scene)
     ig = SymplecticIntegrator(1 * unit.femtoseconds, name, system=system, backend="custom")
-    ctx = mm.Context(system, ig, mm.Platform.getPlatformByName("Reference"))
-    ctx.setPositions(scene.positions)
-    ctx.setVelocities(scene.velocities)
+    ctx = reference_context(system, ig, scene)  # noqa: F841 (kept alive while stepping)
     ig.step(1)
-    counter.n = 0
-    ig.step(50)
-    assert counter.n == 50 * catalogue[name].force_evals
+    assert evaluations(ig, [counter], 50) == (50 * catalogue[name].force_evals,)
     assert ig.program_info.force_evals == catalogue[name].force_evals
 
 

@@ -9,12 +9,11 @@ import warnings
 
 import numpy as np
 import openmm as mm
-import openmm.app as app
 import openmm.unit as unit
 import pytest
 
 from conftest import platform_available
-from helpers import stiff_diatomic
+from helpers import stiff_diatomic, tip4p_waters, virtual_site_error
 from openmm_symprk import (CheckpointMismatchError, SimulationBlowUpError, SymplecticIntegrator, SystemMismatchError,
                            deserialize, plugin, restore)
 from openmm_symprk.integrators import CustomSymplecticIntegrator, NativeSymplecticIntegrator
@@ -124,26 +123,10 @@ def test_checkpoints_across_backends_and_methods_are_refused(water8):
 # -- 4. virtual sites on OpenCL without constraints ---------------------------------------------------------------------
 def _flexible_tip4p():
     from openmm_symprk.systems.prepare import maxwell_boltzmann, minimise
-    from openmm_symprk.systems.scenes import water_cluster
 
-    base = water_cluster(4, minimize=False)
-    mod = app.Modeller(base.topology, base.positions * unit.nanometer)
-    ff = app.ForceField("tip4pew.xml")
-    mod.addExtraParticles(ff)
-    system = ff.createSystem(mod.topology, nonbondedMethod=app.NoCutoff, constraints=None, rigidWater=False,
-                             removeCMMotion=False)
-    pos = minimise(system, mod.positions, tolerance=1.0)
+    system, positions = tip4p_waters(4, rigid=False)
+    pos = minimise(system, positions, tolerance=1.0)
     return system, pos, maxwell_boltzmann(system, pos, 100.0, 1)
-
-
-def _vsite_error(system, x):
-    err = 0.0
-    for i in range(system.getNumParticles()):
-        if system.isVirtualSite(i):
-            vs = system.getVirtualSite(i)
-            expect = sum(vs.getWeight(k) * x[vs.getParticle(k)] for k in range(vs.getNumParticles()))
-            err = max(err, float(np.abs(x[i] - expect).max()))
-    return err
 
 
 @needs_opencl
@@ -157,7 +140,7 @@ def test_custom_places_virtual_sites_on_opencl_without_constraints():
     ctx.setPositions(pos)
     ctx.setVelocities(vel)
     ig.step(200)
-    assert _vsite_error(system, _positions(ctx)) < 1e-9
+    assert virtual_site_error(system, _positions(ctx)) < 1e-9
 
 
 # -- 5. time after setStepSize --------------------------------------------------------------------------------------------

@@ -293,6 +293,16 @@ def test_thermostat_off_is_the_nve_program_bit_for_bit(cluster, method, options)
 
 
 # -- canonical sampling --------------------------------------------------------------------------------------------
+def _peculiar_kinetic_every(ig, ctx, m, every: int, samples: int) -> np.ndarray:
+    """The peculiar kinetic energy (rigid rotation kept) after each of ``samples`` blocks of ``every`` steps."""
+    out = []
+    for _ in range(samples):
+        ig.step(every)
+        xs, vs, _ = state_arrays(ctx)
+        out.append(peculiar_kinetic(xs, vs, m, True))
+    return np.array(out)
+
+
 @pytest.mark.parametrize("backend", BACKENDS)
 def test_ideal_gas_kinetic_energy_is_gamma_distributed(backend):
     """No forces, isolated: the peculiar kinetic energy of the canonical ensemble is Gamma(N_f/2, kT) with
@@ -309,12 +319,7 @@ def test_ideal_gas_kinetic_energy_is_gamma_distributed(backend):
     ctx = context(system, ig, x, v)
     m = masses(system)
     ig.step(50)
-    K = []
-    for _ in range(2000):
-        ig.step(5)
-        xs, vs, _ = state_arrays(ctx)
-        K.append(peculiar_kinetic(xs, vs, m, True))
-    K = np.array(K)
+    K = _peculiar_kinetic_every(ig, ctx, m, 5, 2000)
     kT = R_KJ * T
     g = statistical_inefficiency(K)
     assert g < 2.0  # c^2 = exp(-2.5) per 5 steps: nearly independent
@@ -327,12 +332,7 @@ def test_ideal_gas_kinetic_energy_is_gamma_distributed(backend):
     # a new target acts on the running Context
     ig.setTemperature(2 * T)
     ig.step(200)
-    K2 = []
-    for _ in range(300):
-        ig.step(5)
-        xs, vs, _ = state_arrays(ctx)
-        K2.append(peculiar_kinetic(xs, vs, m, True))
-    s2 = series_stats(K2)
+    s2 = series_stats(_peculiar_kinetic_every(ig, ctx, m, 5, 300))
     assert abs(s2.mean - dof * kT) < 3 * s2.se
 
 

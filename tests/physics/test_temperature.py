@@ -1,20 +1,12 @@
 """Translational and rotational kinetic temperatures of molecules: cases with a known answer."""
 import numpy as np
 import pytest
+from scipy.spatial.transform import Rotation
 
 from openmm_symprk.physics.temperature import R_KJ, kinetic_temperatures, molecule_kinetics
 
 WATER = np.array([[0.0, 0.0, 0.0], [0.09572, 0.0, 0.0], [-0.0239987, 0.0926627, 0.0]])
 MASSES = np.array([15.9994, 1.008, 1.008])
-
-
-def _random_rotation(rng):
-    q = rng.normal(size=4)
-    q /= np.linalg.norm(q)
-    a, b, c, d = q
-    return np.array([[a*a + b*b - c*c - d*d, 2*(b*c - a*d), 2*(b*d + a*c)],
-                     [2*(b*c + a*d), a*a - b*b + c*c - d*d, 2*(c*d - a*b)],
-                     [2*(b*d - a*c), 2*(c*d + a*b), a*a - b*b - c*c + d*d]])
 
 
 def _waters(n, t_trans, t_rot, seed=3, exact=True):
@@ -25,7 +17,7 @@ def _waters(n, t_trans, t_rot, seed=3, exact=True):
     M = MASSES.sum()
     xs, Vs, Ws = [], [], []
     for k in range(n):
-        R = _random_rotation(rng)
+        R = Rotation.random(random_state=rng).as_matrix()
         body = (WATER - com0) @ R.T
         xs.append(body + rng.uniform(0, 5, 3))
         I = np.eye(3) * (MASSES * (body ** 2).sum(1)).sum() - np.einsum("i,ij,ik->jk", MASSES, body, body)

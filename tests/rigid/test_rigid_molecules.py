@@ -202,12 +202,7 @@ def test_virtual_site_groups_keep_mass_and_centre_of_mass(geometry):
         assert g.inertia_change > 0.01
 
     # It moves rigidly under RATTLE (no interactions on the sites: see the module notes).
-    vel = rigid_body_velocities(pos, new, [3.0, -5.0, 7.0], [0.1, 0.2, 0.3])
-    integrator = SymplecticIntegrator(0.002, "yoshida-4", system=s)
-    integrator.setConstraintTolerance(1e-12)
-    ctx = mm.Context(s, integrator, REFERENCE)
-    ctx.setPositions(pos)
-    ctx.setVelocities(vel)
+    integrator, ctx = _spinning(s, pos, new, [3.0, -5.0, 7.0], 0.002, "yoshida-4")
     integrator.step(1)  # the first step projects onto the constraints (exact up to adjusted_constraints)
     x1 = ctx.getState(getPositions=True).getPositions(asNumpy=True)._value
     np.testing.assert_allclose(pair_distances(x1, range(len(pos))), pair_distances(pos, range(len(pos))),
@@ -215,6 +210,17 @@ def test_virtual_site_groups_keep_mass_and_centre_of_mass(geometry):
     integrator.step(200)
     x = ctx.getState(getPositions=True).getPositions(asNumpy=True)._value
     np.testing.assert_allclose(pair_distances(x, range(len(pos))), pair_distances(x1, range(len(pos))), rtol=0, atol=1e-10)
+
+
+def _spinning(system, pos, masses, angular_velocity, step_ps, method):
+    """(integrator, Reference Context) of a rigid group spinning at ``angular_velocity`` and drifting at
+    (0.1, 0.2, 0.3) nm/ps, run by ``method`` through RATTLE at a constraint tolerance of 1e-12."""
+    integrator = SymplecticIntegrator(step_ps, method, system=system)
+    integrator.setConstraintTolerance(1e-12)
+    ctx = mm.Context(system, integrator, REFERENCE)
+    ctx.setPositions(pos)
+    ctx.setVelocities(rigid_body_velocities(pos, masses, angular_velocity, [0.1, 0.2, 0.3]))
+    return integrator, ctx
 
 
 def test_isosceles_triangle_with_unequal_masses_avoids_settle():
@@ -231,12 +237,7 @@ def test_isosceles_triangle_with_unequal_masses_avoids_settle():
     # plain water (equal base masses) keeps its exact distances: SETTLE is right for it
     (w,) = make_rigid(system_of([15.999, 1.008, 1.008]), pos, [[0, 1, 2]])
     assert w.adjusted_constraints == ()
-    vel = rigid_body_velocities(pos, masses, [3.0, -20.0, 10.0], [0.1, 0.2, 0.3])
-    integrator = SymplecticIntegrator(0.001, "verlet", system=s)
-    integrator.setConstraintTolerance(1e-12)
-    ctx = mm.Context(s, integrator, REFERENCE)
-    ctx.setPositions(pos)
-    ctx.setVelocities(vel)
+    integrator, ctx = _spinning(s, pos, masses, [3.0, -20.0, 10.0], 0.001, "verlet")
     integrator.step(500)
     x = ctx.getState(getPositions=True).getPositions(asNumpy=True)._value
     np.testing.assert_allclose([np.linalg.norm(x[a] - x[b]) for a, b, _ in g.constraints],
