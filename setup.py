@@ -27,7 +27,8 @@ PLATFORMS = os.path.join(HERE, "platforms")
 #: Kernel libraries whose failure to build leaves the rest of the plugin working (CMake target per platform).
 OPTIONAL_TARGETS = {"OpenCL": "OpenMMSymPRKOpenCL", "CUDA": "OpenMMSymPRKCUDA"}
 CORE_TARGETS = ["OpenMMSymPRK", "OpenMMSymPRKReference", "symprk_swig_ext"]
-TEST_TARGETS = ["TestSerializeSymPRKIntegrator", "TestReferenceSymPRKStep", "TestReferenceSymPRKThermostat"]
+TEST_TARGETS = ["TestSerializeSymPRKIntegrator", "TestReferenceSymPRKStep", "TestReferenceSymPRKThermostat",
+                "TestReferenceSymPRKStepPlan"]
 OUTPUTS = ["_build_info.json", "_build_error.txt", "symprk_swig.py"]
 
 

@@ -10,7 +10,7 @@ while(start LESS length)
     string(APPEND body "    R\"SYMPRKSRC(${chunk})SYMPRKSRC\"\n")
     math(EXPR start "${start} + 12000")
 endwhile()
-set(content "// Generated from ${INPUT_NAME} by EmbedKernelSource.cmake: do not edit.\n#include \"CommonSymPRKKernels.h\"\nconst std::string OpenMM::CommonSymPRKKernelSources::symprk = std::string(\n${body});\n")
+set(content "// Generated from ${INPUT_NAME} by EmbedKernelSource.cmake: do not edit.\n#include \"CommonSymPRKKernels.h\"\nconst std::string SymPRKPlugin::CommonSymPRKKernelSources::symprk = std::string(\n${body});\n")
 # Write only when the text changed, so that an unchanged kernel source compiles nothing again.
 set(old "")
 if(EXISTS "${OUTPUT}")

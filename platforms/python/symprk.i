@@ -9,6 +9,7 @@
 namespace std {
   %template(vectori) vector<int>;
   %template(vectord) vector<double>;
+  %template(vectorstring) vector<string>;
 };
 
 %{
@@ -47,7 +48,7 @@ static void symprk_set_python_error(const char* what) {
 }
 
 /* step() releases the GIL (a PythonForce re-acquires it for its callback). */
-%exception OpenMM::SymPRKIntegrator::step {
+%exception SymPRKPlugin::SymPRKIntegrator::step {
     std::string symprk_error;
     bool symprk_failed = false;
     Py_BEGIN_ALLOW_THREADS
@@ -65,9 +66,9 @@ static void symprk_set_python_error(const char* what) {
     }
 }
 
-namespace OpenMM {
+namespace SymPRKPlugin {
 
-class SymPRKIntegrator : public Integrator {
+class SymPRKIntegrator : public OpenMM::Integrator {
 public:
     /* the same names and numbers as openmm_symprk.methods.resolved.SubstepKind and SubstepFlag */
     enum SubstepKind {
@@ -116,16 +117,20 @@ public:
     static std::vector<double> computeRescalingFactor(double kinetic, double target, int dof, double c, double r1, double chi2);
     static void registerMissingKernelFactories();
     void step(int steps);
+    /* for tests: the step plan of the bound Context and what the kernel executed of it */
+    std::vector<std::string> getStepPlan() const;
+    void setExecutionTraceEnabled(bool record);
+    std::vector<int> getExecutionTrace() const;
     %extend {
         /** The same integrator seen as a SymPRKIntegrator (e.g. after XmlSerializer.deserialize). */
-        static OpenMM::SymPRKIntegrator& cast(OpenMM::Integrator& integrator) {
-            OpenMM::SymPRKIntegrator* p = dynamic_cast<OpenMM::SymPRKIntegrator*>(&integrator);
+        static SymPRKPlugin::SymPRKIntegrator& cast(OpenMM::Integrator& integrator) {
+            SymPRKPlugin::SymPRKIntegrator* p = dynamic_cast<SymPRKPlugin::SymPRKIntegrator*>(&integrator);
             if (p == NULL)
                 throw OpenMM::OpenMMException("the integrator is not a SymPRKIntegrator");
             return *p;
         }
         static bool isinstance(OpenMM::Integrator& integrator) {
-            return dynamic_cast<OpenMM::SymPRKIntegrator*>(&integrator) != NULL;
+            return dynamic_cast<SymPRKPlugin::SymPRKIntegrator*>(&integrator) != NULL;
         }
     }
 };

@@ -23,7 +23,8 @@ from openmm_symprk import plugin
 REPO = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
 SETUP = os.path.join(REPO, "setup.py")
 SOURCE_CHECKOUT = os.path.exists(os.path.join(REPO, "platforms", "CMakeLists.txt")) and os.path.exists(SETUP)
-CPP_TESTS = ["TestSerializeSymPRKIntegrator", "TestReferenceSymPRKStep", "TestReferenceSymPRKThermostat"]
+CPP_TESTS = ["TestSerializeSymPRKIntegrator", "TestReferenceSymPRKStep", "TestReferenceSymPRKThermostat",
+             "TestReferenceSymPRKStepPlan"]
 
 
 def _setup_module():

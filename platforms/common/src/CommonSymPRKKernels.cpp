@@ -1,4 +1,5 @@
-/* openmm_symprk native plugin: the Common compute framework SymPRKIntegrator kernel. */
+/* openmm_symprk native plugin: the Common compute framework SymPRKIntegrator kernel.  It runs the operations of
+ * the step plan (SymPRKStepPlan) in order, one or a few device kernels per operation. */
 
 #include "CommonSymPRKKernels.h"
 #include "openmm/common/ContextSelector.h"
@@ -7,24 +8,24 @@
 #include "openmm/internal/ContextImpl.h"
 #include <algorithm>
 #include <climits>
-#include <cmath>
+#include <initializer_list>
 #include <map>
 #include <memory>
-#include <set>
 #include <vector>
 
+using namespace SymPRKPlugin;
 using namespace OpenMM;
 using namespace std;
 
-void CommonIntegrateSymPRKStepKernel::initialize(const System& system, const SymPRKIntegrator& integrator) {
+void CommonIntegrateSymPRKStepKernel::initialize(const System& system, const SymPRKIntegrator& integrator, const SymPRKStepPlan& plan) {
     cc.initializeContexts();
     ContextSelector selector(cc);
-    hasConstraints = (system.getNumConstraints() > 0);
+    hasConstraints = plan.hasConstraints();
     projectionBlockSize = 1;
     while (projectionBlockSize*2 <= min(128, cc.getMaxThreadBlockSize()))
         projectionBlockSize *= 2;
     // The thermostat's reduction leaves its 17 sums in the first 17 threads' slots (kernels/symprk.cc).
-    if (integrator.hasThermostat() && projectionBlockSize < 32)
+    if (plan.hasThermostatEvents() && projectionBlockSize < 32)
         throw OpenMMException("SymPRKIntegrator: the thermostat's device reduction needs work groups of at least 32 "
                               "threads; this device allows " + cc.intToString(cc.getMaxThreadBlockSize()) +
                               ". Use the Reference or CPU platform, or backend='custom'.");
@@ -49,35 +50,86 @@ void CommonIntegrateSymPRKStepKernel::initialize(const System& system, const Sym
     projectionKernel = program->createKernel("symprkProjection");
     rigidSumsKernel = program->createKernel("symprkRigidSums");
     rigidApplyKernel = program->createKernel("symprkRigidApply");
-    bool useDouble = (cc.getUseDoublePrecision() || cc.getUseMixedPrecision());
-    projection.initialize(cc, 9, useDouble ? sizeof(double) : sizeof(float), "symprkProjection");
-    rigid.initialize(cc, 9, useDouble ? sizeof(double) : sizeof(float), "symprkRigid");
-    vBefore.initialize(cc, cc.getPaddedNumAtoms(), useDouble ? 4*sizeof(double) : 4*sizeof(float), "symprkVelocitiesBefore");
+    const int mixedSize = (doubleVelocities ? sizeof(double) : sizeof(float));
+    projection.initialize(cc, 9, mixedSize, "symprkProjection");
+    rigid.initialize(cc, 9, mixedSize, "symprkRigid");
+    vBefore.initialize(cc, cc.getPaddedNumAtoms(), 4*mixedSize, "symprkVelocitiesBefore");
     badStep.initialize<int>(cc, 1, "symprkBadStep");
-    if (integrator.hasThermostat()) {
+    if (plan.hasThermostatEvents()) {
         thermostatSumsKernel = program->createKernel("symprkThermostatSums");
         thermostatApplyKernel = program->createKernel("symprkThermostatApply");
         // the sums' type: double where the device has it (symprk_acc in the device source)
         thermostatSums.initialize(cc, SymPRKThermostat::NumSums, cc.getSupportsDoublePrecision() ? sizeof(double) : sizeof(float),
                                   "symprkThermostatSums");
     }
-    set<int> kickGroups;
-    for (int s = 0; s < integrator.getNumSubsteps(); s++)
-        if (integrator.getSubstepKind(s) == SymPRKIntegrator::Kick)
-            kickGroups.insert(integrator.getSubstepForceGroups(s) == -1 ? integrator.getIntegrationForceGroups()
-                                                                        : integrator.getSubstepForceGroups(s));
-    multipleGroups = (kickGroups.size() > 1);
-    if (multipleGroups)
-        for (int mask : kickGroups) {
-            groupForces[mask].reset(new ComputeArray());
-            groupForces[mask]->initialize(cc, cc.getLongForceBuffer().getSize(), cc.getLongForceBuffer().getElementSize(),
-                                          "symprkGroupForces");
-            groupForcesValid[mask] = false;
-        }
+    groupForces.clear();
+    groupForcesValid.clear();
     int zero = 0;
     badStep.upload(&zero);
     if (blowUpStep != 0)
         setBlowUpStep(*cc.getContextImpl(), blowUpStep);
+}
+
+void CommonIntegrateSymPRKStepKernel::addPositionArgs(ComputeKernel& kernel) {
+    kernel->addArg(cc.getPosq());
+    if (cc.getUseMixedPrecision())
+        kernel->addArg(cc.getPosqCorrection());
+    else
+        kernel->addArg(nullptr);
+}
+
+void CommonIntegrateSymPRKStepKernel::addArrayArgs(ComputeKernel& kernel, initializer_list<ArrayInterface*> arrays) {
+    for (ArrayInterface* array : arrays)
+        kernel->addArg(*array);
+}
+
+void CommonIntegrateSymPRKStepKernel::setKernelArguments(const SymPRKIntegrator& integrator, const SymPRKStepPlan& plan) {
+    // Arguments set per operation (left empty here): the coefficient c*dt (index 0), the check step, the forces.
+    IntegrationUtilities& integration = cc.getIntegrationUtilities();
+    ArrayInterface* velm = &cc.getVelm();
+    ArrayInterface* posDelta = &integration.getPosDelta();
+    kickKernel->addArg();
+    addArrayArgs(kickKernel, {velm, &cc.getLongForceBuffer()});
+    kickKernel->addArg(0);
+    kickKernel->addArg(badStep);
+    kickProjectedKernel->addArg();
+    addArrayArgs(kickProjectedKernel, {velm, &cc.getLongForceBuffer()});
+    addPositionArgs(kickProjectedKernel);
+    kickProjectedKernel->addArg(projection);
+    kickProjectedKernel->addArg(0);
+    kickProjectedKernel->addArg(badStep);
+    driftKernel->addArg();
+    addPositionArgs(driftKernel);
+    driftKernel->addArg(*velm);
+    driftDeltaKernel->addArg();
+    addArrayArgs(driftDeltaKernel, {velm, posDelta});
+    driftApplyKernel->addArg();
+    addPositionArgs(driftApplyKernel);
+    addArrayArgs(driftApplyKernel, {velm, posDelta});
+    driftApplyKernel->addArg(0);
+    driftApplyKernel->addArg(badStep);
+    driftApplyKernel->addArg(0);
+    driftApplyKernel->addArg(rigid);
+    rigidSumsKernel->addArg();
+    rigidSumsKernel->addArg();
+    addPositionArgs(rigidSumsKernel);
+    addArrayArgs(rigidSumsKernel, {velm, posDelta, &vBefore, &rigid});
+    addPositionArgs(rigidApplyKernel);
+    addArrayArgs(rigidApplyKernel, {velm, &rigid});
+    addPositionArgs(projectionKernel);
+    addArrayArgs(projectionKernel, {velm, &cc.getLongForceBuffer(), &projection});
+    if (plan.hasThermostatEvents()) {
+        const int withPositions = integrator.getThermostatKeepsRotation() ? 1 : 0;
+        addPositionArgs(thermostatSumsKernel);
+        thermostatSumsKernel->addArg(*velm);
+        thermostatSumsKernel->addArg(withPositions);
+        thermostatSumsKernel->addArg(thermostatSums);
+        addPositionArgs(thermostatApplyKernel);
+        thermostatApplyKernel->addArg(*velm);
+        thermostatApplyKernel->addArg(withPositions);
+        for (int i = 0; i < 10; i++)
+            thermostatApplyKernel->addArg();  // alpha, V, R, w: set per event
+    }
 }
 
 void CommonIntegrateSymPRKStepKernel::setMixedArg(ComputeKernel& kernel, int index, double value) {
@@ -87,111 +139,17 @@ void CommonIntegrateSymPRKStepKernel::setMixedArg(ComputeKernel& kernel, int ind
         kernel->setArg(index, (float) value);
 }
 
-void CommonIntegrateSymPRKStepKernel::execute(ContextImpl& context, const SymPRKIntegrator& integrator, bool& forcesAreValid, long long stepIndex) {
+void CommonIntegrateSymPRKStepKernel::execute(ContextImpl& context, const SymPRKIntegrator& integrator, const SymPRKStepPlan& plan,
+        bool& forcesAreValid, long long stepIndex) {
     ContextSelector selector(cc);
-    IntegrationUtilities& integration = cc.getIntegrationUtilities();
-    const int numAtoms = cc.getNumAtoms();
-    const bool mixed = cc.getUseMixedPrecision();
     if (!hasInitializedKernels) {
         hasInitializedKernels = true;
-        // Arguments set per sub-step: the coefficient (index 0) and the check step.
-        kickKernel->addArg();
-        kickKernel->addArg(cc.getVelm());
-        kickKernel->addArg(cc.getLongForceBuffer());
-        kickKernel->addArg(0);
-        kickKernel->addArg(badStep);
-        kickProjectedKernel->addArg();
-        kickProjectedKernel->addArg(cc.getVelm());
-        kickProjectedKernel->addArg(cc.getLongForceBuffer());
-        kickProjectedKernel->addArg(cc.getPosq());
-        if (mixed)
-            kickProjectedKernel->addArg(cc.getPosqCorrection());
-        else
-            kickProjectedKernel->addArg(nullptr);
-        kickProjectedKernel->addArg(projection);
-        kickProjectedKernel->addArg(0);
-        kickProjectedKernel->addArg(badStep);
-        driftKernel->addArg();
-        driftKernel->addArg(cc.getPosq());
-        if (mixed)
-            driftKernel->addArg(cc.getPosqCorrection());
-        else
-            driftKernel->addArg(nullptr);
-        driftKernel->addArg(cc.getVelm());
-        driftDeltaKernel->addArg();
-        driftDeltaKernel->addArg(cc.getVelm());
-        driftDeltaKernel->addArg(integration.getPosDelta());
-        driftApplyKernel->addArg();
-        driftApplyKernel->addArg(cc.getPosq());
-        if (mixed)
-            driftApplyKernel->addArg(cc.getPosqCorrection());
-        else
-            driftApplyKernel->addArg(nullptr);
-        driftApplyKernel->addArg(cc.getVelm());
-        driftApplyKernel->addArg(integration.getPosDelta());
-        driftApplyKernel->addArg(0);
-        driftApplyKernel->addArg(badStep);
-        driftApplyKernel->addArg(0);
-        driftApplyKernel->addArg(rigid);
-        rigidSumsKernel->addArg();
-        rigidSumsKernel->addArg();
-        rigidSumsKernel->addArg(cc.getPosq());
-        if (mixed)
-            rigidSumsKernel->addArg(cc.getPosqCorrection());
-        else
-            rigidSumsKernel->addArg(nullptr);
-        rigidSumsKernel->addArg(cc.getVelm());
-        rigidSumsKernel->addArg(integration.getPosDelta());
-        rigidSumsKernel->addArg(vBefore);
-        rigidSumsKernel->addArg(rigid);
-        rigidApplyKernel->addArg(cc.getPosq());
-        if (mixed)
-            rigidApplyKernel->addArg(cc.getPosqCorrection());
-        else
-            rigidApplyKernel->addArg(nullptr);
-        rigidApplyKernel->addArg(cc.getVelm());
-        rigidApplyKernel->addArg(rigid);
-        projectionKernel->addArg(cc.getPosq());
-        if (mixed)
-            projectionKernel->addArg(cc.getPosqCorrection());
-        else
-            projectionKernel->addArg(nullptr);
-        projectionKernel->addArg(cc.getVelm());
-        projectionKernel->addArg(cc.getLongForceBuffer());
-        projectionKernel->addArg(projection);
-        if (integrator.hasThermostat()) {
-            const int withPositions = integrator.getThermostatKeepsRotation() ? 1 : 0;
-            thermostatSumsKernel->addArg(cc.getPosq());
-            if (mixed)
-                thermostatSumsKernel->addArg(cc.getPosqCorrection());
-            else
-                thermostatSumsKernel->addArg(nullptr);
-            thermostatSumsKernel->addArg(cc.getVelm());
-            thermostatSumsKernel->addArg(withPositions);
-            thermostatSumsKernel->addArg(thermostatSums);
-            thermostatApplyKernel->addArg(cc.getPosq());
-            if (mixed)
-                thermostatApplyKernel->addArg(cc.getPosqCorrection());
-            else
-                thermostatApplyKernel->addArg(nullptr);
-            thermostatApplyKernel->addArg(cc.getVelm());
-            thermostatApplyKernel->addArg(withPositions);
-            for (int i = 0; i < 10; i++)
-                thermostatApplyKernel->addArg();  // alpha, V, R, w: set per event
-        }
+        setKernelArguments(integrator, plan);
     }
     const double dt = integrator.getStepSize();
     const double tol = integrator.getConstraintTolerance();
-    const int groups = integrator.getIntegrationForceGroups();
     const bool exact = integrator.getExactMomentum();
-    const int numSubsteps = integrator.getNumSubsteps();
-    integration.setNextStepSize(dt);
-
-    // The velocities are checked for a blow-up in the last sub-step that changes them.
-    int lastVelocityStep = -1;
-    for (int s = 0; s < numSubsteps; s++)
-        if (integrator.getSubstepKind(s) == SymPRKIntegrator::Kick || hasConstraints)
-            lastVelocityStep = s;
+    cc.getIntegrationUtilities().setNextStepSize(dt);
     const int check = (int) min(stepIndex, (long long) INT_MAX);
 
     if (context.updateContextState())
@@ -199,88 +157,106 @@ void CommonIntegrateSymPRKStepKernel::execute(ContextImpl& context, const SymPRK
     if (!forcesAreValid)
         for (auto& entry : groupForcesValid)
             entry.second = false;  // cached forces of a multiple-time-step method belong to old positions
-    // Thermostat: a half event before the first step of every interval (after the Context's state updates, a
-    // barostat's move included), and one after its last step (below).
-    if (thermostatBefore(integrator, stepIndex))
-        thermostatEvent(integrator);
-    for (int s = 0; s < numSubsteps; s++) {
-        const double cdt = integrator.getSubstepCoefficient(s)*dt;
-        const int checkStep = (s == lastVelocityStep && blowUpStep == 0 ? check : 0);
-        if (integrator.getSubstepKind(s) == SymPRKIntegrator::Kick) {
-            // The forces of this kick's groups: computed unless cached since the last drift (a multiple-time-step
-            // method keeps a copy per group, so that a group is evaluated only where a drift came between two of
-            // its kicks).
-            const int mask = (integrator.getSubstepForceGroups(s) == -1 ? groups : integrator.getSubstepForceGroups(s));
-            const bool reuse = (integrator.getSubstepFlags(s) & SymPRKIntegrator::ForcesCached) != 0;
-            ArrayInterface* kickForces = &cc.getLongForceBuffer();
-            if (reuse && multipleGroups && groupForcesValid[mask])
-                kickForces = groupForces[mask].get();
-            else {
-                if (!reuse || !forcesAreValid || context.getLastForceGroups() != mask) {
-                    ContextDeselector deselector(cc);
-                    context.calcForcesAndEnergy(true, false, mask);
-                    forcesAreValid = true;
-                }
-                if (multipleGroups) {
-                    cc.getLongForceBuffer().copyTo(*groupForces[mask]);
-                    groupForcesValid[mask] = true;
-                    kickForces = groupForces[mask].get();
-                }
-            }
-            kickKernel->setArg(2, *kickForces);
-            kickProjectedKernel->setArg(2, *kickForces);
-            projectionKernel->setArg(3, *kickForces);
-            if (exact) {
-                projectionKernel->execute(projectionBlockSize, projectionBlockSize);
-                setMixedArg(kickProjectedKernel, 0, cdt);
-                kickProjectedKernel->setArg(6, checkStep);
-                kickProjectedKernel->execute(numAtoms);
-            }
-            else {
-                setMixedArg(kickKernel, 0, cdt);
-                kickKernel->setArg(3, checkStep);
-                kickKernel->execute(numAtoms);
-            }
-        }
-        else {
-            // a projection before a drift flagged for one (openmm_symprk.methods.resolved states the rule)
-            if (hasConstraints && (integrator.getSubstepFlags(s) & SymPRKIntegrator::ProjectVelocitiesBefore) != 0)
-                projectVelocities(tol, exact);
-            if (hasConstraints) {
-                setMixedArg(driftDeltaKernel, 0, cdt);
-                driftDeltaKernel->execute(numAtoms);
-                integration.applyConstraints(tol);
-                if (exact) {
-                    // Exact momentum: cancel the round-off net momentum and torque of the constraint impulses
-                    // (about the pre-drift positions) with a rigid-body velocity at the new positions.
-                    rigidSumsKernel->setArg(0, 0);
-                    setMixedArg(rigidSumsKernel, 1, cdt);
-                    rigidSumsKernel->execute(projectionBlockSize, projectionBlockSize);
-                }
-                setMixedArg(driftApplyKernel, 0, cdt);
-                driftApplyKernel->setArg(5, checkStep);
-                driftApplyKernel->setArg(7, exact ? 1 : 0);
-                driftApplyKernel->execute(numAtoms);
-            }
-            else {
-                setMixedArg(driftKernel, 0, cdt);
-                driftKernel->execute(numAtoms);
-            }
-            integration.computeVirtualSites();
+    const vector<SymPRKStepPlan::Operation>& ops = plan.getOperations();
+    for (int k = 0; k < (int) ops.size(); k++) {
+        const SymPRKStepPlan::Operation& op = ops[k];
+        // the velocities are checked for a blow-up by the kernel of the operation the plan names
+        const int checkStep = (op.checkVelocities && blowUpStep == 0 ? check : 0);
+        int evaluated = 0;
+        switch (op.kind) {
+        case SymPRKStepPlan::ThermostatEvent:
+            if (!op.runsInStep(stepIndex))
+                continue;
+            thermostatEvent(integrator, op.decay(dt));
+            break;
+        case SymPRKStepPlan::Kick:
+            kick(kickForces(context, op, forcesAreValid, evaluated), op.coefficient*dt, exact, checkStep);
+            break;
+        case SymPRKStepPlan::Drift:
+            drift(op.coefficient*dt, tol, exact, checkStep);
             forcesAreValid = false;
             for (auto& entry : groupForcesValid)
                 entry.second = false;
+            break;
+        case SymPRKStepPlan::ProjectVelocities:
+            projectVelocities(tol, exact);
+            break;
         }
+        trace.record(stepIndex, k, evaluated);
     }
-    if (hasConstraints)
-        projectVelocities(tol, exact);
-    if (thermostatAfter(integrator, stepIndex))
-        thermostatEvent(integrator);
     cc.setTime(cc.getTime()+dt);
     cc.setStepCount(cc.getStepCount()+1);
     cc.reorderAtoms();
     if (cc.getAtomsWereReordered())
         forcesAreValid = false;
+}
+
+ArrayInterface& CommonIntegrateSymPRKStepKernel::kickForces(ContextImpl& context, const SymPRKStepPlan::Operation& op,
+        bool& forcesAreValid, int& evaluated) {
+    // The forces of this kick's groups: computed unless the plan lets it reuse cached forces and they are still
+    // valid (a multiple-time-step method keeps a copy per group, so that a group is evaluated only where a drift
+    // came between two of its kicks).
+    evaluated = 0;
+    if (op.reuseForces && op.keepGroupCopy && groupForcesValid[op.forceGroups])
+        return *groupForces[op.forceGroups];
+    if (mustEvaluateForces(op, forcesAreValid, context)) {
+        ContextDeselector deselector(cc);
+        context.calcForcesAndEnergy(true, false, op.forceGroups);
+        forcesAreValid = true;
+        evaluated = op.forceGroups;
+    }
+    if (!op.keepGroupCopy)
+        return cc.getLongForceBuffer();
+    unique_ptr<ComputeArray>& copy = groupForces[op.forceGroups];
+    if (!copy) {
+        copy.reset(new ComputeArray());
+        copy->initialize(cc, cc.getLongForceBuffer().getSize(), cc.getLongForceBuffer().getElementSize(), "symprkGroupForces");
+    }
+    cc.getLongForceBuffer().copyTo(*copy);
+    groupForcesValid[op.forceGroups] = true;
+    return *copy;
+}
+
+void CommonIntegrateSymPRKStepKernel::kick(ArrayInterface& forces, double cdt, bool exact, int checkStep) {
+    kickKernel->setArg(2, forces);
+    kickProjectedKernel->setArg(2, forces);
+    projectionKernel->setArg(3, forces);
+    if (exact) {
+        projectionKernel->execute(projectionBlockSize, projectionBlockSize);
+        setMixedArg(kickProjectedKernel, 0, cdt);
+        kickProjectedKernel->setArg(6, checkStep);
+        kickProjectedKernel->execute(cc.getNumAtoms());
+    }
+    else {
+        setMixedArg(kickKernel, 0, cdt);
+        kickKernel->setArg(3, checkStep);
+        kickKernel->execute(cc.getNumAtoms());
+    }
+}
+
+void CommonIntegrateSymPRKStepKernel::drift(double cdt, double tol, bool exact, int checkStep) {
+    IntegrationUtilities& integration = cc.getIntegrationUtilities();
+    if (hasConstraints) {
+        setMixedArg(driftDeltaKernel, 0, cdt);
+        driftDeltaKernel->execute(cc.getNumAtoms());
+        integration.applyConstraints(tol);
+        if (exact) {
+            // Exact momentum: cancel the round-off net momentum and torque of the constraint impulses
+            // (about the pre-drift positions) with a rigid-body velocity at the new positions.
+            rigidSumsKernel->setArg(0, 0);
+            setMixedArg(rigidSumsKernel, 1, cdt);
+            rigidSumsKernel->execute(projectionBlockSize, projectionBlockSize);
+        }
+        setMixedArg(driftApplyKernel, 0, cdt);
+        driftApplyKernel->setArg(5, checkStep);
+        driftApplyKernel->setArg(7, exact ? 1 : 0);
+        driftApplyKernel->execute(cc.getNumAtoms());
+    }
+    else {
+        setMixedArg(driftKernel, 0, cdt);
+        driftKernel->execute(cc.getNumAtoms());
+    }
+    integration.computeVirtualSites();
 }
 
 void CommonIntegrateSymPRKStepKernel::projectVelocities(double tol, bool exact) {
@@ -298,7 +274,7 @@ void CommonIntegrateSymPRKStepKernel::projectVelocities(double tol, bool exact) 
     rigidApplyKernel->execute(cc.getNumAtoms());
 }
 
-void CommonIntegrateSymPRKStepKernel::thermostatEvent(const SymPRKIntegrator& integrator) {
+void CommonIntegrateSymPRKStepKernel::thermostatEvent(const SymPRKIntegrator& integrator, double decay) {
     // One reduction on the device, one download of its sums, the factor and the kept field on the host
     // (SymPRKThermostat), one kernel applying them.
     thermostatSumsKernel->execute(projectionBlockSize, projectionBlockSize);
@@ -311,7 +287,8 @@ void CommonIntegrateSymPRKStepKernel::thermostatEvent(const SymPRKIntegrator& in
         for (int i = 0; i < SymPRKThermostat::NumSums; i++)
             sums[i] = single[i];
     }
-    const SymPRKThermostat::Event e = thermostat.event(sums.data(), integrator, thermostatDecay(integrator));
+    const SymPRKThermostat::Event e = thermostat.event(sums.data(), integrator.getThermostatTemperature(), integrator.getThermostatDof(),
+                                                       integrator.getThermostatKeepsRotation(), decay);
     if (!e.apply)
         return;
     const double values[10] = {e.alpha, e.velocity[0], e.velocity[1], e.velocity[2], e.centre[0], e.centre[1], e.centre[2],

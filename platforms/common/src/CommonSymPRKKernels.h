@@ -7,9 +7,10 @@
 #include "openmm/common/ComputeKernel.h"
 #include <map>
 #include <memory>
+#include <initializer_list>
 #include <string>
 
-namespace OpenMM {
+namespace SymPRKPlugin {
 
 /** Kernel source (platforms/common/src/kernels/symprk.cc, embedded at build time). */
 class CommonSymPRKKernelSources {
@@ -25,29 +26,39 @@ public:
  */
 class CommonIntegrateSymPRKStepKernel : public IntegrateSymPRKStepKernel {
 public:
-    CommonIntegrateSymPRKStepKernel(std::string name, const Platform& platform, ComputeContext& cc) :
-            IntegrateSymPRKStepKernel(name, platform), cc(cc), hasInitializedKernels(false), multipleGroups(false), blowUpStep(0) {
+    CommonIntegrateSymPRKStepKernel(std::string name, const OpenMM::Platform& platform, OpenMM::ComputeContext& cc) :
+            IntegrateSymPRKStepKernel(name, platform), cc(cc), hasInitializedKernels(false), blowUpStep(0) {
     }
-    void initialize(const System& system, const SymPRKIntegrator& integrator);
-    void execute(ContextImpl& context, const SymPRKIntegrator& integrator, bool& forcesAreValid, long long stepIndex);
-    double computeKineticEnergy(ContextImpl& context, const SymPRKIntegrator& integrator);
-    long long getBlowUpStep(ContextImpl& context);
-    void setBlowUpStep(ContextImpl& context, long long step);
+    void initialize(const OpenMM::System& system, const SymPRKIntegrator& integrator, const SymPRKStepPlan& plan);
+    void execute(OpenMM::ContextImpl& context, const SymPRKIntegrator& integrator, const SymPRKStepPlan& plan,
+                 bool& forcesAreValid, long long stepIndex);
+    double computeKineticEnergy(OpenMM::ContextImpl& context, const SymPRKIntegrator& integrator);
+    long long getBlowUpStep(OpenMM::ContextImpl& context);
+    void setBlowUpStep(OpenMM::ContextImpl& context, long long step);
 private:
-    void setMixedArg(ComputeKernel& kernel, int index, double value);
+    void setKernelArguments(const SymPRKIntegrator& integrator, const SymPRKStepPlan& plan);
+    void addArrayArgs(OpenMM::ComputeKernel& kernel, std::initializer_list<OpenMM::ArrayInterface*> arrays);
+    /** Add the arguments posq and posqCorrection (null unless in mixed precision) to kernel. */
+    void addPositionArgs(OpenMM::ComputeKernel& kernel);
+    void setMixedArg(OpenMM::ComputeKernel& kernel, int index, double value);
+    OpenMM::ArrayInterface& kickForces(OpenMM::ContextImpl& context, const SymPRKStepPlan::Operation& kick, bool& forcesAreValid,
+                                       int& evaluated);
+    void kick(OpenMM::ArrayInterface& forces, double cdt, bool exact, int checkStep);
+    void drift(double cdt, double tol, bool exact, int checkStep);
     void projectVelocities(double tol, bool exact);
-    void thermostatEvent(const SymPRKIntegrator& integrator);
-    ComputeContext& cc;
-    bool hasInitializedKernels, hasConstraints, multipleGroups;
-    std::map<int, std::unique_ptr<ComputeArray> > groupForces;  // multiple time stepping: forces per group mask
+    void thermostatEvent(const SymPRKIntegrator& integrator, double decay);
+    OpenMM::ComputeContext& cc;
+    bool hasInitializedKernels, hasConstraints;
+    std::map<int, std::unique_ptr<OpenMM::ComputeArray> > groupForces;  // multiple time stepping: forces per group mask
     std::map<int, bool> groupForcesValid;
     int projectionBlockSize;
     long long blowUpStep;
-    ComputeArray projection, badStep, rigid, vBefore, thermostatSums;
-    ComputeKernel thermostatSumsKernel, thermostatApplyKernel;
-    ComputeKernel kickKernel, kickProjectedKernel, driftKernel, driftDeltaKernel, driftApplyKernel, projectionKernel, rigidSumsKernel, rigidApplyKernel;
+    OpenMM::ComputeArray projection, badStep, rigid, vBefore, thermostatSums;
+    OpenMM::ComputeKernel thermostatSumsKernel, thermostatApplyKernel;
+    OpenMM::ComputeKernel kickKernel, kickProjectedKernel, driftKernel, driftDeltaKernel, driftApplyKernel, projectionKernel,
+            rigidSumsKernel, rigidApplyKernel;
 };
 
-} // namespace OpenMM
+} // namespace SymPRKPlugin
 
 #endif /*COMMON_SYMPRK_KERNELS_H_*/

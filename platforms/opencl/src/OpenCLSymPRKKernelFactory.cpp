@@ -7,38 +7,13 @@
 #undef cl_khr_command_buffer
 #undef cl_khr_command_buffer_mutable_dispatch
 
-#include "CommonSymPRKKernels.h"
+#include "CommonSymPRKKernelFactory.h"
 #include "openmm/opencl/OpenCLContext.h"
 #include "openmm/opencl/OpenCLPlatform.h"
-#include "openmm/KernelFactory.h"
-#include "openmm/OpenMMException.h"
-#include "openmm/internal/ContextImpl.h"
-
-using namespace OpenMM;
-
-namespace {
-
-class OpenCLSymPRKKernelFactory : public KernelFactory {
-public:
-    KernelImpl* createKernelImpl(std::string name, const Platform& platform, ContextImpl& context) const {
-        OpenCLContext& cl = *static_cast<OpenCLPlatform::PlatformData*>(context.getPlatformData())->contexts[0];
-        if (name == IntegrateSymPRKStepKernel::Name())
-            return new CommonIntegrateSymPRKStepKernel(name, platform, cl);
-        throw OpenMMException("SymPRK OpenCL plugin: unknown kernel '"+name+"'");
-    }
-};
-
-}
 
 extern "C" void registerPlatforms() {
 }
 
 extern "C" void registerKernelFactories() {
-    try {
-        Platform& platform = Platform::getPlatformByName("OpenCL");
-        platform.registerKernelFactory(IntegrateSymPRKStepKernel::Name(), new OpenCLSymPRKKernelFactory());
-    }
-    catch (...) {
-        // No OpenCL platform in this process: nothing to register.
-    }
+    SymPRKPlugin::CommonSymPRKKernelFactory<OpenMM::OpenCLPlatform::PlatformData>::registerWith("OpenCL");
 }

@@ -15,6 +15,7 @@
 #include <sstream>
 #include <string>
 
+using namespace SymPRKPlugin;
 using namespace OpenMM;
 using namespace std;
 
@@ -28,7 +29,7 @@ SymPRKIntegrator::SymPRKIntegrator(double stepSize) : exactMomentum(false), forc
         methodName("verlet"), stepsTaken(0), blowUpStep(0), maxSpeed(0.0), expectedParticles(-1),
         expectedConstraints(false),
         thermostat(false), keepRotation(false), thermostatTemperature(0.0), collisionTime(0.0), thermostatInterval(1),
-        thermostatDof(0), randomSeed(0) {
+        thermostatDof(0), randomSeed(0), traceEnabled(false) {
     setStepSize(stepSize);
     setConstraintTolerance(1e-5);
     setSubsteps({Kick, Drift, Kick}, {0.5, 1.0, 0.5}, {-1, -1, -1}, {ForcesCached, 0, 0});
@@ -39,7 +40,7 @@ SymPRKIntegrator::SymPRKIntegrator(double stepSize, const vector<int>& kinds, co
         exactMomentum(false), forcesAreValid(false), methodName(""), stepsTaken(0), blowUpStep(0), maxSpeed(0.0),
         expectedParticles(-1), expectedConstraints(false),
         thermostat(false), keepRotation(false), thermostatTemperature(0.0), collisionTime(0.0), thermostatInterval(1),
-        thermostatDof(0), randomSeed(0) {
+        thermostatDof(0), randomSeed(0), traceEnabled(false) {
     setStepSize(stepSize);
     setConstraintTolerance(1e-5);
     setSubsteps(kinds, coefficients, groups, flags);
@@ -82,28 +83,30 @@ void SymPRKIntegrator::setSubsteps(const vector<int>& newKinds, const vector<dou
     flags = newFlags;
 }
 
+int SymPRKIntegrator::substep(int index) const {
+    if (index < 0 || index >= (int) kinds.size()) {
+        stringstream msg;
+        msg << "SymPRKIntegrator: sub-step index " << index << " is out of range (the sequence has " << kinds.size()
+            << " sub-steps: 0 to " << kinds.size()-1 << ")";
+        throw OpenMMException(msg.str());
+    }
+    return index;
+}
+
 int SymPRKIntegrator::getSubstepForceGroups(int index) const {
-    if (index < 0 || index >= (int) kinds.size())
-        throw OpenMMException("SymPRKIntegrator: sub-step index out of range");
-    return groups[index];
+    return groups[substep(index)];
 }
 
 int SymPRKIntegrator::getSubstepKind(int index) const {
-    if (index < 0 || index >= (int) kinds.size())
-        throw OpenMMException("SymPRKIntegrator: sub-step index out of range");
-    return kinds[index];
+    return kinds[substep(index)];
 }
 
 double SymPRKIntegrator::getSubstepCoefficient(int index) const {
-    if (index < 0 || index >= (int) kinds.size())
-        throw OpenMMException("SymPRKIntegrator: sub-step index out of range");
-    return coefficients[index];
+    return coefficients[substep(index)];
 }
 
 int SymPRKIntegrator::getSubstepFlags(int index) const {
-    if (index < 0 || index >= (int) kinds.size())
-        throw OpenMMException("SymPRKIntegrator: sub-step index out of range");
-    return flags[index];
+    return flags[substep(index)];
 }
 
 int SymPRKIntegrator::getForceEvaluationsPerStep() const {
@@ -281,13 +284,45 @@ void SymPRKIntegrator::initialize(ContextImpl& contextRef) {
             << " constraints: create the integrator with system= the System you simulate";
         throw OpenMMException(msg.str());
     }
+    plan = SymPRKStepPlan(*this, system.getNumConstraints() > 0);
     context = &contextRef;
     owner = &contextRef.getOwner();
     kernel = context->getPlatform().createKernel(IntegrateSymPRKStepKernel::Name(), contextRef);
-    kernel.getAs<IntegrateSymPRKStepKernel>().initialize(contextRef.getSystem(), *this);
-    kernel.getAs<IntegrateSymPRKStepKernel>().setBlowUpStep(contextRef, blowUpStep);
-    kernel.getAs<IntegrateSymPRKStepKernel>().getThermostat().initialize(randomSeed);
+    IntegrateSymPRKStepKernel& k = kernel.getAs<IntegrateSymPRKStepKernel>();
+    k.initialize(contextRef.getSystem(), *this, plan);
+    k.setBlowUpStep(contextRef, blowUpStep);
+    k.getThermostat().initialize(randomSeed);
+    k.getTrace().setEnabled(traceEnabled);
     forcesAreValid = false;
+}
+
+const SymPRKStepPlan& SymPRKIntegrator::currentPlan() {
+    // The only setting of the plan that may change while bound: Integrator::setIntegrationForceGroups.
+    if (plan.getIntegrationForceGroups() != getIntegrationForceGroups())
+        plan = SymPRKStepPlan(*this, plan.hasConstraints());
+    return plan;
+}
+
+vector<string> SymPRKIntegrator::getStepPlan() const {
+    if (context == NULL)
+        throw OpenMMException("SymPRKIntegrator::getStepPlan: the step plan is made when the integrator is bound to a Context; "
+                              "create the Context first");
+    vector<string> lines;
+    for (int i = 0; i < (int) plan.getOperations().size(); i++)
+        lines.push_back(plan.describe(i));
+    return lines;
+}
+
+void SymPRKIntegrator::setExecutionTraceEnabled(bool record) {
+    traceEnabled = record;
+    if (context != NULL)
+        kernel.getAs<IntegrateSymPRKStepKernel>().getTrace().setEnabled(record);
+}
+
+vector<int> SymPRKIntegrator::getExecutionTrace() const {
+    if (context == NULL)
+        return {};
+    return const_cast<Kernel&>(kernel).getAs<IntegrateSymPRKStepKernel>().getTrace().getEntries();
 }
 
 void SymPRKIntegrator::cleanup() {
@@ -315,9 +350,10 @@ void SymPRKIntegrator::step(int steps) {
     if (context == NULL)
         throw OpenMMException("This Integrator is not bound to a context!");
     IntegrateSymPRKStepKernel& k = kernel.getAs<IntegrateSymPRKStepKernel>();
+    const SymPRKStepPlan& stepPlan = currentPlan();
     for (int i = 0; i < steps; ++i) {
         stepsTaken++;
-        k.execute(*context, *this, forcesAreValid, stepsTaken);
+        k.execute(*context, *this, stepPlan, forcesAreValid, stepsTaken);
     }
 }
 

@@ -1,12 +1,13 @@
 /* openmm_symprk native plugin: the host side of a thermostat event (see SymPRKThermostat.h). */
 
 #include "openmm/internal/SymPRKThermostat.h"
-#include "openmm/SymPRKIntegrator.h"
+#include "openmm/internal/SymPRKInertia.h"
 #include "openmm/OpenMMException.h"
 #include "SimTKOpenMMRealType.h"
 #include <cmath>
 #include <sstream>
 
+using namespace SymPRKPlugin;
 using namespace OpenMM;
 using namespace std;
 
@@ -57,36 +58,11 @@ double SymPRKThermostat::rescalingFactor(double kinetic, double target, int dof,
     return alpha;
 }
 
-Vec3 SymPRKThermostat::solveInertia(Vec3 d, Vec3 o, Vec3 tau, bool regularise) {
-    double Ixx = d[1]+d[2], Iyy = d[0]+d[2], Izz = d[0]+d[1];
-    double Ixy = -o[0], Ixz = -o[1], Iyz = -o[2];
-    const double trace = Ixx+Iyy+Izz;
-    if (!regularise) {
-        // the exact inverse, unless the tensor is (nearly) singular: then the regularised one
-        double axx = Iyy*Izz-Iyz*Iyz, ayy = Ixx*Izz-Ixz*Ixz, azz = Ixx*Iyy-Ixy*Ixy;
-        double axy = Ixz*Iyz-Izz*Ixy, axz = Ixy*Iyz-Iyy*Ixz, ayz = Ixy*Ixz-Ixx*Iyz;
-        double det = Ixx*axx+Ixy*axy+Ixz*axz;
-        if (std::isfinite(det) && fabs(det) > 1e-9*trace*trace*trace)
-            return Vec3(axx*tau[0]+axy*tau[1]+axz*tau[2], axy*tau[0]+ayy*tau[1]+ayz*tau[2], axz*tau[0]+ayz*tau[1]+azz*tau[2])/det;
-    }
-    double shift = 1e-12*trace;
-    Ixx += shift;
-    Iyy += shift;
-    Izz += shift;
-    double axx = Iyy*Izz-Iyz*Iyz, ayy = Ixx*Izz-Ixz*Ixz, azz = Ixx*Iyy-Ixy*Ixy;
-    double axy = Ixz*Iyz-Izz*Ixy, axz = Ixy*Iyz-Iyy*Ixz, ayz = Ixy*Ixz-Ixx*Iyz;
-    double det = Ixx*axx+Ixy*axy+Ixz*axz;
-    if (det == 0.0 || !std::isfinite(det))
-        return Vec3();
-    return Vec3(axx*tau[0]+axy*tau[1]+axz*tau[2], axy*tau[0]+ayy*tau[1]+ayz*tau[2], axz*tau[0]+ayz*tau[1]+azz*tau[2])/det;
-}
-
-SymPRKThermostat::Event SymPRKThermostat::event(const double* sums, const SymPRKIntegrator& integrator, double c) {
+SymPRKThermostat::Event SymPRKThermostat::event(const double* sums, double temperature, int dof, bool keepRotation, double c) {
     Event e;
     e.apply = false;
     e.alpha = 1.0;
     e.kinetic = e.newKinetic = 0.0;
-    const int dof = integrator.getThermostatDof();
     // The noise is drawn first, whatever follows, so that the random stream advances by one event per event.
     normal_distribution<double> normal(0.0, 1.0);
     const double r1 = normal(rng);
@@ -101,7 +77,7 @@ SymPRKThermostat::Event SymPRKThermostat::event(const double* sums, const SymPRK
     const Vec3 P(sums[SumMomentum], sums[SumMomentum+1], sums[SumMomentum+2]);
     e.velocity = P/M;
     double kinetic = 0.5*sums[SumTwiceKinetic] - 0.5*P.dot(P)/M;
-    if (integrator.getThermostatKeepsRotation()) {
+    if (keepRotation) {
         const Vec3 R = Vec3(sums[SumMomentX], sums[SumMomentX+1], sums[SumMomentX+2])/M;
         const double* S = sums+SumSecond;
         // second moments and angular momentum about the centre of mass
@@ -112,7 +88,7 @@ SymPRKThermostat::Event SymPRKThermostat::event(const double* sums, const SymPRK
         e.omega = solveInertia(d, o, L, false);
         kinetic -= 0.5*L.dot(e.omega);
     }
-    const double target = 0.5*dof*BOLTZ*integrator.getThermostatTemperature();
+    const double target = 0.5*dof*BOLTZ*temperature;
     double newKinetic;
     const double alpha = rescalingFactor(kinetic, target, dof, c, r1, chi2, newKinetic);
     if (!(kinetic > 0) || !std::isfinite(kinetic) || !std::isfinite(alpha) || !std::isfinite(newKinetic))

@@ -7,6 +7,7 @@
 #include "openmm/OpenMMException.h"
 #include "openmm/internal/ContextImpl.h"
 
+using namespace SymPRKPlugin;
 using namespace OpenMM;
 
 namespace {

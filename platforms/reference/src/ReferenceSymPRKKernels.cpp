@@ -1,7 +1,8 @@
 /* openmm_symprk native plugin: the Reference (and CPU) SymPRKIntegrator kernel.
  *
- * Arithmetic follows the CustomIntegrator program of openmm_symprk/program.py operation by operation, so
- * that on Reference both give the same trajectory to round-off:
+ * It runs the operations of the step plan (SymPRKStepPlan) in order.  Arithmetic follows the CustomIntegrator
+ * program of openmm_symprk/integrators/program.py operation by operation, so that on Reference both give the
+ * same trajectory to round-off:
  *   kick   v = v + (c*dt)*f/m
  *   drift  x_ref = x;  x = x + (c*dt)*v;  [constraints] x_u = x;  constrain x against x_ref;
  *          v = v + (x - x_u)/(c*dt)
@@ -13,13 +14,14 @@
 #include "ReferenceVirtualSites.h"
 #include "openmm/OpenMMException.h"
 #include "openmm/internal/ContextImpl.h"
+#include "openmm/internal/SymPRKInertia.h"
 #include "openmm/internal/ThreadPool.h"
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <limits>
-#include <set>
 
+using namespace SymPRKPlugin;
 using namespace OpenMM;
 using namespace std;
 
@@ -32,7 +34,7 @@ static int threadThreshold() {
     return 8192;
 }
 
-void ReferenceIntegrateSymPRKStepKernel::initialize(const System& sys, const SymPRKIntegrator& integrator) {
+void ReferenceIntegrateSymPRKStepKernel::initialize(const System& sys, const SymPRKIntegrator& integrator, const SymPRKStepPlan& plan) {
     system = &sys;
     numParticles = sys.getNumParticles();
     masses.resize(numParticles);
@@ -44,12 +46,7 @@ void ReferenceIntegrateSymPRKStepKernel::initialize(const System& sys, const Sym
         if (sys.isVirtualSite(i))
             hasVirtualSites = true;
     }
-    hasConstraints = (sys.getNumConstraints() > 0);
-    set<int> kickGroups;
-    for (int s = 0; s < integrator.getNumSubsteps(); s++)
-        if (integrator.getSubstepKind(s) == SymPRKIntegrator::Kick)
-            kickGroups.insert(integrator.getSubstepForceGroups(s));
-    multipleGroups = (kickGroups.size() > 1);
+    hasConstraints = plan.hasConstraints();
     groupForces.clear();
     xRef.resize(numParticles);
     xUnconstrained.resize(numParticles);
@@ -74,11 +71,13 @@ void ReferenceIntegrateSymPRKStepKernel::parallelFor(const function<void(int, in
     data.threads.waitForThreads();
 }
 
-void ReferenceIntegrateSymPRKStepKernel::computeProjection(const vector<Vec3>& pos, const vector<Vec3>& force) {
-    // Sums in double, in a fixed order (per-chunk partial sums added in chunk order): deterministic.
+ReferenceIntegrateSymPRKStepKernel::Moments ReferenceIntegrateSymPRKStepKernel::computeMoments(const vector<Vec3>& pos,
+        const vector<Vec3>* vectors) {
+    // Sums in double, in a fixed order (per-chunk partial sums added in chunk order): deterministic.  Two passes:
+    // the mass, centre of mass (and the vectors' sum), then the second moments (and the vectors' moment) about it.
     int chunks = threadStart.size()-1;
     vector<double> mass(chunks, 0.0);
-    vector<Vec3> mx(chunks), fsum(chunks);
+    vector<Vec3> mx(chunks), vsum(chunks);
     parallelFor([&] (int t, int start, int end) {
         double m = 0;
         Vec3 a, b;
@@ -86,57 +85,62 @@ void ReferenceIntegrateSymPRKStepKernel::computeProjection(const vector<Vec3>& p
             if (masses[i] != 0.0) {
                 m += masses[i];
                 a += pos[i]*masses[i];
-                b += force[i];
+                if (vectors != NULL)
+                    b += (*vectors)[i];
             }
         mass[t] = m;
         mx[t] = a;
-        fsum[t] = b;
+        vsum[t] = b;
     });
-    double totalMass = 0;
-    Vec3 moment, netForce;
+    Moments result;
+    result.mass = 0;
+    Vec3 moment;
     for (int t = 0; t < chunks; t++) {
-        totalMass += mass[t];
+        result.mass += mass[t];
         moment += mx[t];
-        netForce += fsum[t];
+        result.sum += vsum[t];
     }
-    if (totalMass == 0.0) {
-        com = acm = alpha = Vec3();
-        return;
-    }
-    com = moment/totalMass;
-    acm = netForce/totalMass;
-    vector<Vec3> torque(chunks), diag(chunks), offdiag(chunks);
+    if (result.mass == 0.0)
+        return result;
+    const Vec3 c = result.centre = moment/result.mass;
+    vector<Vec3> vmoment(chunks), diag(chunks), offdiag(chunks);
     parallelFor([&] (int t, int start, int end) {
         Vec3 tau, d, o;
         for (int i = start; i < end; i++)
             if (masses[i] != 0.0) {
-                Vec3 r = pos[i]-com;
-                tau += r.cross(force[i]);
+                Vec3 r = pos[i]-c;
+                if (vectors != NULL)
+                    tau += r.cross((*vectors)[i]);
                 double m = masses[i];
                 d += Vec3(m*r[0]*r[0], m*r[1]*r[1], m*r[2]*r[2]);
                 o += Vec3(m*r[0]*r[1], m*r[0]*r[2], m*r[1]*r[2]);
             }
-        torque[t] = tau;
+        vmoment[t] = tau;
         diag[t] = d;
         offdiag[t] = o;
     });
-    Vec3 tau, d, o;
     for (int t = 0; t < chunks; t++) {
-        tau += torque[t];
-        d += diag[t];
-        o += offdiag[t];
+        result.moment += vmoment[t];
+        result.d += diag[t];
+        result.o += offdiag[t];
     }
-    alpha = solveInertia(d, o, tau);
+    return result;
 }
 
-Vec3 ReferenceIntegrateSymPRKStepKernel::solveInertia(Vec3 d, Vec3 o, Vec3 tau) {
-    // d = (sum m x^2, sum m y^2, sum m z^2), o = (sum m xy, sum m xz, sum m yz) about the centre of mass.
-    // The inertia tensor is regularised by 1e-12 of its trace (a linear molecule or a single particle then
-    // gives a finite result; the shift changes a round-off-sized torque by 1e-12 of itself).
-    return SymPRKThermostat::solveInertia(d, o, tau);
+void ReferenceIntegrateSymPRKStepKernel::computeProjection(const vector<Vec3>& pos, const vector<Vec3>& force) {
+    // The exact-momentum kick: the acceleration of the centre of mass and the angular acceleration about it
+    // (the inertia tensor regularised by 1e-12 of its trace).
+    const Moments m = computeMoments(pos, &force);
+    if (m.mass == 0.0) {
+        com = acm = alpha = Vec3();
+        return;
+    }
+    com = m.centre;
+    acm = m.sum/m.mass;
+    alpha = solveInertia(m.d, m.o, m.moment);
 }
 
-void ReferenceIntegrateSymPRKStepKernel::thermostatEvent(const SymPRKIntegrator& integrator) {
+void ReferenceIntegrateSymPRKStepKernel::thermostatEvent(const SymPRKIntegrator& integrator, double decay) {
     // The sums in double, serially in particle order (deterministic, whatever the thread count); the host
     // computes the kept field and the factor (SymPRKThermostat), then every particle with mass is rescaled.
     const vector<Vec3>& pos = *data.positions;
@@ -190,7 +194,8 @@ void ReferenceIntegrateSymPRKStepKernel::thermostatEvent(const SymPRKIntegrator&
         for (int j = 0; j < 6; j++)
             sums[SymPRKThermostat::SumSecond+j] = moments[3+j];
     }
-    const SymPRKThermostat::Event e = thermostat.event(sums, integrator, thermostatDecay(integrator));
+    const SymPRKThermostat::Event e = thermostat.event(sums, integrator.getThermostatTemperature(), integrator.getThermostatDof(),
+                                                       rotation, decay);
     if (!e.apply)
         return;
     const double alpha = e.alpha;
@@ -217,49 +222,12 @@ void ReferenceIntegrateSymPRKStepKernel::removeRigidChange(const vector<Vec3>& p
     // Velocities changed by impulses whose net momentum dP and angular momentum dL (about the origin) should be
     // zero but are not, by round-off: add the rigid-body velocity w + gamma x (r - c) that cancels both
     // (c: centre of mass of pos).  A rigid-body velocity keeps every distance-constraint velocity condition.
-    int chunks = threadStart.size()-1;
-    vector<double> mass(chunks, 0.0);
-    vector<Vec3> mx(chunks);
-    parallelFor([&] (int t, int start, int end) {
-        double m = 0;
-        Vec3 a;
-        for (int i = start; i < end; i++)
-            if (masses[i] != 0.0) {
-                m += masses[i];
-                a += pos[i]*masses[i];
-            }
-        mass[t] = m;
-        mx[t] = a;
-    });
-    double M = 0;
-    Vec3 moment;
-    for (int t = 0; t < chunks; t++) {
-        M += mass[t];
-        moment += mx[t];
-    }
-    if (M == 0.0)
+    const Moments m = computeMoments(pos, NULL);
+    if (m.mass == 0.0)
         return;
-    Vec3 c = moment/M;
-    vector<Vec3> diag(chunks), offdiag(chunks);
-    parallelFor([&] (int t, int start, int end) {
-        Vec3 d, o;
-        for (int i = start; i < end; i++)
-            if (masses[i] != 0.0) {
-                Vec3 r = pos[i]-c;
-                double m = masses[i];
-                d += Vec3(m*r[0]*r[0], m*r[1]*r[1], m*r[2]*r[2]);
-                o += Vec3(m*r[0]*r[1], m*r[0]*r[2], m*r[1]*r[2]);
-            }
-        diag[t] = d;
-        offdiag[t] = o;
-    });
-    Vec3 d, o;
-    for (int t = 0; t < chunks; t++) {
-        d += diag[t];
-        o += offdiag[t];
-    }
-    Vec3 w = -dP/M;
-    Vec3 gamma = solveInertia(d, o, c.cross(dP)-dL);
+    const Vec3 c = m.centre;
+    Vec3 w = -dP/m.mass;
+    Vec3 gamma = solveInertia(m.d, m.o, c.cross(dP)-dL);
     parallelFor([&] (int t, int start, int end) {
         for (int i = start; i < end; i++)
             if (masses[i] != 0.0)
@@ -286,164 +254,168 @@ void ReferenceIntegrateSymPRKStepKernel::projectVelocities(vector<Vec3>& pos, ve
     removeRigidChange(pos, vel, dP, dL);
 }
 
-void ReferenceIntegrateSymPRKStepKernel::execute(ContextImpl& context, const SymPRKIntegrator& integrator, bool& forcesAreValid, long long stepIndex) {
+const vector<Vec3>& ReferenceIntegrateSymPRKStepKernel::kickForces(ContextImpl& context, const SymPRKStepPlan::Operation& op,
+        bool& forcesAreValid, int& evaluated) {
+    // The forces of this kick's groups: computed unless the plan lets it reuse cached forces and they are still
+    // valid.  A multiple-time-step method keeps a copy per group, so that a group is evaluated only where a
+    // drift came between two of its kicks.
+    evaluated = 0;
+    if (op.reuseForces) {
+        auto cached = groupForces.find(op.forceGroups);
+        if (cached != groupForces.end())
+            return cached->second;
+    }
+    if (mustEvaluateForces(op, forcesAreValid, context)) {
+        context.calcForcesAndEnergy(true, false, op.forceGroups);
+        forcesAreValid = true;
+        evaluated = op.forceGroups;
+    }
+    if (op.keepGroupCopy)
+        return groupForces[op.forceGroups] = *data.forces;
+    return *data.forces;
+}
+
+void ReferenceIntegrateSymPRKStepKernel::kick(const vector<Vec3>& f, double cdt, bool exact, const SymPRKStepPlan::Operation* drift,
+        double dt) {
+    // One pass over the atoms: the kick, and the drift after it when one is given (the per-atom arithmetic is the
+    // same as in two passes).
     vector<Vec3>& pos = *data.positions;
     vector<Vec3>& vel = *data.velocities;
-    vector<Vec3>& force = *data.forces;
+    const bool fuse = (drift != NULL);
+    const double cdtDrift = (fuse ? drift->coefficient*dt : 0.0);
+    if (exact) {
+        computeProjection(pos, f);
+        parallelFor([&] (int t, int start, int end) {
+            for (int i = start; i < end; i++) {
+                if (masses[i] != 0.0) {
+                    Vec3 a = f[i]/masses[i] - acm - alpha.cross(pos[i]-com);
+                    vel[i] = vel[i] + a*cdt;
+                }
+                if (fuse)
+                    driftAtom(i, cdtDrift);
+            }
+        });
+    }
+    else {
+        parallelFor([&] (int t, int start, int end) {
+            for (int i = start; i < end; i++) {
+                if (masses[i] != 0.0)
+                    for (int j = 0; j < 3; j++)
+                        vel[i][j] = vel[i][j] + cdt*f[i][j]/masses[i];
+                if (fuse)
+                    driftAtom(i, cdtDrift);
+            }
+        });
+    }
+}
+
+void ReferenceIntegrateSymPRKStepKernel::finishDrift(double cdt, double tol, bool exact, bool& forcesAreValid) {
+    // RATTLE: constrain the positions against the pre-drift ones, v += (x - x_unconstrained)/(c*dt); then the
+    // virtual sites.  The forces no longer belong to the positions.
+    vector<Vec3>& pos = *data.positions;
+    vector<Vec3>& vel = *data.velocities;
+    if (hasConstraints) {
+        data.constraints->apply(xRef, pos, inverseMasses, tol);
+        int chunks = threadStart.size()-1;
+        vector<Vec3> netP(chunks), netL(chunks);
+        parallelFor([&] (int t, int start, int end) {
+            Vec3 p, l;
+            for (int i = start; i < end; i++)
+                if (masses[i] != 0.0) {
+                    for (int j = 0; j < 3; j++)
+                        vel[i][j] = vel[i][j] + (pos[i][j]-xUnconstrained[i][j])/cdt;
+                    if (exact) {
+                        Vec3 impulse = (pos[i]-xUnconstrained[i])*(masses[i]/cdt);
+                        p += impulse;
+                        l += xRef[i].cross(impulse);
+                    }
+                }
+            netP[t] = p;
+            netL[t] = l;
+        });
+        if (exact) {
+            // Exact momentum: the constraint impulses m (x - x_u)/h carry no net momentum and no torque about
+            // the pre-drift positions in exact arithmetic; remove their round-off values.
+            Vec3 dP, dL;
+            for (int t = 0; t < chunks; t++) {
+                dP += netP[t];
+                dL += netL[t];
+            }
+            removeRigidChange(pos, vel, dP, dL);
+        }
+    }
+    if (hasVirtualSites)
+        data.virtualSites->computePositions(*system, pos, data.periodicBoxVectors);
+    forcesAreValid = false;
+    groupForces.clear();
+}
+
+void ReferenceIntegrateSymPRKStepKernel::checkVelocities(const SymPRKIntegrator& integrator, long long stepIndex) {
+    // Record the first step that leaves a velocity NaN, infinite or beyond the blow-up speed (NaN fails every <=).
+    if (blowUpStep != 0)
+        return;
+    const vector<Vec3>& vel = *data.velocities;
+    const double maxSpeed = integrator.getMaxSpeed();
+    const double limit = (maxSpeed > 0 ? maxSpeed*maxSpeed : numeric_limits<double>::max());
+    for (int i = 0; i < numParticles; i++)
+        if (!(vel[i].dot(vel[i]) <= limit)) {
+            blowUpStep = stepIndex;
+            break;
+        }
+}
+
+void ReferenceIntegrateSymPRKStepKernel::execute(ContextImpl& context, const SymPRKIntegrator& integrator, const SymPRKStepPlan& plan,
+        bool& forcesAreValid, long long stepIndex) {
     const double dt = integrator.getStepSize();
     const double tol = integrator.getConstraintTolerance();
-    const int groups = integrator.getIntegrationForceGroups();
     const bool exact = integrator.getExactMomentum();
-    ReferenceConstraintAlgorithm& constraints = *data.constraints;
-    const ReferenceVirtualSites& vsites = *data.virtualSites;
-
     if (context.updateContextState())
         forcesAreValid = false;
     if (!forcesAreValid)
         groupForces.clear();  // the cached forces of a multiple-time-step method belong to old positions
-    // Thermostat: a half event before the first step of every interval (after the Context's state updates, a
-    // barostat's move included), and one after its last step (below).
-    if (thermostatBefore(integrator, stepIndex))
-        thermostatEvent(integrator);
-
-    // One pass over the atoms per kick and per drift; a kick directly followed by a drift (every kick but a
-    // step's last) shares its pass with it.  The per-atom arithmetic is the same either way.
-    auto driftAtom = [&] (int i, double cdt) {
-        if (hasConstraints)
-            xRef[i] = pos[i];
-        if (masses[i] != 0.0)
-            for (int j = 0; j < 3; j++)
-                pos[i][j] = pos[i][j] + cdt*vel[i][j];
-        if (hasConstraints)
-            xUnconstrained[i] = pos[i];
-    };
-    auto finishDrift = [&] (double cdt) {
-        if (hasConstraints) {
-            constraints.apply(xRef, pos, inverseMasses, tol);
-            int chunks = threadStart.size()-1;
-            vector<Vec3> netP(chunks), netL(chunks);
-            parallelFor([&] (int t, int start, int end) {
-                Vec3 p, l;
-                for (int i = start; i < end; i++)
-                    if (masses[i] != 0.0) {
-                        for (int j = 0; j < 3; j++)
-                            vel[i][j] = vel[i][j] + (pos[i][j]-xUnconstrained[i][j])/cdt;
-                        if (exact) {
-                            Vec3 impulse = (pos[i]-xUnconstrained[i])*(masses[i]/cdt);
-                            p += impulse;
-                            l += xRef[i].cross(impulse);
-                        }
-                    }
-                netP[t] = p;
-                netL[t] = l;
-            });
-            if (exact) {
-                // Exact momentum: the constraint impulses m (x - x_u)/h carry no net momentum and no torque about
-                // the pre-drift positions in exact arithmetic; remove their round-off values.
-                Vec3 dP, dL;
-                for (int t = 0; t < chunks; t++) {
-                    dP += netP[t];
-                    dL += netL[t];
-                }
-                removeRigidChange(pos, vel, dP, dL);
+    const vector<SymPRKStepPlan::Operation>& ops = plan.getOperations();
+    for (int k = 0; k < (int) ops.size(); k++) {
+        const SymPRKStepPlan::Operation& op = ops[k];
+        bool check = op.checkVelocities;
+        switch (op.kind) {
+        case SymPRKStepPlan::ThermostatEvent:
+            if (!op.runsInStep(stepIndex))
+                continue;
+            thermostatEvent(integrator, op.decay(dt));
+            trace.record(stepIndex, k, 0);
+            break;
+        case SymPRKStepPlan::Kick: {
+            int evaluated;
+            const vector<Vec3>& f = kickForces(context, op, forcesAreValid, evaluated);
+            trace.record(stepIndex, k, evaluated);
+            // the drift right after a kick shares its pass over the atoms
+            const SymPRKStepPlan::Operation* drift = (op.driftFollows ? &ops[k+1] : NULL);
+            kick(f, op.coefficient*dt, exact, drift, dt);
+            if (drift != NULL) {
+                k++;
+                trace.record(stepIndex, k, 0);
+                finishDrift(drift->coefficient*dt, tol, exact, forcesAreValid);
+                check = check || drift->checkVelocities;
             }
+            break;
         }
-        if (hasVirtualSites)
-            vsites.computePositions(*system, pos, data.periodicBoxVectors);
-        forcesAreValid = false;
-        groupForces.clear();
-    };
-    // The sub-step flags come with the sequence (openmm_symprk.methods.resolved states the rules): a velocity
-    // projection before a drift flagged ProjectVelocitiesBefore (where the System has constraints), and forces
-    // reused by a kick flagged ForcesCached while they are still valid.
-    const int numSubsteps = integrator.getNumSubsteps();
-    auto projectBefore = [&] (int s) {
-        return hasConstraints && (integrator.getSubstepFlags(s) & SymPRKIntegrator::ProjectVelocitiesBefore) != 0;
-    };
-    for (int s = 0; s < numSubsteps; ) {
-        const double cdt = integrator.getSubstepCoefficient(s)*dt;
-        if (integrator.getSubstepKind(s) == SymPRKIntegrator::Kick) {
-            // The forces of this kick's groups: computed unless cached since the last drift.  A
-            // multiple-time-step method keeps a copy per group, so that a group is evaluated only where a
-            // drift came between two of its kicks.
-            const int mask = (integrator.getSubstepForceGroups(s) == -1 ? groups : integrator.getSubstepForceGroups(s));
-            const bool reuse = (integrator.getSubstepFlags(s) & SymPRKIntegrator::ForcesCached) != 0;
-            const vector<Vec3>* kickForces = &force;
-            auto cached = (reuse ? groupForces.find(mask) : groupForces.end());
-            if (cached != groupForces.end())
-                kickForces = &cached->second;
-            else {
-                if (!reuse || !forcesAreValid || context.getLastForceGroups() != mask) {
-                    context.calcForcesAndEnergy(true, false, mask);
-                    forcesAreValid = true;
-                }
-                if (multipleGroups) {
-                    groupForces[mask] = force;
-                    kickForces = &groupForces[mask];
-                }
-            }
-            const vector<Vec3>& f = *kickForces;
-            // a drift right after this kick shares its pass, unless it projects the velocities first (a kick of
-            // another force group may follow too: multiple time stepping)
-            const bool fuse = (s+1 < numSubsteps && integrator.getSubstepKind(s+1) == SymPRKIntegrator::Drift &&
-                               !projectBefore(s+1));
-            const double cdtDrift = (fuse ? integrator.getSubstepCoefficient(s+1)*dt : 0.0);
-            if (exact) {
-                computeProjection(pos, f);
-                parallelFor([&] (int t, int start, int end) {
-                    for (int i = start; i < end; i++) {
-                        if (masses[i] != 0.0) {
-                            Vec3 a = f[i]/masses[i] - acm - alpha.cross(pos[i]-com);
-                            vel[i] = vel[i] + a*cdt;
-                        }
-                        if (fuse)
-                            driftAtom(i, cdtDrift);
-                    }
-                });
-            }
-            else {
-                parallelFor([&] (int t, int start, int end) {
-                    for (int i = start; i < end; i++) {
-                        if (masses[i] != 0.0)
-                            for (int j = 0; j < 3; j++)
-                                vel[i][j] = vel[i][j] + cdt*f[i][j]/masses[i];
-                        if (fuse)
-                            driftAtom(i, cdtDrift);
-                    }
-                });
-            }
-            if (fuse) {
-                finishDrift(cdtDrift);
-                s += 2;
-            }
-            else
-                s += 1;
-        }
-        else {
-            if (projectBefore(s))
-                projectVelocities(pos, vel, tol, exact);
+        case SymPRKStepPlan::Drift: {
+            const double cdt = op.coefficient*dt;
             parallelFor([&] (int t, int start, int end) {
                 for (int i = start; i < end; i++)
                     driftAtom(i, cdt);
             });
-            finishDrift(cdt);
-            s += 1;
+            trace.record(stepIndex, k, 0);
+            finishDrift(cdt, tol, exact, forcesAreValid);
+            break;
         }
-    }
-    if (hasConstraints)
-        projectVelocities(pos, vel, tol, exact);
-    if (thermostatAfter(integrator, stepIndex))
-        thermostatEvent(integrator);
-
-    // Record the first step that leaves a velocity NaN, infinite or beyond the blow-up speed (NaN fails every <=).
-    if (blowUpStep == 0) {
-        const double maxSpeed = integrator.getMaxSpeed();
-        const double limit = (maxSpeed > 0 ? maxSpeed*maxSpeed : numeric_limits<double>::max());
-        for (int i = 0; i < numParticles; i++)
-            if (!(vel[i].dot(vel[i]) <= limit)) {
-                blowUpStep = stepIndex;
-                break;
-            }
+        case SymPRKStepPlan::ProjectVelocities:
+            projectVelocities(*data.positions, *data.velocities, tol, exact);
+            trace.record(stepIndex, k, 0);
+            break;
+        }
+        if (check)
+            checkVelocities(integrator, stepIndex);
     }
     data.time += dt;
     data.stepCount++;

@@ -20,6 +20,7 @@
 extern "C" void registerKernelFactories();  // the Reference kernel library's plugin entry point
 
 using namespace OpenMM;
+using namespace SymPRKPlugin;
 using namespace std;
 
 static const double MASS[2] = {2.0, 5.0};            // Da

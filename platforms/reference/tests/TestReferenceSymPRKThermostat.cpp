@@ -23,6 +23,7 @@
 extern "C" void registerKernelFactories();  // the Reference kernel library's plugin entry point
 
 using namespace OpenMM;
+using namespace SymPRKPlugin;
 using namespace std;
 
 static const double MASS[5] = {12.0, 1.0, 16.0, 0.0, 2.5};  // Da; particle 3 is massless

@@ -8,6 +8,7 @@
 #include <typeinfo>
 #include <vector>
 
+using namespace SymPRKPlugin;
 using namespace OpenMM;
 using namespace std;
 

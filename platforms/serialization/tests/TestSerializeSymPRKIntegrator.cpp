@@ -10,6 +10,7 @@
 #include <vector>
 
 using namespace OpenMM;
+using namespace SymPRKPlugin;
 using namespace std;
 
 static int failures = 0;

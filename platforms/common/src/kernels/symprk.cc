@@ -28,6 +28,67 @@ inline DEVICE void symprkStorePos(GLOBAL real4* RESTRICT posq, GLOBAL real4* RES
 #endif
 }
 
+/** The type of the block reductions' sums and of the 3x3 solves: double where the device has it, else the mixed type. */
+#ifdef SUPPORTS_DOUBLE_PRECISION
+typedef double symprk_acc;
+typedef double3 symprk_acc3;
+#define make_symprk_acc3 make_double3
+#else
+typedef mixed symprk_acc;
+typedef mixed3 symprk_acc3;
+#define make_symprk_acc3 make_mixed3
+#endif
+
+/**
+ * Sum the count per-thread values s[0..count-1] over one block of WORK_GROUP_SIZE threads into total[0..count-1]:
+ * each thread's values go to partial[k*WORK_GROUP_SIZE+thread], then thread k adds column k in thread order (a
+ * fixed order: deterministic).  Two barriers, none inside a loop (PoCL's kernel compiler is slow on those).
+ */
+inline DEVICE void symprkBlockSums(const symprk_acc* s, int count, LOCAL_ARG symprk_acc* partial, LOCAL_ARG symprk_acc* total) {
+    const int tid = LOCAL_ID;
+    for (int k = 0; k < count; k++)
+        partial[k*WORK_GROUP_SIZE+tid] = s[k];
+    SYNC_THREADS;
+    if (tid < count) {
+        symprk_acc sum = 0;
+        for (int i = 0; i < WORK_GROUP_SIZE; i++)
+            sum += partial[tid*WORK_GROUP_SIZE+i];
+        total[tid] = sum;
+    }
+    SYNC_THREADS;
+}
+
+/** adj(I) rhs for the symmetric tensor I, and its determinant in *det: I^-1 rhs = adj(I) rhs / det. */
+inline DEVICE symprk_acc3 symprkAdjugateTimes(symprk_acc Ixx, symprk_acc Iyy, symprk_acc Izz, symprk_acc Ixy, symprk_acc Ixz,
+        symprk_acc Iyz, symprk_acc3 rhs, symprk_acc* det) {
+    symprk_acc axx = Iyy*Izz-Iyz*Iyz, ayy = Ixx*Izz-Ixz*Ixz, azz = Ixx*Iyy-Ixy*Ixy;
+    symprk_acc axy = Ixz*Iyz-Izz*Ixy, axz = Ixy*Iyz-Iyy*Ixz, ayz = Ixy*Ixz-Ixx*Iyz;
+    *det = Ixx*axx+Ixy*axy+Ixz*axz;
+    return make_symprk_acc3(axx*rhs.x+axy*rhs.y+axz*rhs.z, axy*rhs.x+ayy*rhs.y+ayz*rhs.z, axz*rhs.x+ayz*rhs.y+azz*rhs.z);
+}
+
+/**
+ * I^-1 rhs for the inertia tensor about the centre of mass given by d = (sum m x^2, sum m y^2, sum m z^2) and
+ * o = (sum m xy, sum m xz, sum m yz) (the operations of the host's SymPRKPlugin::solveInertia).  regularise: I
+ * shifted by 1e-12 of its trace, 0 if still singular; else the exact inverse unless the determinant is below
+ * 1e-9 trace^3 (then the regularised one).
+ */
+inline DEVICE symprk_acc3 symprkSolveInertia(symprk_acc3 d, symprk_acc3 o, symprk_acc3 rhs, int regularise) {
+    const symprk_acc Ixx = d.y+d.z, Iyy = d.x+d.z, Izz = d.x+d.y, Ixy = -o.x, Ixz = -o.y, Iyz = -o.z;
+    const symprk_acc trace = Ixx+Iyy+Izz;
+    symprk_acc det;
+    if (!regularise) {
+        symprk_acc3 exact = symprkAdjugateTimes(Ixx, Iyy, Izz, Ixy, Ixz, Iyz, rhs, &det);
+        if (isfinite(det) && fabs(det) > (symprk_acc) 1e-9*trace*trace*trace)
+            return make_symprk_acc3(exact.x/det, exact.y/det, exact.z/det);
+    }
+    const symprk_acc shift = (symprk_acc) 1e-12*trace;
+    symprk_acc3 shifted = symprkAdjugateTimes(Ixx+shift, Iyy+shift, Izz+shift, Ixy, Ixz, Iyz, rhs, &det);
+    if (det == 0 || !isfinite(det))
+        return make_symprk_acc3(0, 0, 0);
+    return make_symprk_acc3(shifted.x/det, shifted.y/det, shifted.z/det);
+}
+
 /** Record the step in *badStep if a velocity is NaN, infinite or beyond the blow-up speed (NaN fails every <=). */
 inline DEVICE void symprkCheckVelocity(mixed4 v, int checkStep, GLOBAL int* RESTRICT badStep) {
     if (checkStep > 0 && !(v.x*v.x+v.y*v.y+v.z*v.z <= (mixed) MAX_SPEED2) && badStep[0] == 0)
@@ -136,20 +197,17 @@ KERNEL void symprkDriftApply(mixed cdt, GLOBAL real4* RESTRICT posq, GLOBAL real
 
 /**
  * The exact-momentum projection, run as one block of WORK_GROUP_SIZE threads: centre of mass r_cm, net force,
- * torque about r_cm and the inertia tensor about r_cm (sums in the mixed type: double in mixed and double
- * precision), then projection[0..2] = r_cm, [3..5] = a_cm = F/M, [6..8] = alpha = I^-1 tau (I regularised by
- * 1e-12 of its trace).  Massless particles are excluded.  Each thread's partial sums are added in a fixed
- * order by one thread per quantity (deterministic, and only four barriers: PoCL's kernel compiler is slow
- * on barriers inside loops).
+ * torque about r_cm and the inertia tensor about r_cm (per-thread sums in the mixed type, block sums in
+ * symprk_acc), then projection[0..2] = r_cm, [3..5] = a_cm = F/M, [6..8] = alpha = I^-1 tau (I regularised by
+ * 1e-12 of its trace).  Massless particles are excluded.
  */
 KERNEL void symprkProjection(GLOBAL const real4* RESTRICT posq, GLOBAL const real4* RESTRICT posqCorrection,
         GLOBAL const mixed4* RESTRICT velm, GLOBAL const mm_long* RESTRICT force, GLOBAL mixed* RESTRICT projection) {
-    LOCAL mixed partial[9*WORK_GROUP_SIZE];
-    LOCAL mixed total[9];
-    const int tid = LOCAL_ID;
+    LOCAL symprk_acc partial[9*WORK_GROUP_SIZE];
+    LOCAL symprk_acc total[9];
     const mixed fscale = 1/(mixed) 0x100000000;
     mixed s0 = 0, s1 = 0, s2 = 0, s3 = 0, s4 = 0, s5 = 0, s6 = 0;
-    for (int index = tid; index < NUM_ATOMS; index += WORK_GROUP_SIZE) {
+    for (int index = LOCAL_ID; index < NUM_ATOMS; index += WORK_GROUP_SIZE) {
         mixed4 v = velm[index];
         if (v.w != 0) {
             mixed mass = 1/v.w;
@@ -163,27 +221,14 @@ KERNEL void symprkProjection(GLOBAL const real4* RESTRICT posq, GLOBAL const rea
             s6 += fscale*force[index+2*PADDED_NUM_ATOMS];
         }
     }
-    partial[tid] = s0;
-    partial[tid+WORK_GROUP_SIZE] = s1;
-    partial[tid+2*WORK_GROUP_SIZE] = s2;
-    partial[tid+3*WORK_GROUP_SIZE] = s3;
-    partial[tid+4*WORK_GROUP_SIZE] = s4;
-    partial[tid+5*WORK_GROUP_SIZE] = s5;
-    partial[tid+6*WORK_GROUP_SIZE] = s6;
-    SYNC_THREADS;
-    if (tid < 7) {
-        mixed sum = 0;
-        for (int i = 0; i < WORK_GROUP_SIZE; i++)
-            sum += partial[tid*WORK_GROUP_SIZE+i];
-        total[tid] = sum;
-    }
-    SYNC_THREADS;
+    const symprk_acc first[7] = {s0, s1, s2, s3, s4, s5, s6};
+    symprkBlockSums(first, 7, partial, total);
     const mixed m = total[0];
     const mixed invM = (m == 0 ? (mixed) 0 : 1/m);
     const mixed cx = total[1]*invM, cy = total[2]*invM, cz = total[3]*invM;
     const mixed fx = total[4], fy = total[5], fz = total[6];
     mixed tx = 0, ty = 0, tz = 0, dxx = 0, dyy = 0, dzz = 0, oxy = 0, oxz = 0, oyz = 0;
-    for (int index = tid; index < NUM_ATOMS; index += WORK_GROUP_SIZE) {
+    for (int index = LOCAL_ID; index < NUM_ATOMS; index += WORK_GROUP_SIZE) {
         mixed4 v = velm[index];
         if (v.w != 0) {
             mixed mass = 1/v.w;
@@ -201,51 +246,20 @@ KERNEL void symprkProjection(GLOBAL const real4* RESTRICT posq, GLOBAL const rea
             oyz += mass*ry*rz;
         }
     }
-    SYNC_THREADS;
-    partial[tid] = tx;
-    partial[tid+WORK_GROUP_SIZE] = ty;
-    partial[tid+2*WORK_GROUP_SIZE] = tz;
-    partial[tid+3*WORK_GROUP_SIZE] = dxx;
-    partial[tid+4*WORK_GROUP_SIZE] = dyy;
-    partial[tid+5*WORK_GROUP_SIZE] = dzz;
-    partial[tid+6*WORK_GROUP_SIZE] = oxy;
-    partial[tid+7*WORK_GROUP_SIZE] = oxz;
-    partial[tid+8*WORK_GROUP_SIZE] = oyz;
-    SYNC_THREADS;
-    if (tid < 9) {
-        mixed sum = 0;
-        for (int i = 0; i < WORK_GROUP_SIZE; i++)
-            sum += partial[tid*WORK_GROUP_SIZE+i];
-        total[tid] = sum;
-    }
-    SYNC_THREADS;
-    if (tid == 0) {
-        const mixed Tx = total[0], Ty = total[1], Tz = total[2];
-        mixed Ixx = total[4]+total[5], Iyy = total[3]+total[5], Izz = total[3]+total[4];
-        mixed Ixy = -total[6], Ixz = -total[7], Iyz = -total[8];
-        mixed shift = (mixed) 1e-12*(Ixx+Iyy+Izz);
-        Ixx += shift;
-        Iyy += shift;
-        Izz += shift;
-        mixed axx = Iyy*Izz-Iyz*Iyz, ayy = Ixx*Izz-Ixz*Ixz, azz = Ixx*Iyy-Ixy*Ixy;
-        mixed axy = Ixz*Iyz-Izz*Ixy, axz = Ixy*Iyz-Iyy*Ixz, ayz = Ixy*Ixz-Ixx*Iyz;
-        mixed det = Ixx*axx+Ixy*axy+Ixz*axz;
+    const symprk_acc second[9] = {tx, ty, tz, dxx, dyy, dzz, oxy, oxz, oyz};
+    symprkBlockSums(second, 9, partial, total);
+    if (LOCAL_ID == 0) {
+        const symprk_acc3 alpha = symprkSolveInertia(make_symprk_acc3(total[3], total[4], total[5]),
+                make_symprk_acc3(total[6], total[7], total[8]), make_symprk_acc3(total[0], total[1], total[2]), 1);
         projection[0] = cx;
         projection[1] = cy;
         projection[2] = cz;
         projection[3] = fx*invM;
         projection[4] = fy*invM;
         projection[5] = fz*invM;
-        if (det != 0 && m != 0) {
-            projection[6] = (axx*Tx+axy*Ty+axz*Tz)/det;
-            projection[7] = (axy*Tx+ayy*Ty+ayz*Tz)/det;
-            projection[8] = (axz*Tx+ayz*Ty+azz*Tz)/det;
-        }
-        else {
-            projection[6] = 0;
-            projection[7] = 0;
-            projection[8] = 0;
-        }
+        projection[6] = alpha.x;
+        projection[7] = alpha.y;
+        projection[8] = alpha.z;
     }
 }
 
@@ -259,13 +273,12 @@ KERNEL void symprkProjection(GLOBAL const real4* RESTRICT posq, GLOBAL const rea
 KERNEL void symprkRigidSums(int mode, mixed cdt, GLOBAL const real4* RESTRICT posq, GLOBAL const real4* RESTRICT posqCorrection,
         GLOBAL const mixed4* RESTRICT velm, GLOBAL const mixed4* RESTRICT posDelta, GLOBAL const mixed4* RESTRICT vBefore,
         GLOBAL mixed* RESTRICT rigid) {
-    LOCAL mixed partial[10*WORK_GROUP_SIZE];
-    LOCAL mixed total[10];
-    const int tid = LOCAL_ID;
+    LOCAL symprk_acc partial[10*WORK_GROUP_SIZE];
+    LOCAL symprk_acc total[10];
     mixed s[10];
     for (int k = 0; k < 10; k++)
         s[k] = 0;
-    for (int index = tid; index < NUM_ATOMS; index += WORK_GROUP_SIZE) {
+    for (int index = LOCAL_ID; index < NUM_ATOMS; index += WORK_GROUP_SIZE) {
         mixed4 v = velm[index];
         if (v.w != 0) {
             mixed mass = 1/v.w;
@@ -293,16 +306,10 @@ KERNEL void symprkRigidSums(int mode, mixed cdt, GLOBAL const real4* RESTRICT po
             s[9] += x.x*J.y-x.y*J.x;
         }
     }
+    symprk_acc first[10];
     for (int k = 0; k < 10; k++)
-        partial[k*WORK_GROUP_SIZE+tid] = s[k];
-    SYNC_THREADS;
-    if (tid < 10) {
-        mixed sum = 0;
-        for (int i = 0; i < WORK_GROUP_SIZE; i++)
-            sum += partial[tid*WORK_GROUP_SIZE+i];
-        total[tid] = sum;
-    }
-    SYNC_THREADS;
+        first[k] = s[k];
+    symprkBlockSums(first, 10, partial, total);
     const mixed M = total[0];
     const mixed invM = (M == 0 ? (mixed) 0 : 1/M);
     const mixed cx = total[1]*invM, cy = total[2]*invM, cz = total[3]*invM;
@@ -310,7 +317,7 @@ KERNEL void symprkRigidSums(int mode, mixed cdt, GLOBAL const real4* RESTRICT po
     const mixed lx = total[7], ly = total[8], lz = total[9];
     for (int k = 0; k < 6; k++)
         s[k] = 0;
-    for (int index = tid; index < NUM_ATOMS; index += WORK_GROUP_SIZE) {
+    for (int index = LOCAL_ID; index < NUM_ATOMS; index += WORK_GROUP_SIZE) {
         mixed4 v = velm[index];
         if (v.w != 0) {
             mixed mass = 1/v.w;
@@ -330,45 +337,24 @@ KERNEL void symprkRigidSums(int mode, mixed cdt, GLOBAL const real4* RESTRICT po
             s[5] += mass*ry*rz;
         }
     }
-    SYNC_THREADS;
+    symprk_acc second[6];
     for (int k = 0; k < 6; k++)
-        partial[k*WORK_GROUP_SIZE+tid] = s[k];
-    SYNC_THREADS;
-    if (tid < 6) {
-        mixed sum = 0;
-        for (int i = 0; i < WORK_GROUP_SIZE; i++)
-            sum += partial[tid*WORK_GROUP_SIZE+i];
-        total[tid] = sum;
-    }
-    SYNC_THREADS;
-    if (tid == 0) {
-        mixed Ixx = total[1]+total[2], Iyy = total[0]+total[2], Izz = total[0]+total[1];
-        mixed Ixy = -total[3], Ixz = -total[4], Iyz = -total[5];
-        mixed shift = (mixed) 1e-12*(Ixx+Iyy+Izz);
-        Ixx += shift;
-        Iyy += shift;
-        Izz += shift;
-        mixed axx = Iyy*Izz-Iyz*Iyz, ayy = Ixx*Izz-Ixz*Ixz, azz = Ixx*Iyy-Ixy*Ixy;
-        mixed axy = Ixz*Iyz-Izz*Ixy, axz = Ixy*Iyz-Iyy*Ixz, ayz = Ixy*Ixz-Ixx*Iyz;
-        mixed det = Ixx*axx+Ixy*axy+Ixz*axz;
+        second[k] = s[k];
+    symprkBlockSums(second, 6, partial, total);
+    if (LOCAL_ID == 0) {
         // right-hand side c x dP - dL
-        mixed bx = (cy*pz-cz*py)-lx, by = (cz*px-cx*pz)-ly, bz = (cx*py-cy*px)-lz;
+        const symprk_acc3 b = make_symprk_acc3((cy*pz-cz*py)-lx, (cz*px-cx*pz)-ly, (cx*py-cy*px)-lz);
+        const symprk_acc3 gamma = symprkSolveInertia(make_symprk_acc3(total[0], total[1], total[2]),
+                make_symprk_acc3(total[3], total[4], total[5]), b, 1);
         rigid[0] = cx;
         rigid[1] = cy;
         rigid[2] = cz;
         rigid[3] = -px*invM;
         rigid[4] = -py*invM;
         rigid[5] = -pz*invM;
-        if (det != 0 && M != 0) {
-            rigid[6] = (axx*bx+axy*by+axz*bz)/det;
-            rigid[7] = (axy*bx+ayy*by+ayz*bz)/det;
-            rigid[8] = (axz*bx+ayz*by+azz*bz)/det;
-        }
-        else {
-            rigid[6] = 0;
-            rigid[7] = 0;
-            rigid[8] = 0;
-        }
+        rigid[6] = gamma.x;
+        rigid[7] = gamma.y;
+        rigid[8] = gamma.z;
     }
 }
 
@@ -396,16 +382,12 @@ KERNEL void symprkRigidApply(GLOBAL const real4* RESTRICT posq, GLOBAL const rea
  * it (else in the mixed type), one block of WORK_GROUP_SIZE threads, partial sums added in a fixed order: one
  * buffer, downloaded once per event.
  */
-#ifdef SUPPORTS_DOUBLE_PRECISION
-typedef double symprk_acc;
-#else
-typedef mixed symprk_acc;
-#endif
 #define SYMPRK_THERMOSTAT_SUMS 17
 
 KERNEL void symprkThermostatSums(GLOBAL const real4* RESTRICT posq, GLOBAL const real4* RESTRICT posqCorrection,
         GLOBAL const mixed4* RESTRICT velm, int withPositions, GLOBAL symprk_acc* RESTRICT sums) {
     LOCAL symprk_acc partial[SYMPRK_THERMOSTAT_SUMS*WORK_GROUP_SIZE];
+    LOCAL symprk_acc total[SYMPRK_THERMOSTAT_SUMS];
     const int tid = LOCAL_ID;
     symprk_acc s[SYMPRK_THERMOSTAT_SUMS];
     for (int k = 0; k < SYMPRK_THERMOSTAT_SUMS; k++)
@@ -438,15 +420,9 @@ KERNEL void symprkThermostatSums(GLOBAL const real4* RESTRICT posq, GLOBAL const
             }
         }
     }
-    for (int k = 0; k < SYMPRK_THERMOSTAT_SUMS; k++)
-        partial[k*WORK_GROUP_SIZE+tid] = s[k];
-    SYNC_THREADS;
-    if (tid < SYMPRK_THERMOSTAT_SUMS) {
-        symprk_acc sum = 0;
-        for (int i = 0; i < WORK_GROUP_SIZE; i++)
-            sum += partial[tid*WORK_GROUP_SIZE+i];
-        sums[tid] = sum;
-    }
+    symprkBlockSums(s, SYMPRK_THERMOSTAT_SUMS, partial, total);
+    if (tid < SYMPRK_THERMOSTAT_SUMS)
+        sums[tid] = total[tid];
 }
 
 /**

@@ -31,13 +31,15 @@
 
 #include "openmm/Integrator.h"
 #include "openmm/Kernel.h"
-#include "openmm/internal/windowsExport.h"
+#include "openmm/internal/SymPRKStepPlan.h"
+#include "openmm/internal/windowsExportSymPRK.h"
 #include <string>
 #include <vector>
 
-namespace OpenMM {
+/** The openmm_symprk plugin's C++ classes (Python: openmm_symprk.plugin.symprk_swig). */
+namespace SymPRKPlugin {
 
-class OPENMM_EXPORT SymPRKIntegrator : public Integrator {
+class OPENMM_EXPORT_SYMPRK SymPRKIntegrator : public OpenMM::Integrator {
 public:
     /** What a sub-step does (openmm_symprk.methods.resolved.SubstepKind has the same numbers). */
     enum SubstepKind {
@@ -105,8 +107,9 @@ public:
     }
     /**
      * The first step (1-based, counted like getStepsTaken()) at whose end some velocity was NaN, infinite
-     * or faster than getMaxSpeed(); 0 if none (or since clearBlowUp()).  Checked on the device at the end of
-     * every step.
+     * or faster than getMaxSpeed(); 0 if none (or since clearBlowUp()).  Checked (on the device on OpenCL/CUDA)
+     * right after the last operation of every step that changes the velocities, a kick or a drift with constraints
+     * (SymPRKStepPlan says which).
      */
     long long getBlowUpStep() const;
     /** Forget a recorded blow-up (the Python layer does this when it reports one). */
@@ -195,12 +198,30 @@ public:
      */
     static void registerMissingKernelFactories();
     void step(int steps);
+    /**
+     * For tests: the step plan of the bound Context (SymPRKStepPlan, decided once for every platform), one line
+     * per operation in the order a step runs them (SymPRKStepPlan::describe gives the grammar).  Throws when the
+     * integrator is not bound to a Context.
+     */
+    std::vector<std::string> getStepPlan() const;
+    /**
+     * For tests: start (true; what was recorded is cleared) or stop (false) recording what the kernel executes.
+     * Kept across Contexts; off by default (recording costs a little per operation).
+     */
+    void setExecutionTraceEnabled(bool record);
+    /**
+     * For tests: what the kernel executed while recording, three numbers per operation run: the step (1-based, as
+     * getStepsTaken() counts it), the operation's index in getStepPlan(), and the force-group mask whose forces it
+     * evaluated (0 when it evaluated none: a kick reusing cached forces, or any other operation).  Empty when not
+     * bound.
+     */
+    std::vector<int> getExecutionTrace() const;
 
 protected:
-    void initialize(ContextImpl& context);
+    void initialize(OpenMM::ContextImpl& context);
     void cleanup();
     std::vector<std::string> getKernelNames();
-    void stateChanged(State::DataType changed);
+    void stateChanged(OpenMM::State::DataType changed);
     double computeKineticEnergy();
     bool kineticEnergyRequiresForce() const {
         return false;
@@ -209,6 +230,10 @@ protected:
     void loadCheckpoint(std::istream& stream);
 
 private:
+    /** index, after checking that it names a sub-step. */
+    int substep(int index) const;
+    /** The plan for the bound Context, made again if the integration force groups have changed. */
+    const SymPRKStepPlan& currentPlan();
     std::vector<int> kinds, groups, flags;
     std::vector<double> coefficients;
     bool exactMomentum, forcesAreValid;
@@ -221,9 +246,11 @@ private:
     bool thermostat, keepRotation;
     double thermostatTemperature, collisionTime;
     int thermostatInterval, thermostatDof, randomSeed;
-    Kernel kernel;
+    bool traceEnabled;
+    SymPRKStepPlan plan;
+    OpenMM::Kernel kernel;
 };
 
-} // namespace OpenMM
+} // namespace SymPRKPlugin
 
 #endif /*OPENMM_SYMPRK_INTEGRATOR_H_*/

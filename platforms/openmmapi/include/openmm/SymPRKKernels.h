@@ -5,32 +5,61 @@
 #include "openmm/Platform.h"
 #include "openmm/System.h"
 #include "openmm/SymPRKIntegrator.h"
+#include "openmm/internal/ContextImpl.h"
+#include "openmm/internal/SymPRKStepPlan.h"
 #include "openmm/internal/SymPRKThermostat.h"
-#include <cmath>
 #include <string>
+#include <vector>
 
-namespace OpenMM {
+namespace SymPRKPlugin {
 
 /**
- * Executes one step of a SymPRKIntegrator.  Implemented by the Reference kernel (also serving the CPU
- * platform) and the Common kernel (OpenCL; CUDA and HIP by the same source).
+ * For tests: what a kernel executed, three numbers per operation run (step, operation index in the plan, force
+ * groups evaluated or 0), recorded only while enabled (SymPRKIntegrator::setExecutionTraceEnabled).
  */
-class IntegrateSymPRKStepKernel : public KernelImpl {
+class SymPRKExecutionTrace {
+public:
+    SymPRKExecutionTrace() : enabled(false) {
+    }
+    /** Start (clearing the record) or stop recording. */
+    void setEnabled(bool record) {
+        enabled = record;
+        if (record)
+            entries.clear();
+    }
+    void record(long long step, int operation, int evaluatedGroups) {
+        if (enabled)
+            entries.insert(entries.end(), {(int) step, operation, evaluatedGroups});
+    }
+    const std::vector<int>& getEntries() const {
+        return entries;
+    }
+private:
+    bool enabled;
+    std::vector<int> entries;
+};
+
+/**
+ * Executes one step of a SymPRKIntegrator: the operations of its SymPRKStepPlan, in order.  Implemented by the
+ * Reference kernel (also serving the CPU platform) and the Common kernel (OpenCL; CUDA and HIP by the same source).
+ */
+class IntegrateSymPRKStepKernel : public OpenMM::KernelImpl {
 public:
     static std::string Name() {
         return "IntegrateSymPRKStep";
     }
-    IntegrateSymPRKStepKernel(std::string name, const Platform& platform) : KernelImpl(name, platform) {
+    IntegrateSymPRKStepKernel(std::string name, const OpenMM::Platform& platform) : OpenMM::KernelImpl(name, platform) {
     }
-    virtual void initialize(const System& system, const SymPRKIntegrator& integrator) = 0;
+    virtual void initialize(const OpenMM::System& system, const SymPRKIntegrator& integrator, const SymPRKStepPlan& plan) = 0;
     /**
-     * Advance one step.  forcesAreValid says whether the Context's forces belong to the current positions
-     * (and the integrator's force groups); the kernel updates it.  stepIndex is the 1-based number of this
-     * step, used to record the first non-finite one.
+     * Advance one step: run the operations of plan.  forcesAreValid says whether the Context's forces belong to the
+     * current positions (and the integrator's force groups); the kernel updates it.  stepIndex is the 1-based number
+     * of this step: it decides which thermostat events run, and is recorded as the first non-finite one.
      */
-    virtual void execute(ContextImpl& context, const SymPRKIntegrator& integrator, bool& forcesAreValid, long long stepIndex) = 0;
+    virtual void execute(OpenMM::ContextImpl& context, const SymPRKIntegrator& integrator, const SymPRKStepPlan& plan,
+                         bool& forcesAreValid, long long stepIndex) = 0;
     /** Kinetic energy of the current (full-step) velocities. */
-    virtual double computeKineticEnergy(ContextImpl& context, const SymPRKIntegrator& integrator) = 0;
+    virtual double computeKineticEnergy(OpenMM::ContextImpl& context, const SymPRKIntegrator& integrator) = 0;
     /**
      * True if an energy-only evaluation (Context::getState(getEnergy=True)) leaves the force buffer intact, so
      * cached forces survive it (Reference/CPU restore them; the Common platforms clear them).
@@ -39,31 +68,28 @@ public:
         return false;
     }
     /** First step recorded as non-finite by execute(), or 0. */
-    virtual long long getBlowUpStep(ContextImpl& context) = 0;
+    virtual long long getBlowUpStep(OpenMM::ContextImpl& context) = 0;
     /** Restore the value returned by getBlowUpStep() (checkpoints). */
-    virtual void setBlowUpStep(ContextImpl& context, long long step) = 0;
-    /**
-     * The host side of the thermostat (random state, heat-bath energy), per Context.  execute() runs an event
-     * before a step whose 0-based index is a multiple of the interval and after a step that completes one.
-     */
+    virtual void setBlowUpStep(OpenMM::ContextImpl& context, long long step) = 0;
+    /** The host side of the thermostat (random state, heat-bath energy), per Context. */
     SymPRKThermostat& getThermostat() {
         return thermostat;
     }
-    /** Whether a thermostat event comes before / after step stepIndex (1-based, as execute() gets it). */
-    static bool thermostatBefore(const SymPRKIntegrator& integrator, long long stepIndex) {
-        return integrator.hasThermostat() && (stepIndex-1) % integrator.getThermostatInterval() == 0;
-    }
-    static bool thermostatAfter(const SymPRKIntegrator& integrator, long long stepIndex) {
-        return integrator.hasThermostat() && stepIndex % integrator.getThermostatInterval() == 0;
-    }
-    /** c = exp(-interval*dt/(2 tau)) of a half event. */
-    static double thermostatDecay(const SymPRKIntegrator& integrator) {
-        return std::exp(-0.5*integrator.getThermostatInterval()*integrator.getStepSize()/integrator.getCollisionTime());
+    SymPRKExecutionTrace& getTrace() {
+        return trace;
     }
 protected:
+    /**
+     * Whether kick must evaluate its forces: it does not reuse cached forces, or they no longer belong to the
+     * positions, or they are another set of groups' (the run-time half of the plan's reuse decision).
+     */
+    static bool mustEvaluateForces(const SymPRKStepPlan::Operation& kick, bool forcesAreValid, OpenMM::ContextImpl& context) {
+        return !kick.reuseForces || !forcesAreValid || context.getLastForceGroups() != kick.forceGroups;
+    }
     SymPRKThermostat thermostat;
+    SymPRKExecutionTrace trace;
 };
 
-} // namespace OpenMM
+} // namespace SymPRKPlugin
 
 #endif /*OPENMM_SYMPRK_KERNELS_H_*/

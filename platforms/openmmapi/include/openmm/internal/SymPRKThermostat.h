@@ -14,15 +14,13 @@
  */
 
 #include "openmm/Vec3.h"
-#include "openmm/internal/windowsExport.h"
+#include "openmm/internal/windowsExportSymPRK.h"
 #include <random>
 #include <string>
 
-namespace OpenMM {
+namespace SymPRKPlugin {
 
-class SymPRKIntegrator;
-
-class OPENMM_EXPORT SymPRKThermostat {
+class OPENMM_EXPORT_SYMPRK SymPRKThermostat {
 public:
     /** Layout of the sums a kernel provides (all over particles with mass m > 0; positions x, velocities v). */
     enum SumIndex {
@@ -38,18 +36,18 @@ public:
     struct Event {
         bool apply;            // false: nothing to do (no mass, no peculiar motion, or a non-finite sum)
         double alpha;
-        Vec3 velocity, centre, omega;  // omega = 0 unless the rotation is kept
+        OpenMM::Vec3 velocity, centre, omega;  // omega = 0 unless the rotation is kept
         double kinetic, newKinetic;    // peculiar kinetic energy before and after (kJ/mol)
     };
     SymPRKThermostat();
     /** Seed the generator (0: a seed from std::random_device) and zero the heat-bath energy. */
     void initialize(int seed);
     /**
-     * One event with relaxation factor c = exp(-t/tau) for the integrator's temperature, degrees of freedom and
-     * kept rotation: draws r1 ~ N(0,1) and chi2 ~ chi^2(dof-1), and subtracts K' - K_pec from the heat-bath energy.
-     * A (nearly) singular inertia tensor is regularised by 1e-12 of its trace (solveInertia).
+     * One event with relaxation factor c = exp(-t/tau) for a target temperature (K), the degrees of freedom and
+     * whether the rotation is kept: draws r1 ~ N(0,1) and chi2 ~ chi^2(dof-1), and subtracts K' - K_pec from the
+     * heat-bath energy.  A (nearly) singular inertia tensor is regularised by 1e-12 of its trace (solveInertia).
      */
-    Event event(const double* sums, const SymPRKIntegrator& integrator, double c);
+    Event event(const double* sums, double temperature, int dof, bool keepRotation, double c);
     double getHeatBathEnergy() const {
         return heatBathEnergy;
     }
@@ -64,10 +62,6 @@ public:
      * chi-squared variable chi2 of dof-1 degrees of freedom; K' is written to newKinetic.
      */
     static double rescalingFactor(double kinetic, double target, int dof, double c, double r1, double chi2, double& newKinetic);
-    /** I^-1 rhs for the inertia tensor from d = (sum m x^2, sum m y^2, sum m z^2), o = (sum m xy, sum m xz,
-     *  sum m yz) about the centre of mass, regularised by 1e-12 of its trace (0 if still singular); with
-     *  regularise false, the exact inverse unless the determinant is below 1e-9 trace^3 (then regularised). */
-    static Vec3 solveInertia(Vec3 d, Vec3 o, Vec3 rhs, bool regularise = true);
     /** Boltzmann's constant in kJ/mol/K, OpenMM's value. */
     static double boltzmann();
 private:
@@ -75,6 +69,6 @@ private:
     double heatBathEnergy;
 };
 
-} // namespace OpenMM
+} // namespace SymPRKPlugin
 
 #endif /*OPENMM_SYMPRK_THERMOSTAT_H_*/

@@ -3,16 +3,17 @@
 
 #include "openmm/serialization/SerializationProxy.h"
 
-namespace OpenMM {
+namespace SymPRKPlugin {
 
-/** XmlSerializer support for SymPRKIntegrator (registered when libOpenMMSymPRK is loaded). */
-class SymPRKIntegratorProxy : public SerializationProxy {
+/** XmlSerializer support for SymPRKIntegrator (registered when libOpenMMSymPRK is loaded), under the type name
+ *  "SymPRKIntegrator". */
+class SymPRKIntegratorProxy : public OpenMM::SerializationProxy {
 public:
     SymPRKIntegratorProxy();
-    void serialize(const void* object, SerializationNode& node) const;
-    void* deserialize(const SerializationNode& node) const;
+    void serialize(const void* object, OpenMM::SerializationNode& node) const;
+    void* deserialize(const OpenMM::SerializationNode& node) const;
 };
 
-} // namespace OpenMM
+} // namespace SymPRKPlugin
 
 #endif /*OPENMM_SYMPRK_INTEGRATOR_PROXY_H_*/

@@ -1,0 +1,114 @@
+"""Where a velocity thermostat sits in a kick/drift step, and what that does to sampling (pure numerics).
+
+A thermostat O that acts on velocities only can sit at the ends of the symplectic step (half an event before
+and half after: O_{h/2} . step . O_{h/2}) or at its exact centre (one whole event there). On N independent
+harmonic oscillators q'' = -w^2 q the choice decides how far the sampled configurations are from the canonical
+ones: velocity Verlet with O at the ends samples <q^2> w^2/kT = 1/(1 - h^2 w^2/4) (configurations hot), with O in
+the middle (between its two half drifts: BAOAB) exactly 1, while its on-step velocities then read
+<v^2>/kT = 1 - h^2 w^2/4 (docs/theory.md, section 6).  Higher-order splittings behave otherwise (omelyan-2's ends
+placement is already within 0.4% of exact at h w <= 1, its middle one 6% off), so the package does not assume
+which placement helps a method: :func:`harmonic_sampling` computes the stationary moments of a step with its
+thermostat exactly, and :func:`best_position` picks the placement for ``thermostat_position="auto"``.
+
+Everything here works on plain sequences of ``(label, coefficient)``: labels "kick" (or "kick:<groups>" of a
+multiple-time-step sequence), "drift" and :data:`THERMOSTAT`, coefficients as fractions of the step (a
+thermostat entry's coefficient is the fraction of the step whose relaxation it applies).
+"""
+from __future__ import annotations
+
+from fractions import Fraction
+
+import numpy as np
+
+__all__ = ["THERMOSTAT", "POSITIONS", "centre", "with_thermostat", "harmonic_sampling", "placement_errors",
+           "best_position", "H_OMEGA_GRID"]
+
+#: The label of a thermostat event in a step sequence.
+THERMOSTAT = "thermostat"
+#: The placements a user can ask for ("auto": the one :func:`best_position` picks for the method).
+POSITIONS = ("ends", "middle", "auto")
+#: The h*omega values over which "auto" compares the placements: water's librations at 1-4 fs span about
+#: 0.13-0.5, an O-H stretch at 1 fs about 0.9.
+H_OMEGA_GRID = (0.25, 0.5, 0.75, 1.0)
+
+
+def centre(steps) -> int:
+    """Index of the middle sub-step of a symmetric (self-adjoint) sequence, the one the step's time centre lies
+    in.  ValueError for a sequence that does not read the same backwards: its centre in time is not one point."""
+    steps = [(label, Fraction(c)) for label, c in steps]
+    if len(steps) % 2 == 0 or steps != steps[::-1]:
+        raise ValueError("the thermostat can only sit in the middle of a symmetric (self-adjoint) step, whose "
+                         "sequence reads the same backwards; this one does not (use thermostat_position='ends')")
+    return len(steps) // 2
+
+
+def with_thermostat(steps, position: str) -> list:
+    """``steps`` with the thermostat where ``position`` ("ends" or "middle") puts it: half an event at each end,
+    or the middle sub-step split in two equal halves with one whole event between them."""
+    steps = [(label, Fraction(c)) for label, c in steps]
+    if position == "ends":
+        half = Fraction(1, 2)
+        return [(THERMOSTAT, half), *steps, (THERMOSTAT, half)]
+    if position == "middle":
+        i = centre(steps)
+        label, c = steps[i]
+        return [*steps[:i], (label, c / 2), (THERMOSTAT, Fraction(1)), (label, c / 2), *steps[i + 1:]]
+    raise ValueError(f"thermostat position must be 'ends' or 'middle', got {position!r}")
+
+
+def harmonic_sampling(steps, h_omega: float, decay: float = 0.5, forced=None) -> tuple:
+    """(<q^2> w^2/kT, <v^2>/kT) that a step with its thermostat samples, exactly, for q'' = -w^2 q.
+
+    ``steps`` includes the thermostat entries (:func:`with_thermostat`); each is a Langevin (Ornstein-Uhlenbeck)
+    velocity update over its fraction f of the step, v <- a v + sqrt(1 - a^2) sqrt(kT/m) xi with a = decay**f
+    (``decay`` = exp(-h/tau) per step, 0 < decay < 1).  Velocity rescaling of the whole kinetic energy gives the same
+    moments to 3 digits (docs/theory.md, section 6).  ``forced``: the kick labels that carry the oscillator's force
+    (default: every kick; for a multiple-time-step sequence the fast level's label).  The moments are the
+    stationary covariance of the linear stochastic map of one step (the discrete Lyapunov equation S = A S A^T + Q), taken at the
+    step's end: <v^2> is what a State's on-step velocities read.  ValueError when the step is unstable at h_omega
+    (no stationary distribution)."""
+    if not 0.0 < decay < 1.0:
+        raise ValueError(f"decay must lie strictly between 0 and 1, got {decay!r}")
+    x = float(h_omega)
+    A, Q = np.eye(2), np.zeros((2, 2))
+    for label, c in steps:
+        c = float(c)
+        noise = np.zeros((2, 2))
+        if label == THERMOSTAT:
+            a = decay ** c
+            M = np.array([[1.0, 0.0], [0.0, a]])
+            noise[1, 1] = 1.0 - a * a
+        elif label == "drift":
+            M = np.array([[1.0, c * x], [0.0, 1.0]])
+        elif forced is None or label in forced:
+            M = np.array([[1.0, 0.0], [-c * x, 1.0]])
+        else:
+            continue  # a kick of a force group the oscillator does not feel
+        A, Q = M @ A, M @ Q @ M.T + noise
+    if max(abs(np.linalg.eigvals(A))) >= 1.0:
+        raise ValueError(f"the step is not stable at h*omega = {x:g}: no stationary distribution")
+    # S = A S A^T + Q, as (I - A (x) A) vec(S) = vec(Q): a 4x4 solve
+    S = np.linalg.solve(np.eye(4) - np.kron(A, A), Q.reshape(4)).reshape(2, 2)
+    return float(S[0, 0]), float(S[1, 1])
+
+
+def placement_errors(steps, h_omegas=H_OMEGA_GRID, decay: float = 0.5, forced=None) -> dict:
+    """{position: largest |<q^2> w^2/kT - 1| over ``h_omegas``} for "ends" and "middle" (inf where the step is
+    unstable at one of them, or where the middle is not one point)."""
+    out = {}
+    for position in ("ends", "middle"):
+        try:
+            seq = with_thermostat(steps, position)
+            out[position] = max(abs(harmonic_sampling(seq, x, decay, forced)[0] - 1.0) for x in h_omegas)
+        except ValueError:
+            out[position] = float("inf")
+    return out
+
+
+def best_position(steps, stability: float | None = None, forced=None) -> str:
+    """The placement "auto" gives: "middle" where it samples the harmonic oscillators' configurations closer to
+    canonical than "ends" over :data:`H_OMEGA_GRID` (cut at 90% of the method's stability limit ``stability``),
+    by at least a factor of 2, else "ends" (the package's placement before the middle one existed)."""
+    grid = tuple(x for x in H_OMEGA_GRID if stability is None or x < 0.9 * stability) or (H_OMEGA_GRID[0],)
+    err = placement_errors(steps, grid, forced=forced)
+    return "middle" if err["middle"] < 0.5 * err["ends"] else "ends"
