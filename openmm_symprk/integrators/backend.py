@@ -55,7 +55,8 @@ def resolve_for_system(where: str, method, system, options: IntegratorOptions, n
         resolved = resolve(method, name=name)
     if splittings_only is not None and not resolved.is_splitting:
         raise NativeMethodError(
-            f"method {resolved.name!r} is a general ({resolved.family or resolved.form}) PRK tableau; {splittings_only}")
+            f"method {resolved.name!r} is a general ({resolved.family or resolved.form}) PRK tableau; "
+            f"{splittings_only}")
     if system is not None:
         validate_system(system, f"{where}({resolved.name})", options.exact_momentum, skip=skip_checks)
         if resolved.groups is not None:

@@ -120,9 +120,9 @@ class PRKIntegrator(IntegratorBase, mm.CustomIntegrator):
         if stored != self.program_info.signature:
             raise CheckpointMismatchError(
                 f"{type(self).__name__}({self.method_name}): the Context holds the state of another integrator "
-                f"program (its signature {stored:.0f} is not this program's {self.program_info.signature}): a checkpoint "
-                f"saved with another method, other options (exact_momentum, constraints, max_speed) or the native "
-                f"backend was loaded. Create the integrator as it was when the checkpoint was saved (a native "
+                f"program (its signature {stored:.0f} is not this program's {self.program_info.signature}): a "
+                f"checkpoint saved with another method, other options (exact_momentum, constraints, max_speed) or the "
+                f"native backend was loaded. Create the integrator as it was when the checkpoint was saved (a native "
                 f"checkpoint needs backend='native'), load the checkpoint into that one, or load a State "
                 f"(positions and velocities) instead.")
 

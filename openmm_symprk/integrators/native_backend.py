@@ -52,8 +52,9 @@ class NativeSymplecticIntegrator(SymplecticIntegrator, _PluginIntegrator, backen
     a Context of another System is refused), and the options both backends take (:mod:`.options`):
     ``exact_momentum`` (needs ``system=``), ``check_finite``, ``max_speed``, ``groups`` and ``inner_method``, and the
     thermostat's ``temperature``, ``collision_time``, ``thermostat_interval`` and ``random_seed`` (see
-    :func:`~openmm_symprk.integrators.thermostat.thermostat_settings`; with groups= it wraps the outer step).  Raises NativeUnavailableError (with the reason and the fix) when the plugin is unavailable
-    and NativeMethodError for implicit and general tableaux, which only the CustomIntegrator backend runs."""
+    :func:`~openmm_symprk.integrators.thermostat.thermostat_settings`; with groups= it wraps the outer step).
+    Raises NativeUnavailableError (with the reason and the fix) when the plugin is unavailable and NativeMethodError
+    for implicit and general tableaux, which only the CustomIntegrator backend runs."""
 
     def __init__(self, stepSize, method="verlet", system=None, backend="native", **options):
         self._check_backend(backend)

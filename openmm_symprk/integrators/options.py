@@ -127,6 +127,6 @@ class IntegratorOptions:
         thermostat = thermostat_settings(system, *(options.get(k) for k in THERMOSTAT_OPTIONS))
         groups = options.get("groups")
         return cls(dt, signature(system) if system is not None else None, exact_momentum,
-                   bool(options.get("check_finite", True)), max_speed, mts_groups(groups) if groups is not None else None,
-                   options.get("inner_method"), thermostat, constraints, bool(options.get("allow_nonsymplectic", False)),
-                   tolerance, max_iterations)
+                   bool(options.get("check_finite", True)), max_speed,
+                   mts_groups(groups) if groups is not None else None, options.get("inner_method"), thermostat,
+                   constraints, bool(options.get("allow_nonsymplectic", False)), tolerance, max_iterations)

@@ -39,6 +39,10 @@ class SymplecticIntegrator(IntegratorBase):
       the step, keeping total momentum (and angular momentum of an isolated System) exactly
       (:mod:`openmm_symprk.integrators.thermostat`, docs/thermostat.md); accessors ``getTemperature``,
       ``setTemperature``, ``computeHeatBathEnergy``, ``thermostat_dof``... (:class:`~.base.IntegratorBase`).
+
+    The options are checked once, into one frozen :class:`~.options.IntegratorOptions` (``integrator.options``),
+    which the backend reads; ``integrator.resolved`` is the method as it runs, ``integrator.program_info`` the facts
+    of the compiled program.
     """
 
     #: backend name -> concrete class (filled by the subclasses)

@@ -5,8 +5,12 @@
 * :mod:`.catalogue` and ``data/*.toml`` -- the named methods (coefficients live in the data files);
   ``methods`` is the catalogue mapping (name or alias -> :class:`~.catalogue.Method`);
 * :mod:`.resolved` -- :func:`resolve`: what the user passed, made once into the description of the step that
-  will run (sub-steps with their flags, force evaluations, orders), taken by everything that runs a method;
+  will run (its form, sub-steps with their flags, force evaluations, orders), taken by everything that runs a
+  method.  A catalogue entry (:class:`~.catalogue.Method`) says what a method is; a
+  :class:`~.resolved.ResolvedMethod` how it runs;
+* :mod:`.description` -- a method as JSON data and back (what a compiled program stores of a user method);
 * :mod:`.respa` -- multiple time stepping as one more kick/drift sequence;
+* :mod:`.placement` -- where a velocity thermostat sits in a kick/drift step, and what that does to sampling;
 * :mod:`.reference` -- pure-numpy integrators on model problems (float64 or long double);
 * :mod:`.stability` -- linear stability intervals; :mod:`.orders` -- the observed-order fit.
 """

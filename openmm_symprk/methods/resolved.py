@@ -10,8 +10,8 @@ user's input itself::
 ``resolve`` takes the method (a catalogue name or alias, a catalogue :class:`~.catalogue.Method`, a
 :class:`~.splitting.Splitting` or a :class:`~.tableau.PRKTableau`), plain facts about the System (whether it
 has constraints; no OpenMM object, so this layer stays free of OpenMM) and the multiple-time-step groups, and
-derives, once: the form of its step (:data:`FORMS`), the kick/drift sequence as it will run (compositions taken over the RATTLE base under
-constraints, the r-RESPA sequence of the groups), every sub-step's kind (:class:`SubstepKind`, the same
+derives, once: the form of its step (:data:`FORMS`), the kick/drift sequence as it will run (compositions taken
+over the RATTLE base under constraints, the r-RESPA sequence of the groups), every sub-step's kind (:class:`SubstepKind`, the same
 numbers as the plugin's ``SymPRKIntegrator::SubstepKind``), its velocity projection and cached-force flags
 (:class:`SubstepFlag`, the plugin's ``SymPRKIntegrator::SubstepFlag``), the force evaluations per step, and
 the catalogue's order, constrained order and stability interval.  The result is frozen and hashable.

@@ -45,13 +45,15 @@ def _with_metadata(xml: str, change) -> str:
     lambda s: PRKIntegrator(0.0005, "pefrl", system=s.system, name="mine", constraints=True),
     lambda s: CustomSymplecticIntegrator(0.0005, "yoshida-4", constraints=False, max_speed=50.0),
     lambda s: CustomSymplecticIntegrator(0.0005, "gauss-2", system=s.system, tolerance=1e-9),
-], ids=["user-splitting", "user-implicit", "user-explicit", "catalogue-renamed", "catalogue-options", "catalogue-implicit"])
+], ids=["user-splitting", "user-implicit", "user-explicit", "catalogue-renamed", "catalogue-options",
+        "catalogue-implicit"])
 def test_restored_from_xml_is_the_same_integrator(build, morse):
     ig = build(morse)
     back = deserialize(mm.XmlSerializer.serialize(ig))
     assert type(back) is type(ig) and back.method_name == ig.method_name
     assert back.resolved == ig.resolved  # the method, resolved again from what the program stored
-    assert back.program_info.signature == ig.program_info.signature and back.program_info.rattle == ig.program_info.rattle
+    assert (back.program_info.signature, back.program_info.rattle) == (ig.program_info.signature,
+                                                                       ig.program_info.rattle)
     assert back.program_info.notes == (*ig.program_info.notes, "restored from XML")
     assert back.options == ig.options  # every option, the non-default ones included
     assert ig.describe().splitlines()[1:3] == back.describe().splitlines()[1:3]
