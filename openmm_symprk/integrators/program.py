@@ -62,7 +62,7 @@ class ProgramInfo:
     levels are the method's: :attr:`method`)."""
 
     method: ResolvedMethod  # the method compiled
-    rattle: bool  # RATTLE steps emitted: the method keeps constraints, or the System has virtual sites (see below)
+    rattle: bool  # RATTLE steps emitted: the method keeps constraints, or virtual sites need them (compile_program)
     signature: int  # the value of global 0 (see the module docstring); the plugin's program signature (native)
     notes: tuple = ()  # lines describe() prints
 
