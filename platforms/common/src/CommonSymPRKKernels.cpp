@@ -306,17 +306,20 @@ void CommonIntegrateSymPRKStepKernel::thermostatEvent(const SymPRKIntegrator& in
 }
 
 void CommonIntegrateSymPRKStepKernel::initializeThermostat(int seed) {
-    if (!thermostatState.isInitialized())
-        return;
+    // The platform's generator is set up with or without a thermostat, so that the Context's checkpoints have the
+    // same layout (its random state comes before the integrator's block) and an NVE checkpoint loaded into an NVT
+    // Context, or the reverse, meets this integrator's own check.  Where something else in the Context (an
+    // AndersenThermostat) seeded it first with another seed, the thermostat draws from that stream.
     ContextSelector selector(cc);
     try {
         cc.getIntegrationUtilities().initRandomNumberGenerator((unsigned int) seed);
+        hostTransfers++;
     }
-    catch (OpenMMException& e) {
-        throw OpenMMException(string("SymPRKIntegrator: the thermostat shares the platform's random number generator, which "
-                "something else in this Context (an AndersenThermostat?) seeded differently: give both the same seed. (")+
-                e.what()+")");
+    catch (OpenMMException&) {
+        // already seeded (with another seed): shared
     }
+    if (!thermostatState.isInitialized())
+        return;
     const vector<double> zero(3, 0.0);
     if (thermostatState.getElementSize() == sizeof(double))
         thermostatState.upload(zero);
