@@ -14,6 +14,7 @@ another program was loaded.
 """
 from __future__ import annotations
 
+import math
 import warnings
 from dataclasses import replace
 
@@ -114,7 +115,10 @@ class PRKIntegrator(IntegratorBase, mm.CustomIntegrator):
         self._nonconverged_seen = 0
 
     def _before_step(self):
-        if not self._checked_context:
+        # the probe flag is back at 0 on a Context that has not stepped yet, also after Context.reinitialize(), which
+        # drops the per-DOF values set while bound (the thermostat's mask, exact_momentum's masses): set them again
+        # before this call's steps, so that its thermostat events run from its first step
+        if not self._checked_context or not self.getGlobalVariableByName(program.PROBED_VAR):
             self._check_context()
         stored = self.getGlobalVariable(0)
         if stored != self.program_info.signature:
@@ -125,6 +129,19 @@ class PRKIntegrator(IntegratorBase, mm.CustomIntegrator):
                 f"native backend was loaded. Create the integrator as it was when the checkpoint was saved (a native "
                 f"checkpoint needs backend='native'), load the checkpoint into that one, or load a State "
                 f"(positions and velocities) instead.")
+        if self.thermostat is not None:
+            self._keep_thermostat_settings()
+
+    def _keep_thermostat_settings(self):
+        """Give the program the integrator's current temperature and collision time if a checkpoint (or a State's
+        integrator parameters) brought back the ones it was saved with: as OpenMM's own thermostatted integrators,
+        whose temperature is the integrator's and not the Context's, and as the native backend."""
+        get = self.getGlobalVariableByName
+        held = (get(thermostat_program.TEMPERATURE_VAR), get(thermostat_program.COLLISION_TIME_VAR))
+        # (a single-precision platform holds the globals as floats: compare to that precision)
+        if not all(math.isclose(a, b, rel_tol=1e-6) for a, b in
+                   zip(held, (self.thermostat.temperature, self.thermostat.collision_time))):
+            self._apply_thermostat(self.thermostat)
 
     def _check_context(self):
         """First step on a Context: its particle count against ``system=`` (read from a per-DOF variable the
@@ -177,6 +194,9 @@ class PRKIntegrator(IntegratorBase, mm.CustomIntegrator):
 
     def _heat_bath_energy(self) -> float:
         return self.getGlobalVariableByName(thermostat_program.HEAT_BATH_VAR)
+
+    def _thermostat_kinetic_energy(self) -> float:
+        return thermostat_program.event_kinetic_energy(self)
 
     def _after_step(self):
         if self.thermostat is not None and self.getGlobalVariableByName(thermostat_program.LOST_MASK_VAR):
@@ -274,7 +294,7 @@ class PRKIntegrator(IntegratorBase, mm.CustomIntegrator):
         if r.is_mts:
             lines.append("  " + r.describe_levels())
         if self.thermostat is not None:
-            lines.append("  " + self._thermostat_values().describe())
+            lines.append("  " + self._thermostat_values().describe(r.thermostat_position))
         return "\n".join(lines)
 
 
