@@ -120,8 +120,9 @@ def test_thermostat_position_is_passed_only_when_asked():
         with pytest.raises(TypeError, match="thermostat_position"):
             Row.parse("verlet 2 fs SVR 0.1 ps middle").build(system)
         pytest.skip("SymplecticIntegrator has no thermostat_position yet")
-    ig = Row.parse("verlet 2 fs SVR 0.1 ps middle").build(system)
+    ig = Row.parse("verlet 2 fs SVR 0.1 ps middle custom").build(system)
     assert ig.options.thermostat.position == "middle"
+    assert Row.parse("verlet 2 fs SVR 0.1 ps custom").build(system).options.thermostat.position == "ends"
 
 
 def test_leapfrog_state_lags_half_a_step():
