@@ -29,7 +29,7 @@ def _cmd_demo(args):
     from .studies.demo import run_demo
 
     run_demo(methods=args.method, n_waters=args.waters, steps=args.steps, step_fs=args.step_fs,
-             platform=_platform_name(args.platform), backend=args.backend)
+             platform=None if args.platform is None else _platform_name(args.platform), backend=args.backend)
 
 
 def _cmd_methods(args):
@@ -120,12 +120,13 @@ def build_parser():
     p = argparse.ArgumentParser(prog="symprk", description="Symplectic PRK integrators for OpenMM")
     sub = p.add_subparsers(dest="command", required=True)
 
-    d = sub.add_parser("demo", help="spinning rigid-water cluster: conservation vs OpenMM's Verlet")
-    d.add_argument("--method", nargs="+", default=["verlet", "yoshida-4"], help="catalogue names")
+    d = sub.add_parser("demo", help="spinning rigid-water cluster: conservation vs OpenMM's Verlet and Langevin")
+    d.add_argument("--method", nargs="+", default=None,
+                   help="catalogue names, each an NVE row beside OpenMM's Verlet (default: the demo's rows)")
     d.add_argument("--waters", type=positive(int), default=64)
     d.add_argument("--steps", type=positive(int), default=2000)
     d.add_argument("--step-fs", type=positive(float), default=2.0)
-    d.add_argument("--platform", default="Reference")
+    d.add_argument("--platform", default=None, help="default: CPU (Reference where CPU is missing)")
     d.add_argument("--backend", default="auto", choices=("auto", "native", "custom"))
     d.set_defaults(func=_cmd_demo)
 

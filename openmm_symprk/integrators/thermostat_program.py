@@ -27,7 +27,8 @@ from .projection import emit_inertia, emit_rigid_solve, emit_second_moments
 from .thermostat import ThermostatSettings
 
 __all__ = ["PREFIX", "LOST_MASK_VAR", "TEMPERATURE_VAR", "COLLISION_TIME_VAR", "HEAT_BATH_VAR", "MASK_VAR", "ALPHA_VAR",
-           "KINETIC_VAR", "NEW_KINETIC_VAR", "add_variables", "emit_half_event", "mask_values"]
+           "KINETIC_VAR", "NEW_KINETIC_VAR", "add_variables", "emit_half_event", "emit_event", "mask_values",
+           "TOTAL_KINETIC_VAR", "event_kinetic_energy"]
 
 PREFIX = "symprk_ts_"
 TEMPERATURE_VAR = PREFIX + "temperature"  # K
@@ -40,6 +41,10 @@ NEW_KINETIC_VAR = PREFIX + "knew"  # and after
 #: set to 1 by an event that found the mask without its dof - 1 ones (a Context reinitialized without its state
 #: loses per-DOF values set while bound): the event then does nothing, and the integrator fills the mask again
 LOST_MASK_VAR = PREFIX + "lost_mask"
+
+#: the total kinetic energy before the last event (kJ/mol); with KINETIC_VAR and NEW_KINETIC_VAR it gives the
+#: kinetic energy at the thermostat point (:func:`event_kinetic_energy`)
+TOTAL_KINETIC_VAR = PREFIX + "K"
 
 _AXES = ("x", "y", "z")
 _PAIRS = ("xx", "yy", "zz", "xy", "yz", "zx")
@@ -141,7 +146,13 @@ def _emit_rotation(ig):
 
 
 def emit_half_event(integrator: mm.CustomIntegrator, settings: ThermostatSettings) -> None:
-    """Append one half thermostat event (relaxation factor c = exp(-(n dt/2)/tau))."""
+    """Append one half thermostat event (relaxation factor c = exp(-(n dt/2)/tau)): the ends placement."""
+    emit_event(integrator, settings, 0.5)
+
+
+def emit_event(integrator: mm.CustomIntegrator, settings: ThermostatSettings, fraction: float) -> None:
+    """Append one thermostat event over ``fraction`` of the step (c = exp(-fraction n dt/tau)): 0.5 at each end of
+    the step, 1 for the one event of the middle placement."""
     ig = integrator
     v = _v
     rot = settings.keep_rotation
@@ -160,7 +171,7 @@ def emit_half_event(integrator: mm.CustomIntegrator, settings: ThermostatSetting
     # the noise, and (alpha, K') as physics.velocity_rescaling.rescaling_factor writes them
     ig.addComputeGlobal(v("r1"), "gaussian")
     ig.addComputeSum(v("chi2"), f"gaussian*gaussian*{MASK_VAR}")
-    ig.addComputeGlobal(v("c"), f"exp(-{_num(0.5 * settings.interval)}*dt/{COLLISION_TIME_VAR})")
+    ig.addComputeGlobal(v("c"), f"exp(-{_num(fraction * settings.interval)}*dt/{COLLISION_TIME_VAR})")
     ig.addComputeGlobal(v("s"), f"{_num(0.5 * dof * R_KJ)}*{TEMPERATURE_VAR}/{dof}")  # target / dof
     c, s, r1, chi2 = v("c"), v("s"), v("r1"), v("chi2")
     # the mask holds its dof - 1 ones (else the Context lost it: do nothing and say so), and K_pec > 0
@@ -181,3 +192,11 @@ def emit_half_event(integrator: mm.CustomIntegrator, settings: ThermostatSetting
     else:
         u = _comb("Vx", "Vy", "Vz")
     ig.addComputePerDof("v", f"select(m, {u} + {alpha}*(v - {u}), v)")
+
+
+def event_kinetic_energy(integrator: mm.CustomIntegrator) -> float:
+    """The total kinetic energy (kJ/mol) just after the last thermostat event: the kept part (centre-of-mass
+    motion, and rigid rotation of an isolated System), which an event leaves alone, plus the peculiar part the event
+    drew.  0 before the first event."""
+    get = integrator.getGlobalVariableByName
+    return float(get(TOTAL_KINETIC_VAR) - get(KINETIC_VAR) + get(NEW_KINETIC_VAR))
