@@ -79,6 +79,7 @@ def _restore_custom(integrator: mm.CustomIntegrator):
     # the program holds the temperature and collision time as they were last set (the metadata: as created)
     obj.thermostat = obj._thermostat_values()
     obj._reset_binding()
+    obj._forget_run_state()
     return obj
 
 

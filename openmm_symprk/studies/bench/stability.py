@@ -65,7 +65,7 @@ def linear_probe(spec: RunSpec, scene):
     rec = base_record(spec, probe_scene, platform)
     rec.n_oscillators = len(omega)
     try:
-        ig, evals, _ = make_integrator(spec.method, spec.h_ps, probe_scene, spec.seed, temperature=0.0)
+        ig, evals, _ = make_integrator(spec.method, spec.step_fs, probe_scene, spec.seed, temperature=0.0)
     except Unsupported as exc:
         rec.update(status="unsupported", failure=str(exc).split(". ")[0])
         return rec

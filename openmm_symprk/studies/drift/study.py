@@ -45,10 +45,9 @@ def check(cfg: dict):
             raise ValueError(f"row {row['name']}: unknown scene {row['scene']!r}; known: {', '.join(SCENES)}")
         if not float(row["step_fs"]) > 0:
             raise ValueError(f"row {row['name']}: step_fs must be positive, got {row['step_fs']!r}")
-        if row["integrator"] != "openmm-verlet":
-            from ...methods.catalogue import get_method
+        from .runs import row_of
 
-            get_method(row["integrator"])  # UnknownMethodError names the catalogue
+        row_of(row)  # ValueError naming the catalogue and OpenMM's integrators
         n = float(cfg["length_ps"]) * 1e3 / float(row["step_fs"])
         if round(n) < 3:
             raise ValueError(f"row {row['name']}: {cfg['length_ps']} ps is under 3 steps of {row['step_fs']} fs")
