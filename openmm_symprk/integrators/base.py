@@ -70,6 +70,7 @@ def _restore(cls, xml: str, state: dict):
     obj._adopt(mm.XmlSerializer.deserialize(xml))
     obj.__dict__.update(state)
     obj._reset_binding()
+    obj._forget_run_state()
     return obj
 
 
@@ -258,6 +259,11 @@ class IntegratorBase:
 
     def _reset_binding(self):
         """Forget per-Context facts (a copy is not bound to any Context)."""
+
+    def _forget_run_state(self):
+        """Give a copy the run-time values of a fresh integrator (heat bath, step counter, first-step flags), which the
+        XML of an integrator that has run carries: a copy with the same settings and seed then runs the trajectory a
+        new integrator would (a checkpoint, not a copy, is what continues a run)."""
 
     def __reduce__(self):
         return _restore, (type(self), mm.XmlSerializer.serialize(self), self._python_state())

@@ -103,6 +103,22 @@ class PRKIntegrator(IntegratorBase, mm.CustomIntegrator):
         self.options = options
         self.program_info = info
 
+    def _forget_run_state(self, per_dof: bool = True):
+        """Every variable at the value a freshly compiled program has, but the signature (global 0), the metadata and
+        the thermostat's temperature and collision time (settings, which a copy keeps as they were last set).
+        ``per_dof=False``: the global variables only (a bound integrator, whose per-DOF values the Context sized)."""
+        options = self.options
+        has_sites = options.system.virtual_sites if options.system is not None else True
+        fresh = mm.CustomIntegrator(options.step_size)
+        program.compile_program(fresh, self.resolved, options, has_sites)
+        kept = {program.SIGNATURE_VAR, thermostat_program.TEMPERATURE_VAR, thermostat_program.COLLISION_TIME_VAR}
+        for i in range(fresh.getNumGlobalVariables()):
+            name = fresh.getGlobalVariableName(i)
+            if name not in kept:
+                self.setGlobalVariableByName(name, fresh.getGlobalVariable(i))
+        for i in range(fresh.getNumPerDofVariables() if per_dof else 0):
+            self.setPerDofVariableByName(fresh.getPerDofVariableName(i), fresh.getPerDofVariable(i))
+
     # -- per-Context checks ----------------------------------------------------------------------------
     _transient = IntegratorBase._transient + ("_context_ref",)
 
@@ -113,13 +129,17 @@ class PRKIntegrator(IntegratorBase, mm.CustomIntegrator):
         self._checked_context = False
         self._checked_probe = False
         self._nonconverged_seen = 0
+        self._step_count = None  # the Context's step count after the last call (thermostat, exact_momentum)
 
     def _before_step(self):
-        # the probe flag is back at 0 on a Context that has not stepped yet, also after Context.reinitialize(), which
-        # drops the per-DOF values set while bound (the thermostat's mask, exact_momentum's masses): set them again
-        # before this call's steps, so that its thermostat events run from its first step
-        if not self._checked_context or not self.getGlobalVariableByName(program.PROBED_VAR):
+        if not self._checked_context:
             self._check_context()
+        elif self._bound_values_may_be_lost():
+            if self._bound_context().getStepCount() == 0:
+                # Context.reinitialize(): a new run, as on the native backend (heat bath, step counter, first-step
+                # probe as a fresh integrator has them; the random stream starts again from the seed)
+                self._forget_run_state(per_dof=False)
+            self._check_context()  # per-DOF values set while bound were dropped: set them again before stepping
         stored = self.getGlobalVariable(0)
         if stored != self.program_info.signature:
             raise CheckpointMismatchError(
@@ -142,6 +162,21 @@ class PRKIntegrator(IntegratorBase, mm.CustomIntegrator):
         if not all(math.isclose(a, b, rel_tol=1e-6) for a, b in
                    zip(held, (self.thermostat.temperature, self.thermostat.collision_time))):
             self._apply_thermostat(self.thermostat)
+
+    def _bound_values_may_be_lost(self) -> bool:
+        """Whether the Context may have dropped the per-DOF values set while bound (the thermostat's mask,
+        exact_momentum's masses): ``Context.reinitialize()`` keeps the integrator's global variables but not those,
+        and sets the Context's step count to 0.  So: the step count is not the one the last call left (also after
+        setStepCount, a checkpoint or a State: then the check finds the values in place and changes nothing)."""
+        if self._step_count is None:
+            return False
+        context = self._bound_context()
+        return context is not None and context.getStepCount() != self._step_count
+
+    def _remember_step_count(self):
+        if self._masses is not None:  # only the thermostat and exact_momentum set per-DOF values while bound
+            context = self._bound_context()
+            self._step_count = context.getStepCount() if context is not None else None
 
     def _check_context(self):
         """First step on a Context: its particle count against ``system=`` (read from a per-DOF variable the
@@ -199,14 +234,16 @@ class PRKIntegrator(IntegratorBase, mm.CustomIntegrator):
         return thermostat_program.event_kinetic_energy(self)
 
     def _after_step(self):
+        self._remember_step_count()
         if self.thermostat is not None and self.getGlobalVariableByName(thermostat_program.LOST_MASK_VAR):
             # the Context was reinitialized without its state (per-DOF values set while bound are lost): the
             # events of this call did nothing (alpha = 1); fill the mask again for the next steps
             self.setGlobalVariableByName(thermostat_program.LOST_MASK_VAR, 0.0)
             self._set_thermostat_mask(len(self.getPerDofVariableByName(program.PROBE_PER_DOF)))
             warnings.warn(f"{type(self).__name__}({self.method_name}): the thermostat's per-DOF mask was lost (the "
-                          f"Context was reinitialized without preserving its state), so the steps of this call ran "
-                          f"without the thermostat; it is restored for the next steps.", RuntimeWarning, stacklevel=3)
+                          f"Context was reinitialized without preserving its state, and the integrator could not find "
+                          f"its Context to notice before stepping), so the steps of this call ran without the "
+                          f"thermostat; it is restored for the next steps.", RuntimeWarning, stacklevel=3)
         if not self._checked_probe:
             self._checked_probe = True
             if self.getGlobalVariableByName(program.PROBE_CONSTRAINTS_VAR) > 0 and not self.program_info.rattle:
