@@ -394,8 +394,14 @@ def test_temperature_changes_mid_run_and_the_rest_is_refused_clearly(water8):
         raw.setThermostat(-3, 0.1, 1, 10, False)
     with pytest.raises(mm.OpenMMException, match="collision time is 0 ps"):
         raw.setThermostat(300, 0, 1, 10, False)
-    with pytest.raises(mm.OpenMMException, match="interval is 0 steps"):
+    with pytest.raises(mm.OpenMMException, match=r"interval \(thermostat_interval\) is 0 steps; expected .* from 1 to 2147483647"):
         raw.setThermostat(300, 0.1, 0, 10, False)
+    # issue 27 #5: beyond a 32-bit int, the plugin's own message (not SWIG's OverflowError)
+    with pytest.raises(mm.OpenMMException, match=r"thermostat_interval\) is 1000000000000 steps; expected .* to 2147483647"):
+        raw.setThermostat(300, 0.1, 10**12, 10, False)
+    largest = swig.SymPRKIntegrator(0.001)
+    largest.setThermostat(300, 0.1, 2**31 - 1, 10, False)
+    assert largest.getThermostatInterval() == 2**31 - 1
     with pytest.raises(mm.OpenMMException, match="0 degrees of freedom"):
         raw.setThermostat(300, 0.1, 1, 0, False)
     with pytest.raises(mm.OpenMMException, match="no thermostat"):

@@ -81,7 +81,7 @@ def test_an_installed_but_broken_package_reports_why(tmp_path, monkeypatch):
 
 @pytest.mark.parametrize("module, extra, message", [
     ("numpy", "analysis", "'numpy' is not an optional dependency"),
-    ("tqdm", "analysis", "the extra 'analysis' does not install tqdm (it is in 'studies', 'all')"),
+    ("pymbar", "analysis", "the extra 'analysis' does not install pymbar (it is in 'studies', 'all')"),
     ("MDAnalysis", "analysys", "the extra 'analysys' does not install MDAnalysis"),
 ])
 def test_a_wrong_call_is_a_value_error(module, extra, message):
