@@ -24,6 +24,7 @@ import numpy as np
 import openmm as mm
 
 from ..conservation.diagnostics import angular_momentum, linear_momentum
+from ..support.files import write_text
 from .core.rows import Row
 from .timing import interleaved
 
@@ -197,8 +198,7 @@ def main(argv=None) -> int:
     text = "\n".join(parts)
     print(text)
     if args.out:
-        with open(args.out, "w") as fh:
-            fh.write(text + "\n")
+        write_text(args.out, text + "\n")
     return 0
 
 

@@ -43,7 +43,7 @@ from ...systems.properties import constraint_violation
 from ...stats import drift
 from . import measure
 from .records import RunRecord
-from ...systems.scene import Scene
+from ...systems.scenes import Scene
 from ..core.rows import Row
 
 #: Constraint tolerance for every run (SETTLE ignores it; CCMA iterates to it) ...
@@ -278,7 +278,7 @@ def _measure(spec, scene, ctx, ig, rec, arrays):
     completed = done == spec.n_steps and not rec.blew_up
     if completed:
         if scene.exact is not None:
-            from .toys import exact_state
+            from ...systems.scenes.toys import exact_state
 
             xe, _ = exact_state(scene.exact, spec.length_ps)
             rec.traj_error = measure.rms_deviation(x, xe)

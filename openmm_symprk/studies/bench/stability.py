@@ -44,7 +44,7 @@ _probe_systems: dict = {}
 
 
 def _dense_harmonic(omega_max: float):
-    from . import toys
+    from ...systems.scenes import toys
 
     key = float(omega_max)
     if key not in _probe_systems:
@@ -55,7 +55,7 @@ def _dense_harmonic(omega_max: float):
 
 def linear_probe(spec: RunSpec, scene):
     """One step of ``spec.method`` on the dense harmonic spectrum; fails if the one-step map grows."""
-    from ...systems.scene import Scene
+    from ...systems.scenes import Scene
 
     omega_max = scene.linear["omega_max"]
     omega, system = _dense_harmonic(omega_max)

@@ -53,7 +53,8 @@ def _evals(method):
 # -- scenes --------------------------------------------------------------------------------------
 def prepare_scenes(config: dict, out: str, reuse: bool = True, log=print) -> dict:
     """Build (or, with ``reuse``, load the saved copy of) every scene of ``config``."""
-    from .registry import build, load_scene, save_scene, user_scene
+    from ...systems.scenes import load_scene, save_scene
+    from ...systems.scenes.named import build, user_scene
 
     folder = os.path.join(out, "scenes")
     result = {}
@@ -129,7 +130,7 @@ _scenes: dict = {}
 def work(payload: dict, spec_dict: dict):
     """One spec in whatever process executes it (each scene is rebuilt from its payload once per process);
     returns (record, arrays)."""
-    from ...systems.scene import Scene
+    from ...systems.scenes import Scene
     from .stability import run_spec
 
     key = (payload["info"]["name"], payload["fingerprint"])

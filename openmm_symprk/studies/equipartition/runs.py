@@ -17,8 +17,7 @@ from ...physics.momenta import kinetic_energy
 from ...physics.temperature import kinetic_temperatures
 from ...rigid.bodies import RigidBodies
 from ...systems.prepare import equilibrate, minimise, without_net_momentum
-from ...systems.scene import Scene
-from ...systems.scenes import WATER_DENSITY_G_CM3, water_box
+from ...systems.scenes import WATER_DENSITY_G_CM3, Scene, water_box
 from ..core.rows import Row
 
 __all__ = ["build_box", "replica_states", "run_nve", "steps_per_sample", "force_evals_per_step", "make_engine"]

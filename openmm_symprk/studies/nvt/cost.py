@@ -36,13 +36,13 @@ def default_rows() -> list:
 def scene(name: str, quick: bool):
     """(title, system, positions, velocities) of a cost scene; ``quick``: a small water box / short equilibration."""
     from ...systems.forcegroups import split_forces
-    from ..bench import registry
+    from ...systems.scenes import named
 
     if name == "water":
-        sc = registry.water_box_pme(box_nm=2.2 if quick else 3.9)
+        sc = named.water_box_pme(box_nm=2.2 if quick else 3.9)
         split_forces(sc.system, slow="reciprocal")
     elif name == "villin":
-        sc = registry.villin_pme(equilibrate_ps=0.02 if quick else 0.2)
+        sc = named.villin_pme(equilibrate_ps=0.02 if quick else 0.2)
     else:
         raise ValueError(f"unknown cost scene {name!r}; known: water, villin")
     return f"{sc.name}: {sc.description}", sc.system, sc.positions, sc.velocities
