@@ -39,7 +39,7 @@ import openmm.unit as unit
 from ..physics import momenta
 from ..physics.temperature import kinetic_temperatures
 from ..support import require
-from ..stats.drift import RunningLine
+from ..stats.slope import RunningLine
 from ..systems.checks import conservation_issues, integrator_issues, warn_conservation, warn_once
 from ..systems.properties import constraint_arrays, constraint_violation, degrees_of_freedom, masses, molecules
 from ..systems.virtual_sites import VirtualSiteVelocities
