@@ -13,10 +13,11 @@ as pure-numpy functions of arrays (nm, ps, Da), each with known-answer tests in 
 - :mod:`.literature` - constants and published model data (viscosities) with their sources.
 
 The study (``symprk fidelity``, docs/fidelity.md) is built on them and on the study skeleton: :mod:`.presets`
-(its settings and rows, data), :mod:`.rows` (a row made into a running OpenMM integrator), :mod:`.runs` (one run:
-frames at the cadence each observable needs), :mod:`.observe` (every observable of one run), :mod:`.study`
-(:class:`~.study.FidelityStudy`, replica states shared with the equipartition study), :mod:`.report` (tables,
-pairing, the extrapolated reference, verdicts, chart) and :mod:`.cli`.  Only the pure modules are imported here.
+(its settings and rows, data), :mod:`.simulation.engines` (a row made into a running OpenMM integrator),
+:mod:`.simulation.runs` (one run: frames at the cadence each observable needs), :mod:`.observe` (every observable
+of one run), :mod:`.simulation.study` (:class:`~.simulation.study.FidelityStudy`, replica states shared with the
+equipartition study), :mod:`.report` (tables, pairing, the extrapolated reference, verdicts, chart) and
+:mod:`.cli`.  Only the pure modules are imported here.
 """
 from . import angular, correlation, diffusion, extrapolation, literature, molecules, presets, reorientation, structure
 
