@@ -267,7 +267,7 @@ class BinaryDistribution(Distribution):
 #: Optional dependencies by use; the core (integrators, methods, rigid bodies, diagnostics, `symprk demo`) needs
 #: only openmm, numpy and scipy.  The package names the extra in its error when a missing one is used.
 EXTRAS = {
-    "analysis": ["MDAnalysis>=2.7", "scipy>=1.10"],
+    "analysis": ["MDAnalysis>=2.7", "scipy>=1.10", "tqdm>=4.60"],
     "studies": ["matplotlib>=3.7", "tqdm>=4.60", "pymbar>=4", "scipy>=1.10", "MDAnalysis>=2.7"],
     "cluster": ["dask[distributed]>=2023.1"],
     "cuda12": ["openmm-cuda-12>=8.6,<8.7"],
@@ -275,7 +275,9 @@ EXTRAS = {
     "docs": ["sphinx>=8,<10", "myst-parser>=4", "furo>=2024.1"],
 }
 EXTRAS["all"] = sorted(set(EXTRAS["analysis"] + EXTRAS["studies"]))
-EXTRAS["test"] = sorted(set(["pytest>=7", "pyelftools>=0.29"] + EXTRAS["all"] + EXTRAS["cluster"]))
+#: The test-suite cross-checks the analyses against MDAnalysis' test files and the MDAKits that compute the same.
+CROSS_CHECKS = ["MDAnalysisTests>=2.7", "waterdynamics>=1.2", "transport-analysis>=0.1.2", "tidynamics>=1.1"]
+EXTRAS["test"] = sorted(set(["pytest>=7", "pyelftools>=0.29"] + EXTRAS["all"] + EXTRAS["cluster"] + CROSS_CHECKS))
 
 if __name__ == "__main__":
     setup(

@@ -1,5 +1,5 @@
-"""The ``symprk`` command: demo, methods, check, info, and the studies (bench, conservation, speed,
-equipartition, fidelity, drift).
+"""The ``symprk`` command: demo, methods, check, info, observe (a trajectory's water observables), and the
+studies (bench, conservation, speed, equipartition, fidelity, drift).
 
 Every error the user can cause (a bad name, file, platform, value, a blow-up) ends in one line on stderr
 and a non-zero exit status; only a bug shows a traceback.
@@ -152,7 +152,8 @@ def build_parser():
 DELEGATED = {"bench": "openmm_symprk.studies.bench.cli", "conservation": "openmm_symprk.studies.conservation_table",
              "speed": "openmm_symprk.studies.native_speed", "gpucheck": "openmm_symprk.studies.gpucheck",
              "equipartition": "openmm_symprk.studies.equipartition.cli", "fidelity": "openmm_symprk.studies.fidelity.cli",
-             "nvt": "openmm_symprk.studies.nvt.cli", "drift": "openmm_symprk.studies.drift.cli"}
+             "nvt": "openmm_symprk.studies.nvt.cli", "drift": "openmm_symprk.studies.drift.cli",
+             "observe": "openmm_symprk.analysis.cli"}
 DELEGATED_HELP = {"bench": "work-precision and stability sweeps (symprk bench --help)",
                   "conservation": "conservation table: platform x method x projection (symprk conservation --help)",
                   "speed": "native backend vs OpenMM's VerletIntegrator, time per step (symprk speed --help)",
@@ -162,7 +163,9 @@ DELEGATED_HELP = {"bench": "work-precision and stability sweeps (symprk bench --
                               "thermostat (symprk fidelity --help)",
                   "nvt": "thermostat: cost vs LangevinMiddleIntegrator, effective-energy drift (symprk nvt --help)",
                   "drift": "NVE energy drift over replicas, paired rows, verdict at 3 SE: hmr, exact-momentum "
-                           "(symprk drift --help)"}
+                           "(symprk drift --help)",
+                  "observe": "water observables of any trajectory (diffusion, reorientation, omega ACF, T_trans/T_rot, "
+                             "g(r)) with errors (symprk observe --help)"}
 
 
 def _user_errors():

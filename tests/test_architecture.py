@@ -12,7 +12,7 @@ import openmm_symprk
 ROOT = os.path.dirname(openmm_symprk.__file__)
 #: Layer of each sub-package (a module may import from lower layers and from its own sub-package).
 LAYERS = {"support": 0, "methods": 1, "physics": 1, "stats": 1, "plugin": 1, "systems": 2, "integrators": 3,
-          "conservation": 4, "rigid": 4, "studies": 5, "cli": 6}
+          "conservation": 4, "rigid": 4, "analysis": 5, "studies": 6, "cli": 7}
 PURE = ("support", "methods", "physics", "stats")
 
 

@@ -1,5 +1,7 @@
 """MDAnalysis analysis of momentum conservation on stored trajectories (with velocities).
 
+(The kinetic temperatures of molecules on a trajectory are :class:`openmm_symprk.analysis.universe.KineticTemperatures`.)
+
     import MDAnalysis as mda
     from openmm_symprk.conservation.analysis import AngularMomentum, LinearMomentum, universe
     u = universe(topology, "traj.trr", system=system)      # or mda.Universe("top.pdb", "traj.trr")
@@ -31,13 +33,13 @@ import numpy as np
 import openmm as mm
 import openmm.unit as unit
 
-from ..physics import momenta, temperature
+from ..physics import momenta
 from ..support import require
 from ..systems.properties import masses as system_masses
 
 AnalysisBase = require("MDAnalysis.analysis.base", "analysis", "openmm_symprk.conservation.analysis").AnalysisBase
 
-__all__ = ["LinearMomentum", "AngularMomentum", "KineticTemperatures", "universe", "FLOAT32_FLOOR"]
+__all__ = ["LinearMomentum", "AngularMomentum", "universe", "group_masses", "subgroups", "FLOAT32_FLOOR"]
 
 #: Relative resolution of momentum figures recomputed from a float32 trajectory (documented above).
 FLOAT32_FLOOR = 1e-7
@@ -45,7 +47,9 @@ FLOAT32_FLOOR = 1e-7
 _A = 0.1  # Angstrom -> nm
 
 
-def _masses(atomgroup, masses):
+def group_masses(atomgroup, masses=None) -> np.ndarray:
+    """Masses (amu) of the atoms of ``atomgroup``: its own (None), the ``openmm.System``'s, or an array (one per
+    atom of the group or of the whole Universe)."""
     if masses is None:
         return np.asarray(atomgroup.masses, dtype=np.float64)
     if isinstance(masses, mm.System):
@@ -59,8 +63,8 @@ def _masses(atomgroup, masses):
     return m
 
 
-def _groups(atomgroup, by):
-    """Index arrays (into atomgroup) of the sub-groups, or None."""
+def subgroups(atomgroup, by):
+    """Index arrays (into ``atomgroup``) of its ``by`` = "residues", "fragments" or "segments", or None for None."""
     if by is None:
         return None
     if by not in ("residues", "fragments", "segments"):
@@ -81,9 +85,9 @@ class _MomentumBase(AnalysisBase):
     def __init__(self, atomgroup, masses=None, by=None, **kwargs):
         super().__init__(atomgroup.universe.trajectory, **kwargs)
         self._ag = atomgroup
-        self._m = _masses(atomgroup, masses)
+        self._m = group_masses(atomgroup, masses)
         self._by = by
-        self._sub = _groups(atomgroup, by)
+        self._sub = subgroups(atomgroup, by)
 
     def _state(self):
         ts = self._ts
@@ -154,45 +158,6 @@ class AngularMomentum(_MomentumBase):
 
     def _scale(self):
         return float(np.linalg.norm(self.results.total[0])) if len(self.results.total) else 0.0
-
-
-class KineticTemperatures(_MomentumBase):
-    """Translational, rotational and internal kinetic temperature (K) of the molecules per frame.
-
-    Molecules are the group's ``fragments`` (bonded components; :func:`universe` gives them bonds), or its
-    ``residues`` with ``by="residues"``.  ``momentum_fixed`` (default True): the run conserved or removed the
-    total momentum, so translation has 3 N_mol - 3 degrees of freedom; ``constraints``: the number of distance
-    constraints inside the molecules (pass the ``openmm.System`` as ``masses=`` and it is taken from there).
-    Results: ``translational``, ``rotational``, ``internal``, ``difference`` (rotational - translational), one
-    value per frame, and their means ``mean_translational`` ...  Molecules must be whole in the trajectory
-    (:class:`~.reporters.VelocityTRRReporter` writes them so); float32 storage limits each value to ~1e-7
-    relative, far below the statistical spread of a kinetic temperature."""
-
-    def __init__(self, atomgroup, masses=None, by: str = "fragments", momentum_fixed: bool = True,
-                 constraints: int | None = None, **kwargs):
-        super().__init__(atomgroup, masses=masses, by=by, **kwargs)
-        self._fixed = momentum_fixed
-        if constraints is None and isinstance(masses, mm.System):
-            constraints = masses.getNumConstraints()
-        self._constraints = constraints or 0
-
-    def _prepare(self):
-        for key in ("translational", "rotational", "internal", "difference"):
-            self.results[key] = np.zeros(self.n_frames)
-
-    def _single_frame(self):
-        x, v = self._state()
-        t = temperature.kinetic_temperatures(x, v, self._m, [list(g) for g in self._sub], self._fixed,
-                                             self._constraints)
-        i = self._frame_index
-        self.results.translational[i], self.results.rotational[i] = t.translational, t.rotational
-        self.results.internal[i], self.results.difference[i] = t.internal, t.difference
-        self.results.dof = {"translational": t.translational_dof, "rotational": t.rotational_dof,
-                            "internal": t.internal_dof}
-
-    def _conclude(self):
-        for key in ("translational", "rotational", "internal", "difference"):
-            self.results[f"mean_{key}"] = float(np.mean(self.results[key])) if self.n_frames else float("nan")
 
 
 def universe(topology, trajectory=None, system: mm.System | None = None, positions=None):

@@ -39,20 +39,22 @@ def resolve_for_system(where: str, method, system, options: IntegratorOptions, n
 
     The constraint facts come from ``options.constraints``, else from the System (without one kick/drift methods
     keep RATTLE steps); the System is checked for anything that breaks conservation (one warning per kind, less
-    ``skip_checks``) and against the force groups of multiple time stepping.  ``name`` overrides the method's name.
+    ``skip_checks``) and against the force groups of multiple time stepping.  With a thermostat, the method is
+    resolved with its placement (``options.thermostat.position``: a "middle" one is a THERMOSTAT sub-step).  ``name`` overrides the method's name.
     ``splittings_only``: the backend runs kick/drift methods only; a general PRK pair raises NativeMethodError with
     this hint."""
     facts = options.system
     constraints = options.constraints
     if constraints is None and facts is not None:
         constraints = facts.constraints
+    position = options.thermostat.position if options.thermostat is not None else None
     try:
         resolved = resolve(method, constraints=constraints, groups=options.groups, inner_method=options.inner_method,
-                           name=name)
+                           name=name, thermostat_position=position)
     except ConstraintSupportError:
         if splittings_only is None:
             raise
-        resolved = resolve(method, name=name)
+        resolved = resolve(method, name=name, thermostat_position=position)
     if splittings_only is not None and not resolved.is_splitting:
         raise NativeMethodError(
             f"method {resolved.name!r} is a general ({resolved.family or resolved.form}) PRK tableau; "

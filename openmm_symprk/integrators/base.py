@@ -17,19 +17,22 @@ program of :mod:`.custom_backend` or the plugin's SymPRKIntegrator of :mod:`.nat
 
 * the thermostat's accessors (``temperature=`` of :func:`.thermostat.thermostat_settings`), in OpenMM's idiom:
   ``getTemperature``/``setTemperature``, ``getCollisionTime``/``setCollisionTime``, ``getThermostatInterval``,
-  ``setRandomNumberSeed`` (checked), ``computeHeatBathEnergy``, ``thermostat_dof`` /
+  ``setRandomNumberSeed`` (checked), ``computeHeatBathEnergy``, ``thermostat_kinetic_energy`` (the kinetic energy
+  at the thermostat point), ``thermostat_position``, ``thermostat_dof`` /
   ``getThermostatDegreesOfFreedom``; ``thermostat`` holds the :class:`.thermostat.ThermostatSettings` (None:
   NVE).
 
 Backends implement the hooks ``_blowup_step()``, ``_clear_blowup()``, ``_raw_steps_taken()`` and may
 override ``_before_step()`` / ``_after_step()``; with a thermostat, ``_heat_bath_energy()`` (kJ/mol) and
-``_apply_thermostat(settings)`` (give the running program a new temperature or collision time), and may
+``_apply_thermostat(settings)`` (give the running program a new temperature or collision time),
+``_thermostat_kinetic_energy()`` (kJ/mol, after the last event), and may
 override ``_thermostat_values()`` where the program holds them (a checkpoint may bring back older ones).
 """
 from __future__ import annotations
 
 import math
 import operator
+import warnings
 
 import openmm as mm
 import openmm.unit as unit
@@ -68,6 +71,7 @@ def _restore(cls, xml: str, state: dict):
     obj._adopt(mm.XmlSerializer.deserialize(xml))
     obj.__dict__.update(state)
     obj._reset_binding()
+    obj._forget_run_state()
     return obj
 
 
@@ -110,7 +114,32 @@ class IntegratorBase:
                 self._clear_blowup()
                 raise self._blow_up(bad, self._blowup_what())
         self._after_step()
+        self._check_skipped_events()
         return result
+
+    def _check_skipped_events(self):
+        """Warn once per integrator where thermostat events found no peculiar kinetic energy to scale."""
+        if self.thermostat is None or self.__dict__.get("_warned_no_peculiar"):
+            return
+        n = self._skipped_thermostat_events()
+        if n and self._still():  # (a 1-dof vibration passes through K_pec ~ 0 at its turning points, then goes on)
+            self._warned_no_peculiar = True
+            kept = "translation and rotation" if self.thermostat.keep_rotation else "translation"
+            warnings.warn(
+                f"{type(self).__name__}({self.method_name}): {n} thermostat event(s) found no peculiar kinetic energy "
+                f"to scale: the velocities are all zero, or one rigid motion (centre-of-mass {kept}), which the "
+                f"thermostat keeps, so it cannot bring the system to {self.thermostat.temperature:g} K (velocity "
+                f"rescaling scales the motion it finds and makes none). Start the run with velocities drawn at the "
+                f"temperature, e.g. context.setVelocitiesToTemperature({self.thermostat.temperature:g}*unit.kelvin).",
+                RuntimeWarning, stacklevel=3)
+
+    def _still(self) -> bool:
+        """The last thermostat event found no peculiar kinetic energy (a backend that counts skipped events)."""
+        return True
+
+    def _skipped_thermostat_events(self) -> int:
+        """Thermostat events that did nothing for want of peculiar kinetic energy (a backend that counts them)."""
+        return 0
 
     def _before_step(self):
         """Checks before stepping (a backend's Context checks)."""
@@ -218,8 +247,27 @@ class IntegratorBase:
             return 0.0 * unit.kilojoule_per_mole
         return float(self._heat_bath_energy()) * unit.kilojoule_per_mole
 
+    def thermostat_kinetic_energy(self):
+        """The kinetic energy (a Quantity in kJ/mol) of the velocities just after the last thermostat event: the
+        temperature the thermostat samples.  A State holds the on-step velocities; with the thermostat in the middle
+        of the step (``thermostat_position="middle"``) these are not Maxwell-Boltzmann, and a stiff mode of angular
+        frequency w reads T (1 - h^2 w^2/4) there, while the velocities at the thermostat point (between the two
+        half drifts) read T.  With the ends placement both agree.  0 before the first event."""
+        self._require_thermostat("thermostat_kinetic_energy()")
+        return float(self._thermostat_kinetic_energy()) * unit.kilojoule_per_mole
+
+    @property
+    def thermostat_position(self) -> str | None:
+        """Where the thermostat sits in the step as it runs: "ends" or "middle" (None without a thermostat)."""
+        if self.thermostat is None:
+            return None
+        return self.resolved.thermostat_position or "ends"
+
     def _heat_bath_energy(self) -> float:
         raise NotImplementedError
+
+    def _thermostat_kinetic_energy(self) -> float:
+        raise NotImplementedError(f"{type(self).__name__} cannot report the kinetic energy at the thermostat point")
 
     def _apply_thermostat(self, settings):
         raise NotImplementedError
@@ -237,6 +285,11 @@ class IntegratorBase:
 
     def _reset_binding(self):
         """Forget per-Context facts (a copy is not bound to any Context)."""
+
+    def _forget_run_state(self):
+        """Give a copy the run-time values of a fresh integrator (heat bath, step counter, first-step flags), which the
+        XML of an integrator that has run carries: a copy with the same settings and seed then runs the trajectory a
+        new integrator would (a checkpoint, not a copy, is what continues a run)."""
 
     def __reduce__(self):
         return _restore, (type(self), mm.XmlSerializer.serialize(self), self._python_state())

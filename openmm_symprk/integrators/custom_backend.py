@@ -14,12 +14,14 @@ another program was loaded.
 """
 from __future__ import annotations
 
+import math
 import warnings
 from dataclasses import replace
 
 import openmm as mm
 import openmm.unit as unit
 
+from ..physics.velocity_rescaling import no_peculiar_motion
 from ..systems.checks import warn_once
 from ..systems.properties import masses
 from . import program, thermostat_program
@@ -102,6 +104,22 @@ class PRKIntegrator(IntegratorBase, mm.CustomIntegrator):
         self.options = options
         self.program_info = info
 
+    def _forget_run_state(self, per_dof: bool = True):
+        """Every variable at the value a freshly compiled program has, but the signature (global 0), the metadata and
+        the thermostat's temperature and collision time (settings, which a copy keeps as they were last set).
+        ``per_dof=False``: the global variables only (a bound integrator, whose per-DOF values the Context sized)."""
+        options = self.options
+        has_sites = options.system.virtual_sites if options.system is not None else True
+        fresh = mm.CustomIntegrator(options.step_size)
+        program.compile_program(fresh, self.resolved, options, has_sites)
+        kept = {program.SIGNATURE_VAR, thermostat_program.TEMPERATURE_VAR, thermostat_program.COLLISION_TIME_VAR}
+        for i in range(fresh.getNumGlobalVariables()):
+            name = fresh.getGlobalVariableName(i)
+            if name not in kept:
+                self.setGlobalVariableByName(name, fresh.getGlobalVariable(i))
+        for i in range(fresh.getNumPerDofVariables() if per_dof else 0):
+            self.setPerDofVariableByName(fresh.getPerDofVariableName(i), fresh.getPerDofVariable(i))
+
     # -- per-Context checks ----------------------------------------------------------------------------
     _transient = IntegratorBase._transient + ("_context_ref",)
 
@@ -112,10 +130,18 @@ class PRKIntegrator(IntegratorBase, mm.CustomIntegrator):
         self._checked_context = False
         self._checked_probe = False
         self._nonconverged_seen = 0
+        self._step_count = None  # the Context's step count after the last call (thermostat, exact_momentum)
+        self._warned_no_peculiar = False
 
     def _before_step(self):
         if not self._checked_context:
             self._check_context()
+        elif self._bound_values_may_be_lost():
+            if self._bound_context().getStepCount() == 0:
+                # Context.reinitialize(): a new run, as on the native backend (heat bath, step counter, first-step
+                # probe as a fresh integrator has them; the random stream starts again from the seed)
+                self._forget_run_state(per_dof=False)
+            self._check_context()  # per-DOF values set while bound were dropped: set them again before stepping
         stored = self.getGlobalVariable(0)
         if stored != self.program_info.signature:
             raise CheckpointMismatchError(
@@ -125,6 +151,34 @@ class PRKIntegrator(IntegratorBase, mm.CustomIntegrator):
                 f"native backend was loaded. Create the integrator as it was when the checkpoint was saved (a native "
                 f"checkpoint needs backend='native'), load the checkpoint into that one, or load a State "
                 f"(positions and velocities) instead.")
+        if self.thermostat is not None:
+            self._keep_thermostat_settings()
+
+    def _keep_thermostat_settings(self):
+        """Give the program the integrator's current temperature and collision time if a checkpoint (or a State's
+        integrator parameters) brought back the ones it was saved with: as OpenMM's own thermostatted integrators,
+        whose temperature is the integrator's and not the Context's, and as the native backend."""
+        get = self.getGlobalVariableByName
+        held = (get(thermostat_program.TEMPERATURE_VAR), get(thermostat_program.COLLISION_TIME_VAR))
+        # (a single-precision platform holds the globals as floats: compare to that precision)
+        if not all(math.isclose(a, b, rel_tol=1e-6) for a, b in
+                   zip(held, (self.thermostat.temperature, self.thermostat.collision_time))):
+            self._apply_thermostat(self.thermostat)
+
+    def _bound_values_may_be_lost(self) -> bool:
+        """Whether the Context may have dropped the per-DOF values set while bound (the thermostat's mask,
+        exact_momentum's masses): ``Context.reinitialize()`` keeps the integrator's global variables but not those,
+        and sets the Context's step count to 0.  So: the step count is not the one the last call left (also after
+        setStepCount, a checkpoint or a State: then the check finds the values in place and changes nothing)."""
+        if self._step_count is None:
+            return False
+        context = self._bound_context()
+        return context is not None and context.getStepCount() != self._step_count
+
+    def _remember_step_count(self):
+        if self._masses is not None:  # only the thermostat and exact_momentum set per-DOF values while bound
+            context = self._bound_context()
+            self._step_count = context.getStepCount() if context is not None else None
 
     def _check_context(self):
         """First step on a Context: its particle count against ``system=`` (read from a per-DOF variable the
@@ -178,15 +232,27 @@ class PRKIntegrator(IntegratorBase, mm.CustomIntegrator):
     def _heat_bath_energy(self) -> float:
         return self.getGlobalVariableByName(thermostat_program.HEAT_BATH_VAR)
 
+    def _still(self) -> bool:
+        get = self.getGlobalVariableByName
+        return no_peculiar_motion(get(thermostat_program.KINETIC_VAR), get(thermostat_program.TOTAL_KINETIC_VAR))
+
+    def _skipped_thermostat_events(self) -> int:
+        return int(self.getGlobalVariableByName(thermostat_program.SKIPPED_VAR))
+
+    def _thermostat_kinetic_energy(self) -> float:
+        return thermostat_program.event_kinetic_energy(self)
+
     def _after_step(self):
+        self._remember_step_count()
         if self.thermostat is not None and self.getGlobalVariableByName(thermostat_program.LOST_MASK_VAR):
             # the Context was reinitialized without its state (per-DOF values set while bound are lost): the
             # events of this call did nothing (alpha = 1); fill the mask again for the next steps
             self.setGlobalVariableByName(thermostat_program.LOST_MASK_VAR, 0.0)
             self._set_thermostat_mask(len(self.getPerDofVariableByName(program.PROBE_PER_DOF)))
             warnings.warn(f"{type(self).__name__}({self.method_name}): the thermostat's per-DOF mask was lost (the "
-                          f"Context was reinitialized without preserving its state), so the steps of this call ran "
-                          f"without the thermostat; it is restored for the next steps.", RuntimeWarning, stacklevel=3)
+                          f"Context was reinitialized without preserving its state, and the integrator could not find "
+                          f"its Context to notice before stepping), so the steps of this call ran without the "
+                          f"thermostat; it is restored for the next steps.", RuntimeWarning, stacklevel=3)
         if not self._checked_probe:
             self._checked_probe = True
             if self.getGlobalVariableByName(program.PROBE_CONSTRAINTS_VAR) > 0 and not self.program_info.rattle:
@@ -274,7 +340,7 @@ class PRKIntegrator(IntegratorBase, mm.CustomIntegrator):
         if r.is_mts:
             lines.append("  " + r.describe_levels())
         if self.thermostat is not None:
-            lines.append("  " + self._thermostat_values().describe())
+            lines.append("  " + self._thermostat_values().describe(r.thermostat_position))
         return "\n".join(lines)
 
 

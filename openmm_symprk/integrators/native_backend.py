@@ -8,10 +8,14 @@ same trajectory bit for bit) without CustomIntegrator's per-degree-of-freedom in
 Reference and CPU (one kernel), OpenCL and CUDA (the Common compute source); :mod:`openmm_symprk.plugin`
 loads them and says why the backend is unavailable when it is.
 
-With ``temperature=`` the plugin runs the stochastic velocity-rescaling thermostat
-(:mod:`.thermostat` checks the options; the plugin's host code draws the noise and computes the factor, the
-kernels reduce the velocities and rescale them: on OpenCL/CUDA one device reduction and one download per
-event).  The C++ object holds the settings, so a copy or an integrator read back from XML has them.
+With ``temperature=`` the plugin runs the stochastic velocity-rescaling thermostat (:mod:`.thermostat` checks
+the options), at the ends of the step or, with ``thermostat_position="middle"``, as the THERMOSTAT sub-step the
+resolved method holds at the step's centre.  On Reference/CPU the plugin's host code draws the noise and computes
+the factor; on OpenCL/CUDA the whole event runs on the device (OpenMM's random numbers, the chi-squared variate
+summed there): a step makes no host transfer (``getHostTransfers()`` counts the plugin's own).  The C++ object
+holds the settings, so a copy or an integrator read back from XML has them; a State taken with
+``getIntegratorParameters=True`` carries the heat-bath energy.  Where the System has no peculiar kinetic energy
+(at rest, or moving as a rigid whole) an event changes nothing, and the first such event warns once.
 
 The C++ integrator checks, when a Context is created, that its System has the particle count and the
 constraints of ``system=`` (``setExpectedSystem``); its checkpoints carry a signature of the program and
@@ -111,9 +115,12 @@ class NativeSymplecticIntegrator(SymplecticIntegrator, _PluginIntegrator, backen
         the plugin; None without a thermostat."""
         if not self.hasThermostat():
             return None
+        asked = self.options.thermostat if self.options is not None and self.options.thermostat is not None else None
+        middle = any(self.getSubstepKind(i) == SubstepKind.THERMOSTAT for i in range(self.getNumSubsteps()))
+        position = asked.position if asked is not None else ("middle" if middle else "ends")
         return ThermostatSettings(float(self.getThermostatTemperature()), float(_PluginIntegrator.getCollisionTime(self)),
                                   int(_PluginIntegrator.getThermostatInterval(self)), int(self.getRandomNumberSeed()),
-                                  int(self.getThermostatDof()), bool(self.getThermostatKeepsRotation()))
+                                  int(self.getThermostatDof()), bool(self.getThermostatKeepsRotation()), position)
 
     @thermostat.setter
     def thermostat(self, settings):
@@ -145,6 +152,13 @@ class NativeSymplecticIntegrator(SymplecticIntegrator, _PluginIntegrator, backen
     def _heat_bath_energy(self) -> float:
         return float(self.getHeatBathEnergy())
 
+    def _thermostat_kinetic_energy(self) -> float:
+        return float(self.getThermostatKineticEnergy())
+
+    def _skipped_thermostat_events(self) -> int:
+        """Events that found no peculiar kinetic energy (IntegratorBase warns once, for both backends)."""
+        return int(self.getSkippedThermostatEvents())
+
     # -- conveniences ----------------------------------------------------------------------------------------
     @property
     def force_evals(self) -> int:
@@ -173,8 +187,8 @@ class NativeSymplecticIntegrator(SymplecticIntegrator, _PluginIntegrator, backen
         settings = self.thermostat
         if settings is None:
             return ""
-        where = ", around the outer step" if self.resolved.is_mts else ""
-        return f"\n  {settings.describe()}{where}"
+        where = ", around the outer step" if self.resolved.is_mts and self.thermostat_position == "ends" else ""
+        return f"\n  {settings.describe(self.thermostat_position)}{where}"
 
 
 # IntegratorBase.step must come before the plugin's own step in the method resolution order.

@@ -28,7 +28,9 @@ One compiler for everything (docs/openmm_notes.md explains each rule):
   computation or variable differs from the NVE program): a half velocity-rescaling event after the header,
   before the first sub-step of every ``interval`` steps, and one after the end-of-step velocity projection
   of the ``interval``-th step (Trotter splitting; ``if`` blocks on the step counter when interval > 1).  With
-  multiple time stepping the events wrap the outer step, which is the whole program.
+  multiple time stepping the events wrap the outer step, which is the whole program.  The middle placement
+  (a method resolved with ``thermostat_position="middle"``) has no end events: one whole event at the method's
+  THERMOSTAT sub-step, the centre of the (outer) step, in step i where i mod n = (n - 1) // 2.
 """
 from __future__ import annotations
 
@@ -93,11 +95,13 @@ def _num(c) -> str:
 class _Emitter:
     """Appends computations to a CustomIntegrator, with the shared header, kick and drift rules."""
 
-    def __init__(self, integrator: mm.CustomIntegrator, constraints: bool, exact_momentum: bool, thermostat=None):
+    def __init__(self, integrator: mm.CustomIntegrator, constraints: bool, exact_momentum: bool, thermostat=None,
+                 thermostat_ends: bool = True):
         if integrator.getNumComputations() or integrator.getNumGlobalVariables() or integrator.getNumPerDofVariables():
             raise ValueError("compile into an empty CustomIntegrator: this one already has a program")
         self.ig = integrator
         self.thermostat = thermostat
+        self.thermostat_ends = thermostat is not None and thermostat_ends
         self.constraints = constraints
         self.exact_momentum = exact_momentum
         self._vars: set = set()
@@ -116,10 +120,23 @@ class _Emitter:
         self._probe()
         self._thermostat_event(STEP_VAR)
 
+    def middle_thermostat_event(self, fraction):
+        """The thermostat event of a THERMOSTAT sub-step (the middle placement), over ``fraction`` of the step: in
+        step i (counted from 0) where i mod n = (n - 1) // 2 for interval n, with c = exp(-fraction n dt/tau), so that
+        the event sits at the centre of its n steps."""
+        from .thermostat_program import emit_event
+
+        n = int(self.thermostat.interval)
+        if n > 1:
+            self.ig.beginIfBlock(f"abs({STEP_VAR} - {n}*floor({STEP_VAR}/{n}) - {(n - 1) // 2}) < 0.5")
+        emit_event(self.ig, self.thermostat, float(fraction))
+        if n > 1:
+            self.ig.endBlock()
+
     def _thermostat_event(self, counter: str):
-        """A half thermostat event, in an ``if`` block on ``counter`` (a multiple of the interval) when the
-        thermostat acts every n > 1 steps."""
-        if self.thermostat is None:
+        """A half thermostat event of the ends placement, in an ``if`` block on ``counter`` (a multiple of the
+        interval) when the thermostat acts every n > 1 steps."""
+        if not self.thermostat_ends:
             return
         from .thermostat_program import emit_half_event
 
@@ -227,10 +244,16 @@ def _compile_splitting(integrator, method: ResolvedMethod, constraints: bool, op
     """Emit the program of a resolved kick/drift method: its sub-steps as they run, with a velocity projection
     before every drift flagged for one.  ``constraints``: emit the RATTLE steps (the System has constraints, or
     virtual sites that only ConstrainPositions places on the Common platforms)."""
-    em = _Emitter(integrator, constraints, options.exact_momentum, options.thermostat)
+    em = _Emitter(integrator, constraints, options.exact_momentum, options.thermostat,
+                  thermostat_ends=method.thermostat_position != "middle")
     for sub in method.substeps:
         c = float(sub.coefficient)
-        if sub.kind == SubstepKind.DRIFT:
+        if sub.kind == SubstepKind.THERMOSTAT:
+            if options.thermostat is None:
+                raise ValueError(f"{method.name}: the method was resolved with a thermostat sub-step, but the options "
+                                 f"have no thermostat (temperature=)")
+            em.middle_thermostat_event(c)
+        elif sub.kind == SubstepKind.DRIFT:
             if sub.project_before:
                 em.project_velocities()
             em.drift(c)

@@ -20,7 +20,8 @@ import openmm.unit as unit
 
 from .. import plugin
 from ..methods.catalogue import methods as catalogue_methods
-from ..methods.resolved import resolve
+from ..methods.placement import THERMOSTAT
+from ..methods.resolved import SubstepKind, resolve
 from ..methods.splitting import Splitting
 from . import program
 from .backend import resolve_for_system
@@ -75,8 +76,24 @@ def _restore_custom(integrator: mm.CustomIntegrator):
     obj._adopt(integrator)
     obj._set_program(resolved, options, replace(info, notes=(*info.notes, "restored from XML")))
     obj.__dict__.update(_masses=None, thermostat=options.thermostat)
+    # the program holds the temperature and collision time as they were last set (the metadata: as created)
+    obj.thermostat = obj._thermostat_values()
     obj._reset_binding()
+    obj._forget_run_state()
     return obj
+
+
+def _without_thermostat(steps: list) -> list:
+    """(label, coefficient) sub-steps without the thermostat's, the two halves it split joined again."""
+    out = []
+    for i, (label, c) in enumerate(steps):
+        if label == THERMOSTAT:
+            continue
+        if i > 0 and steps[i - 1][0] == THERMOSTAT and out and out[-1][0] == label:
+            out[-1] = (label, out[-1][1] + c)
+        else:
+            out.append((label, c))
+    return out
 
 
 def _restore_native(integrator):
@@ -87,15 +104,19 @@ def _restore_native(integrator):
     constraints = bool(obj.getExpectedConstraints()) if expected >= 0 else True
     plugin_steps = [(obj.getSubstepKind(i), obj.getSubstepCoefficient(i), obj.getSubstepForceGroups(i),
                      obj.getSubstepFlags(i)) for i in range(obj.getNumSubsteps())]
+    # the thermostat's placement: a THERMOSTAT sub-step is the middle one (resolve puts it back at the centre)
+    middle = any(kind == SubstepKind.THERMOSTAT for kind, *_ in plugin_steps)
+    position = "middle" if middle else ("ends" if obj.hasThermostat() else None)
 
     def runs_as_plugin(r):
         return [(int(s.kind), float(s.coefficient), s.group_mask, int(s.flags)) for s in r.substeps] == plugin_steps
 
     # a catalogue method resolved again (exact coefficients) if that is what the plugin runs; otherwise (multiple
     # time stepping, a user splitting) the plugin's sub-steps as they run, with the catalogue's orders if named
-    resolved = resolve(name, constraints=constraints) if name in catalogue_methods else None
+    resolved = resolve(name, constraints=constraints, thermostat_position=position) if name in catalogue_methods else None
     if resolved is None or not runs_as_plugin(resolved):
-        resolved = resolve(Splitting(obj.substeps()), constraints=constraints, name=name)
+        resolved = resolve(Splitting(_without_thermostat(obj.substeps())), constraints=constraints, name=name,
+                           thermostat_position=position)
         if not runs_as_plugin(resolved):
             raise ValueError(f"the SymPRKIntegrator {name!r} read from XML runs sub-steps {plugin_steps} (kind, "
                              f"coefficient, force groups, flags) whose flags its sequence would not get: it was not "

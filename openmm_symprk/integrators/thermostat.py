@@ -16,6 +16,7 @@ import numpy as np
 import openmm as mm
 import openmm.unit as unit
 
+from ..methods.placement import POSITIONS
 from ..physics.temperature import R_KJ
 from ..physics.velocity_rescaling import relaxation_factor
 from ..systems.checks import EXACT_MOMENTUM_FORBIDDEN, check_system_type, conservation_issues
@@ -24,14 +25,18 @@ from .quantities import positive_quantity
 
 __all__ = ["ThermostatSettings", "thermostat_settings", "temperature_in_kelvin", "collision_time_in_ps",
            "check_interval", "check_seed", "system_is_isolated", "DEFAULT_COLLISION_TIME", "THERMOSTAT_OPTIONS",
-           "MAX_SEED"]
+           "MAX_SEED", "MAX_INTERVAL", "DEFAULT_POSITION", "check_position"]
 
 #: Default collision time tau (ps) when ``temperature`` is given without ``collision_time``.
 DEFAULT_COLLISION_TIME = 0.1
 #: The options of the thermostat (both backends take them).
-THERMOSTAT_OPTIONS = ("temperature", "collision_time", "thermostat_interval", "random_seed")
+THERMOSTAT_OPTIONS = ("temperature", "collision_time", "thermostat_interval", "random_seed", "thermostat_position")
 #: Largest random seed: OpenMM's setRandomNumberSeed takes a 32-bit signed int.
 MAX_SEED = 2**31 - 1
+#: Largest thermostat interval: the native plugin holds it in a 32-bit signed int (and a longer one is an NVE run).
+MAX_INTERVAL = 2**31 - 1
+#: Where the thermostat sits when ``thermostat_position`` is not given (see :func:`check_position`).
+DEFAULT_POSITION = "ends"
 
 
 def temperature_in_kelvin(temperature) -> float:
@@ -58,9 +63,22 @@ def _whole_number(value, what: str, minimum: int, accepted: str) -> int:
 
 
 def check_interval(interval) -> int:
-    """The thermostat interval n (the thermostat acts every n steps): an int >= 1."""
-    return _whole_number(interval, "thermostat_interval", 1, "give the number of steps between thermostat "
-                                                               "events, e.g. 1 (every step) or 10")
+    """The thermostat interval n (the thermostat acts every n steps): an int from 1 to :data:`MAX_INTERVAL`."""
+    accepted = f"give the number of steps between thermostat events, from 1 (every step) to {MAX_INTERVAL}"
+    n = _whole_number(interval, "thermostat_interval", 1, accepted)
+    if n > MAX_INTERVAL:
+        raise ValueError(f"thermostat_interval must be at most {MAX_INTERVAL} (the native plugin holds it in a 32-bit "
+                         f"integer; an interval that long is an NVE run: drop temperature= for one), got {n}")
+    return n
+
+
+def check_position(position) -> str:
+    """``thermostat_position``: "ends" (half an event before and after the step), "middle" (one event at the exact
+    centre of the step) or "auto" (the one :func:`openmm_symprk.methods.placement.best_position` picks for the
+    method: "middle" for verlet, "ends" for omelyan-2 and the higher-order methods)."""
+    if not isinstance(position, str) or position not in POSITIONS:
+        raise ValueError(f"thermostat_position must be one of {', '.join(map(repr, POSITIONS))}, got {position!r}")
+    return position
 
 
 def check_seed(seed) -> int:
@@ -84,7 +102,12 @@ class ThermostatSettings:
 
     ``temperature`` (K), ``collision_time`` tau (ps), ``interval`` n (it acts every n steps), ``seed`` (0: a
     fresh one per Context), ``dof`` (the degrees of freedom it samples), ``keep_rotation`` (the System is
-    isolated: the rigid rotation about the centre of mass is kept, as the centre-of-mass velocity always is)."""
+    isolated: the rigid rotation about the centre of mass is kept, as the centre-of-mass velocity always is),
+    ``position`` ("ends", "middle" or "auto" as asked; the method decides "auto": ``resolved.thermostat_position``).
+
+    What it needs: a peculiar kinetic energy to scale (velocities that are not all one rigid motion).  A System at
+    rest, or moving only as a rigid whole, stays where it is (a warning says so): start a run with velocities drawn
+    at the temperature (``context.setVelocitiesToTemperature``)."""
 
     temperature: float
     collision_time: float
@@ -92,6 +115,7 @@ class ThermostatSettings:
     seed: int
     dof: int
     keep_rotation: bool
+    position: str = DEFAULT_POSITION
 
     def c_half(self, step_ps: float) -> float:
         """c = exp(-(n dt / 2) / tau): the relaxation factor of one half event (two per n steps)."""
@@ -112,29 +136,37 @@ class ThermostatSettings:
         return replace(self, seed=check_seed(seed))
 
     def as_dict(self) -> dict:
-        return {"temperature": self.temperature, "collision_time": self.collision_time, "interval": self.interval,
-                "seed": self.seed, "dof": self.dof, "keep_rotation": self.keep_rotation}
+        out = {"temperature": self.temperature, "collision_time": self.collision_time, "interval": self.interval,
+               "seed": self.seed, "dof": self.dof, "keep_rotation": self.keep_rotation}
+        if self.position != "ends":  # (the programs of the ends placement keep the metadata they had before)
+            out["position"] = self.position
+        return out
 
-    def describe(self) -> str:
+    def describe(self, position: str | None = None) -> str:
+        """One line; ``position``: the placement the method resolved "auto" to."""
+        where = position or self.position
+        placed = "half events around the step" if where == "ends" else (
+            "one event at the centre of the step" if where == "middle" else "placement: auto")
         kept = "centre-of-mass velocity and rigid rotation kept" if self.keep_rotation else \
             "centre-of-mass velocity kept"
         every = "every step" if self.interval == 1 else f"every {self.interval} steps"
         return (f"thermostat: stochastic velocity rescaling at {self.temperature:g} K, collision time "
-                f"{self.collision_time:g} ps, {every} (half events around the step), {self.dof} degrees of "
+                f"{self.collision_time:g} ps, {every} ({placed}), {self.dof} degrees of "
                 f"freedom, {kept}, seed {self.seed if self.seed else 'fresh per Context'}")
 
 
 def thermostat_settings(system, temperature=None, collision_time=None, thermostat_interval=None,
-                        random_seed=None) -> ThermostatSettings | None:
+                        random_seed=None, thermostat_position=None) -> ThermostatSettings | None:
     """The checked thermostat settings of an integrator's options, or None without ``temperature``.
 
-    ``collision_time`` (default 0.1 ps), ``thermostat_interval`` (default 1) and ``random_seed`` (default 0)
-    only make sense with ``temperature``; ``system`` (the System the integrator will run) is required with it,
+    ``collision_time`` (default 0.1 ps), ``thermostat_interval`` (default 1), ``random_seed`` (default 0) and
+    ``thermostat_position`` (default :data:`DEFAULT_POSITION`, :func:`check_position`) only make sense with ``temperature``; ``system`` (the System the integrator will run) is required with it,
     since the degrees of freedom come from it."""
     if temperature is None:
         given = [name for name, value in (("collision_time", collision_time),
                                           ("thermostat_interval", thermostat_interval),
-                                          ("random_seed", random_seed)) if value is not None]
+                                          ("random_seed", random_seed),
+                                          ("thermostat_position", thermostat_position)) if value is not None]
         if given:
             raise ValueError(f"{', '.join(given)} {'was' if len(given) == 1 else 'were'} given without temperature: "
                              f"{'it sets' if len(given) == 1 else 'they set'} up the thermostat, which only runs with "
@@ -145,6 +177,7 @@ def thermostat_settings(system, temperature=None, collision_time=None, thermosta
     tau = collision_time_in_ps(DEFAULT_COLLISION_TIME if collision_time is None else collision_time)
     interval = check_interval(1 if thermostat_interval is None else thermostat_interval)
     seed = check_seed(0 if random_seed is None else random_seed)
+    position = check_position(DEFAULT_POSITION if thermostat_position is None else thermostat_position)
     if system is None:
         raise ValueError("temperature= needs system= (the System the integrator will run): the thermostat's "
                          "degrees of freedom and whether the rotation is kept come from it")
@@ -156,5 +189,5 @@ def thermostat_settings(system, temperature=None, collision_time=None, thermosta
             f"no degrees of freedom to thermostat: the System has {system.getNumParticles()} particle(s) and "
             f"{system.getNumConstraints()} constraint(s), which leaves {dof} degrees of freedom once the "
             f"centre-of-mass velocity{' and the rigid rotation (isolated System)' if isolated else ''} are kept "
-            f"(3 per particle with mass - constraints - 3{' - 3' if isolated else ''})")
-    return ThermostatSettings(kelvin, tau, interval, seed, dof, isolated)
+            f"(3 per particle with mass - constraints - 3{' - 3 (2 for two particles)' if isolated else ''})")
+    return ThermostatSettings(kelvin, tau, interval, seed, dof, isolated, position)

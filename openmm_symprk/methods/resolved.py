@@ -22,18 +22,19 @@ CustomIntegrator compiler and the native kernels are sent the flags and do not d
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from enum import IntEnum, IntFlag
 from fractions import Fraction
 
 import numpy as np
 
 from .catalogue import Method, get_method
+from .placement import POSITIONS, THERMOSTAT, best_position, centre
 from .respa import MTSError, evaluations_per_step, label_groups, levels, mts_groups, respa
 from .splitting import DRIFT, KICK, Splitting
 from .tableau import PRKTableau, TableauError
 
-__all__ = ["resolve", "ResolvedMethod", "Substep", "SubstepKind", "SubstepFlag", "ConstraintSupportError",
+__all__ = ["resolve", "thermostat_position_for", "ResolvedMethod", "Substep", "SubstepKind", "SubstepFlag", "ConstraintSupportError",
            "projected_drifts", "FORMS"]
 
 #: The form of a step, which decides how it runs: a kick/drift sequence (any splitting or composition, multiple time
@@ -44,10 +45,11 @@ FORMS = ("splitting", "explicit", "implicit")
 
 class SubstepKind(IntEnum):
     """The kind of one sub-step; the numbers are the plugin's ``SymPRKIntegrator::SubstepKind`` (a test checks
-    it).  A later operation (e.g. a thermostat half step) is one more member on both sides."""
+    it).  A later operation is one more member on both sides."""
 
     KICK = 0  # v += c*dt*F/m
     DRIFT = 1  # x += c*dt*v (RATTLE under constraints)
+    THERMOSTAT = 2  # a thermostat event over the fraction c of the step (c = 1: one whole event, the middle placement)
 
 
 class SubstepFlag(IntFlag):
@@ -77,6 +79,8 @@ class Substep:
         """"drift", "kick", or "kick:<groups>" (the labels of :class:`~.splitting.Splitting`)."""
         if self.kind == SubstepKind.DRIFT:
             return DRIFT
+        if self.kind == SubstepKind.THERMOSTAT:
+            return THERMOSTAT
         return KICK if self.groups is None else KICK + ":" + ",".join(map(str, self.groups))
 
     @property
@@ -145,6 +149,9 @@ class ResolvedMethod:
     levels: tuple = ()  # multiple time stepping: Level, slowest first
     groups: tuple | None = None  # multiple time stepping: ((force group, substeps), ...) as given
     inner_name: str | None = None  # multiple time stepping: the inner levels' method
+    #: where the thermostat sits: None (no thermostat, or one a backend runs at the ends itself), "ends" or
+    #: "middle" (then ``substeps`` holds one THERMOSTAT sub-step at the step's centre)
+    thermostat_position: str | None = None
     entry: Method | None = field(default=None, repr=False)  # the catalogue entry, when there is one
 
     # -- views ----------------------------------------------------------------------------------------------
@@ -218,8 +225,40 @@ def _form(splitting, tableau) -> str:
     return "explicit" if tableau.is_explicit else "implicit"
 
 
+def _with_middle_thermostat(substeps: tuple) -> tuple:
+    """``substeps`` with one whole thermostat event at the step's centre: the central sub-step (a drift, or a kick of
+    BABAB schemes) split in two equal halves around it.  The first half keeps the sub-step's flags; the second half
+    of a kick finds its forces cached (no drift between), that of a drift needs no projection (the same
+    coefficient as the drift before it, see :func:`projected_drifts`)."""
+    i = centre([(s.label, s.coefficient) for s in substeps])
+    sub = substeps[i]
+    half = sub.coefficient / 2
+    first = Substep(sub.kind, half, sub.groups, sub.project_before, sub.forces_cached)
+    second = Substep(sub.kind, half, sub.groups, False, sub.kind == SubstepKind.KICK)
+    event = Substep(SubstepKind.THERMOSTAT, Fraction(1))
+    return (*substeps[:i], first, event, second, *substeps[i + 1:])
+
+
+def thermostat_position_for(resolved: ResolvedMethod, position: str) -> str:
+    """"ends" or "middle": ``position`` as given ("ends", "middle" or "auto"), "auto" being
+    :func:`.placement.best_position` of the method's kick/drift sequence (on multiple time stepping: the inner,
+    fastest level's kicks carry the oscillator's force); a general PRK pair has no centre sub-step: "ends"."""
+    if position not in POSITIONS:
+        raise ValueError(f"thermostat_position must be one of {', '.join(map(repr, POSITIONS))}, got {position!r}")
+    if position != "auto":
+        return position
+    if not resolved.is_splitting:
+        return "ends"
+    forced = None
+    if resolved.is_mts:
+        fastest = resolved.levels[-1].groups
+        forced = [s.label for s in resolved.substeps if s.kind == SubstepKind.KICK and s.groups is not None
+                  and set(s.groups) & set(fastest)]
+    return best_position(resolved.splitting.steps, resolved.stability, forced=forced)
+
+
 def resolve(method, constraints: bool | None = False, groups=None, inner_method=None,
-            name: str | None = None) -> ResolvedMethod:
+            name: str | None = None, thermostat_position: str | None = None) -> ResolvedMethod:
     """The one description of ``method`` as it will run (see the module docstring).
 
     ``constraints``: the System has constraints (True), has none (False, the default: model problems), or is
@@ -227,7 +266,27 @@ def resolve(method, constraints: bool | None = False, groups=None, inner_method=
     constraints too).  ``groups``/``inner_method``: multiple time stepping in the form of OpenMM's
     ``MTSIntegrator`` (:mod:`.respa`).  ``name`` overrides the method's name.  Raises UnknownMethodError (with
     close names), TypeError for something that is not a method, ConstraintSupportError for a general PRK pair
-    under constraints and MTSError for a malformed ``groups``."""
+    under constraints and MTSError for a malformed ``groups``.
+
+    ``thermostat_position``: None (no thermostat), "ends", "middle" or "auto" (:func:`thermostat_position_for`).
+    With "middle" the sub-steps get one :attr:`SubstepKind.THERMOSTAT` event at the exact centre of the step (of the
+    outer step with multiple time stepping), splitting the central drift or kick in two halves; ValueError for a
+    general PRK pair or a sequence that is not symmetric (no one centre).  With "ends" the sub-steps are those of
+    the method alone (both backends put half an event before and after the step themselves)."""
+    if thermostat_position is not None:
+        plain = resolve(method, constraints, groups, inner_method, name)
+        where = thermostat_position_for(plain, thermostat_position)
+        if where == "ends":
+            return replace(plain, thermostat_position="ends")
+        if not plain.is_splitting:
+            raise ValueError(f"thermostat_position='middle' needs a kick/drift method, whose step has a centre "
+                             f"sub-step; {plain.name!r} is a general ({plain.family or plain.form}) PRK tableau: use "
+                             f"thermostat_position='ends' (or 'auto')")
+        try:
+            substeps = _with_middle_thermostat(plain.substeps)
+        except ValueError as exc:
+            raise ValueError(f"{plain.name}: {exc}") from None
+        return replace(plain, substeps=substeps, thermostat_position="middle")
     entry, splitting, tableau = _normalise(method)
     form = _form(splitting, tableau)
     name = name or (entry.name if entry is not None else None) or (

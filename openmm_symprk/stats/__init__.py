@@ -6,11 +6,14 @@ One place for the statistics every study, the bench and the reporters use:
   ``timeseries``), mean and standard error of a correlated series (from the inefficiency, or from block means);
 * :mod:`.drift` -- the energy drift: the least-squares slope of y(t) with its standard error (correlated
   residuals), in one pass over stored samples or with O(1) work per new sample (:class:`.drift.RunningLine`);
-* :mod:`.compare` -- replicas combined into one estimate, and the agreement of two rows (paired by replica).
+* :mod:`.compare` -- replicas combined into one estimate, and the agreement of two rows (paired by replica);
+* :mod:`.jackknife` -- the delete-one-group jackknife: the error of a non-linear figure of an average over
+  molecules (a correlation time) or replicas.
 """
 from .compare import Estimate, agrees, combine, difference, no_larger, paired
 from .drift import Drift, RunningLine, drift
+from .jackknife import jackknife
 from .timeseries import SeriesStats, block_stats, equilibrated_from, series_stats, statistical_inefficiency
 
 __all__ = ["Estimate", "agrees", "combine", "difference", "no_larger", "paired", "Drift", "RunningLine", "drift",
-           "SeriesStats", "block_stats", "equilibrated_from", "series_stats", "statistical_inefficiency"]
+           "jackknife", "SeriesStats", "block_stats", "equilibrated_from", "series_stats", "statistical_inefficiency"]

@@ -24,6 +24,8 @@ import numpy as np
 import openmm as mm
 
 from ..conservation.diagnostics import angular_momentum, linear_momentum
+from ..support.files import write_text
+from .core.rows import Row
 from .timing import interleaved
 
 DEFAULT_PLATFORMS = ("Reference", "CPU", "OpenCL:single", "OpenCL:mixed", "OpenCL:double")
@@ -64,13 +66,12 @@ def _momenta(ctx):
 
 def compare(scene, spec, method, steps, step_size=0.002, chunk=None, backend="auto"):
     """Run off and on side by side (``steps`` rounded down to whole chunks); return a dict of figures."""
-    from ..integrators import SymplecticIntegrator
-
     name, props = _platform(spec)
     if name == "OpenCL" and scene.n_atoms < 2:
         raise ValueError("PoCL crashes on 1-particle systems")
-    igs = {"off": SymplecticIntegrator(step_size, method, system=scene.system, backend=backend),
-           "on": SymplecticIntegrator(step_size, method, system=scene.system, exact_momentum=True, backend=backend)}
+    row = Row(method, step_size * 1e3, backend=backend)
+    igs = {"off": row.build(scene.system, quiet=False),
+           "on": row.replace(exact_momentum=True).build(scene.system, quiet=False)}
     ctxs = {k: scene.context(ig, name, props) for k, ig in igs.items()}
     start = {}
     for k, ig in igs.items():
@@ -94,7 +95,6 @@ def compare(scene, spec, method, steps, step_size=0.002, chunk=None, backend="au
 
 def failure_cases(steps=500):
     """Reference-platform runs where momentum is not conserved, for the second table."""
-    from ..integrators import SymplecticIntegrator
     from ..systems import scenes
 
     rows = []
@@ -111,18 +111,18 @@ def failure_cases(steps=500):
         return float(np.linalg.norm(L1 - L0) / np.linalg.norm(L0)), float(np.linalg.norm(P1 - P0))
 
     for em in (False, True):
-        ig = SymplecticIntegrator(0.001, "rk4", system=morse.system, allow_nonsymplectic=True, exact_momentum=em)
+        ig = Row("rk4", 1.0, exact_momentum=em).build(morse.system, quiet=False)
         rows.append(("rk4 (not symplectic), Morse molecule" + (", projected" if em else ""), "com",
                      *drift(morse, ig), "method error: projection cannot help"))
-    ig = SymplecticIntegrator(0.001, "verlet", system=morse.system)
+    ig = Row("verlet", 1.0).build(morse.system, quiet=False)
     rows.append(("verlet, Morse molecule (reference)", "com", *drift(morse, ig), "round-off"))
-    ig = mm.LangevinMiddleIntegrator(150, 1.0, 0.002)
+    ig = Row.parse("langevin 2 fs friction 1/ps T 150 K").build(water.system, quiet=False)
     rows.append(("LangevinMiddleIntegrator, 8 waters", "com", *drift(water, ig), "thermostat"))
     system = mm.XmlSerializer.clone(water.system)
     system.addForce(mm.CMMotionRemover(1))
     v = water.velocities + np.array([0.3, -0.2, 0.1])
     for about in ("com", "origin"):
-        ig = SymplecticIntegrator(0.002, "verlet", system=system)
+        ig = Row("verlet", 2.0).build(system, quiet=False)
         rows.append(("verlet + CMMotionRemover, 8 waters drifting", about,
                      *drift(water, ig, about=about, system=system, velocities=v),
                      "L about the centre of mass kept" if about == "com" else "L about the origin changes"))
@@ -198,8 +198,7 @@ def main(argv=None) -> int:
     text = "\n".join(parts)
     print(text)
     if args.out:
-        with open(args.out, "w") as fh:
-            fh.write(text + "\n")
+        write_text(args.out, text + "\n")
     return 0
 
 

@@ -18,28 +18,24 @@ import openmm as mm
 import openmm.unit as unit
 
 from ..conservation.diagnostics import angular_momentum, linear_momentum
-from ..integrators import SymplecticIntegrator
+from ..integrators.thermostat import DEFAULT_COLLISION_TIME
 from ..systems.properties import degrees_of_freedom
 from ..systems.scenes import water_cluster
+from .core.rows import Row
 from .timing import interleaved
 
 __all__ = ["ROWS", "DemoRow", "run_demo", "default_platform"]
 
-#: Target temperature (K) of the thermostatted rows.
-NVT_TEMPERATURE = 300.0
-#: Friction of OpenMM's LangevinMiddleIntegrator row (1/ps).
-LANGEVIN_FRICTION = 1.0
-
-#: The demo's rows, in order: (label, integrator, options).  ``openmm-verlet`` and ``openmm-langevin-middle`` are
-#: OpenMM's own integrators; any other name is a catalogue method of :class:`SymplecticIntegrator`, built with
-#: these options.  The first row is the timing reference.
+#: The demo's rows, in order: (name printed, row label without its step; :class:`~.core.rows.Row`).  The first row is
+#: the timing reference.  The thermostatted rows run at 300 K: ours with the package's default collision time, OpenMM's
+#: LangevinMiddleIntegrator with friction 1/ps.
 ROWS = (
-    ("OpenMM VerletIntegrator", "openmm-verlet", {}),
-    ("symprk verlet", "verlet", {}),
-    ("symprk verlet exact_momentum", "verlet", {"exact_momentum": True}),
-    ("symprk yoshida-4", "yoshida-4", {}),
-    ("OpenMM LangevinMiddle 300 K", "openmm-langevin-middle", {"temperature": NVT_TEMPERATURE}),
-    ("symprk verlet 300 K exact_momentum", "verlet", {"temperature": NVT_TEMPERATURE, "exact_momentum": True}),
+    ("OpenMM VerletIntegrator", "openmm-verlet"),
+    ("symprk verlet", "verlet"),
+    ("symprk verlet exact_momentum", "verlet exact-momentum"),
+    ("symprk yoshida-4", "yoshida-4"),
+    ("OpenMM LangevinMiddle 300 K", "langevin friction 1/ps"),
+    ("symprk verlet 300 K exact_momentum", f"verlet SVR {DEFAULT_COLLISION_TIME:g} ps exact-momentum"),
 )
 
 
@@ -67,15 +63,13 @@ def default_platform(names=None) -> tuple[str, str]:
                         "running on Reference as a fallback."
 
 
-def _build(engine: str, options: dict, h, system, backend: str):
-    """(integrator, backend label, force evaluations per step) for one row."""
-    if engine == "openmm-verlet":
-        return mm.VerletIntegrator(h), "OpenMM", 1.0
-    if engine == "openmm-langevin-middle":
-        return mm.LangevinMiddleIntegrator(options["temperature"] * unit.kelvin, LANGEVIN_FRICTION / unit.picosecond,
-                                           h), "OpenMM", 1.0
-    ig = SymplecticIntegrator(h, engine, system=system, backend=backend, **options)
-    return ig, ig.backend, ig.program_info.force_evals
+def _build(label: str, step_fs: float, system, backend: str):
+    """(row, integrator, backend label) for one row of :data:`ROWS`."""
+    row = Row.parse(label, step_fs=step_fs)
+    if row.is_ours:
+        row = row.replace(backend=backend)
+    ig = row.build(system, quiet=False)
+    return row, ig, ig.backend if row.is_ours else "OpenMM"
 
 
 class _Tracker:
@@ -130,9 +124,8 @@ def run_demo(methods=None, n_waters: int = 64, steps: int = 2000, step_fs: float
     if platform is None:
         platform, note = default_platform()
     mm.Platform.getPlatformByName(platform)  # a clear OpenMMException for an unknown platform, before any work
-    specs = ROWS if methods is None else (ROWS[0],) + tuple((f"symprk {m}", m, {}) for m in methods)
+    specs = ROWS if methods is None else (ROWS[0],) + tuple((f"symprk {m}", m) for m in methods)
     scene = water_cluster(n_waters)
-    h = step_fs * unit.femtoseconds
     chunk = max(1, min(chunk, steps))
     if note:
         out(note)
@@ -140,11 +133,11 @@ def run_demo(methods=None, n_waters: int = 64, steps: int = 2000, step_fs: float
     out("OpenMM's VerletIntegrator is leapfrog: its State velocities lag half a step, so x_n x v_(n-1/2) is")
     out("not an invariant for it; our integrators report synchronous (x_n, v_n).\n")
     trackers = []
-    for label, engine, options in specs:
-        ig, used, evals = _build(engine, options, h, scene.system, backend)
-        if engine not in ("openmm-verlet", "openmm-langevin-middle"):
-            label = label.replace(f"symprk {engine}", f"symprk {ig.method_name}", 1)
-        trackers.append(_Tracker(scene, ig, platform, label, used, evals, "temperature" in options))
+    for name, label in specs:
+        row, ig, used = _build(label, step_fs, scene.system, backend)
+        if row.is_ours:
+            name = name.replace(f"symprk {label.split()[0]}", f"symprk {row.method}", 1)
+        trackers.append(_Tracker(scene, ig, platform, name, used, row.evals_per_step(True), bool(row.thermostat)))
     by_name = {tr.name: tr for tr in trackers}
     timings = interleaved({tr.name: tr.ig.step for tr in trackers}, chunk, rounds=max(1, steps // chunk),
                           after=lambda name: by_name[name].record())
@@ -155,8 +148,8 @@ def run_demo(methods=None, n_waters: int = 64, steps: int = 2000, step_fs: float
     out("\n|dE| in kJ/mol per degree of freedom; |dP| in Da nm/ps; time per step relative to OpenMM's "
         "VerletIntegrator,\neach the fastest of its blocks of steps, the integrators taking turns block by block.")
     if any(r.nvt for r in rows):
-        out(f"Rows at {NVT_TEMPERATURE:g} K are NVT, where the energy is not conserved: for ours |dE| is that of the "
-            "energy\nplus the heat-bath energy (computeHeatBathEnergy), which is; OpenMM's LangevinMiddleIntegrator "
-            f"(friction\n{LANGEVIN_FRICTION:g}/ps) has no heat-bath energy (-).  Our thermostat rescales the velocities "
-            "relative to the\ncluster's rigid motion, so P and L stay; Langevin's random forces change both.")
+        out(f"Rows at 300 K are NVT, where the energy is not conserved: for ours |dE| is that of the energy\n"
+            "plus the heat-bath energy (computeHeatBathEnergy), which is; OpenMM's LangevinMiddleIntegrator (friction\n"
+            "1/ps) has no heat-bath energy (-).  Our thermostat rescales the velocities relative to the\n"
+            "cluster's rigid motion, so P and L stay; Langevin's random forces change both.")
     return rows

@@ -19,8 +19,8 @@ from __future__ import annotations
 import argparse
 
 import openmm as mm
-import openmm.unit as unit
 
+from .core.rows import Row
 from .timing import interleaved
 
 DEFAULT_METHODS = ("verlet", "omelyan-2", "yoshida-4", "blanes-moan-srkn6b-4", "kahan-li-6")
@@ -58,15 +58,12 @@ def _contexts(system, pos, vel, platform, properties, entries):
 def measure(system, pos, vel, methods, platform="CPU", properties=None, steps=100, repeats=3, dt_fs=2.0,
             custom=True, log=print) -> dict:
     """Seconds per step for every integrator; keys 'openmm-verlet', 'native:<m>', 'custom:<m>'."""
-    from ..integrators import SymplecticIntegrator, native_available
+    from ..integrators import native_available
 
-    dt = dt_fs * unit.femtoseconds
-    entries = [("openmm-verlet", lambda: mm.VerletIntegrator(dt))]
-    for m in methods:
-        if native_available():
-            entries.append((f"native:{m}", lambda m=m: SymplecticIntegrator(dt, m, system=system, backend="native")))
-        if custom:
-            entries.append((f"custom:{m}", lambda m=m: SymplecticIntegrator(dt, m, system=system, backend="custom")))
+    backends = (["native"] if native_available() else []) + (["custom"] if custom else [])
+    rows = {"openmm-verlet": Row("openmm-verlet", dt_fs)}
+    rows.update({f"{b}:{m}": Row(m, dt_fs, backend=b) for m in methods for b in backends})
+    entries = [(key, lambda row=row: row.build(system, quiet=False)) for key, row in rows.items()]
     ctxs = _contexts(system, pos, vel, platform, properties or {}, entries)
 
     def stepper(ctx, ig):
@@ -79,14 +76,12 @@ def measure(system, pos, vel, methods, platform="CPU", properties=None, steps=10
     return {k: t.best for k, t in timings.items()}
 
 
-def format_table(title, best, methods) -> str:
-    from ..methods.catalogue import methods as catalogue
-
+def format_table(title, best, methods, constraints: bool = True) -> str:
     base = best["openmm-verlet"]
     lines = [title, f"  OpenMM VerletIntegrator: {base * 1e3:.3f} ms/step",
              f"  {'method':22s} {'f/step':>6s} {'native ms':>10s} {'native ratio':>12s} {'custom ms':>10s} {'custom ratio':>12s}"]
     for m in methods:
-        fe = catalogue[m].force_evals
+        fe = Row(m, 1.0).evals_per_step(constraints)
         nat = best.get(f"native:{m}")
         cus = best.get(f"custom:{m}")
         row = f"  {m:22s} {fe:6d} "
@@ -143,7 +138,8 @@ def main(argv=None) -> int:
             title += ", no forces (integrator work only)"
         best = measure(system, pos, vel, methods, args.platform, props, steps=steps,
                        repeats=1 if args.quick else args.repeats, custom=not args.no_custom)
-        print(format_table(f"{title}: {steps} steps x best of {1 if args.quick else args.repeats}", best, methods))
+        print(format_table(f"{title}: {steps} steps x best of {1 if args.quick else args.repeats}", best, methods,
+                           system.getNumConstraints() > 0))
     print(f"load average after: {os.getloadavg()[0]:.2f}")
     return 0
 

@@ -4,7 +4,7 @@ The integrators need only OpenMM and numpy.  Analysis, charts, progress bars, st
 need more; each is installed by an extra of the package (setup.py's ``extras_require`` holds the same
 table as :data:`EXTRAS`)::
 
-    pip install 'openmm_symprk[analysis]'   # MDAnalysis, scipy
+    pip install 'openmm_symprk[analysis]'   # MDAnalysis, scipy, tqdm
     pip install 'openmm_symprk[studies]'    # matplotlib, tqdm, pymbar, scipy, MDAnalysis
     pip install 'openmm_symprk[cluster]'    # dask[distributed]
     pip install 'openmm_symprk[all]'        # analysis + studies
@@ -13,7 +13,7 @@ A module that needs one imports it through :func:`require`, which returns the mo
 :class:`MissingDependencyError` (an ImportError) saying which feature needs which package and which extra
 installs it::
 
-    mda = require("MDAnalysis", "analysis", "openmm_symprk.conservation.analysis")
+    mda = require("MDAnalysis", "analysis", "openmm_symprk.analysis.universe")
 """
 from __future__ import annotations
 
@@ -25,7 +25,7 @@ PACKAGES = {"MDAnalysis": "MDAnalysis", "scipy": "scipy", "matplotlib": "matplot
 
 #: The package's extras and the packages each installs (setup.py's ``extras_require`` names the same).
 EXTRAS = {
-    "analysis": ("MDAnalysis", "scipy"),
+    "analysis": ("MDAnalysis", "scipy", "tqdm"),
     "studies": ("matplotlib", "tqdm", "pymbar", "scipy", "MDAnalysis"),
     "cluster": ("dask[distributed]",),
 }

@@ -73,7 +73,8 @@ public:
     /* the same names and numbers as openmm_symprk.methods.resolved.SubstepKind and SubstepFlag */
     enum SubstepKind {
         Kick = 0,
-        Drift = 1
+        Drift = 1,
+        Thermostat = 2
     };
     enum SubstepFlag {
         ProjectVelocitiesBefore = 1,
@@ -103,7 +104,7 @@ public:
     int getExpectedNumParticles() const;
     bool getExpectedConstraints() const;
     long long getProgramSignature() const;
-    void setThermostat(double temperature, double collisionTime, int interval, int dof, bool keepRotation);
+    void setThermostat(double temperature, double collisionTime, long long interval, int dof, bool keepRotation);
     bool hasThermostat() const;
     double getThermostatTemperature() const;
     void setThermostatTemperature(double temperature);
@@ -114,6 +115,9 @@ public:
     int getRandomNumberSeed() const;
     void setRandomNumberSeed(int seed);
     double getHeatBathEnergy() const;
+    double getThermostatKineticEnergy() const;
+    long long getSkippedThermostatEvents() const;
+    long long getHostTransfers() const;
     static std::vector<double> computeRescalingFactor(double kinetic, double target, int dof, double c, double r1, double chi2);
     static void registerMissingKernelFactories();
     void step(int steps);

@@ -8,8 +8,8 @@ import openmm.app as app
 import pytest
 
 from openmm_symprk import SymplecticIntegrator
-from openmm_symprk.conservation.analysis import (FLOAT32_FLOOR, AngularMomentum, KineticTemperatures, LinearMomentum,
-                                                 universe)
+from openmm_symprk.analysis.universe import KineticTemperatures
+from openmm_symprk.conservation.analysis import FLOAT32_FLOOR, AngularMomentum, LinearMomentum, universe
 from openmm_symprk.conservation import (angular_momentum, kinetic_temperatures, linear_momentum,
                                         molecule_angular_momentum)
 from openmm_symprk.conservation.reporters import VelocityTRRReporter, write_topology

@@ -212,10 +212,12 @@ def test_npt_with_a_monte_carlo_barostat_keeps_momentum():
     pytest.param("OpenCL", {"Precision": "double"}, False, 1e-11, marks=needs_opencl, id="OpenCL-double"),
     pytest.param("OpenCL", {"Precision": "mixed"}, True, 1e-10, marks=needs_opencl, id="OpenCL-mixed-exact"),
     pytest.param("OpenCL", {"Precision": "single"}, True, 1e-5, marks=needs_opencl, id="OpenCL-single-exact")])
-def test_angular_momentum_to_round_off_for_an_isolated_cluster(platform, props, exact, bound, water8):
+@pytest.mark.parametrize("position", ["ends", "middle"])
+def test_angular_momentum_to_round_off_for_an_isolated_cluster(platform, props, exact, bound, position, water8):
+    """Both placements (the middle one inside omelyan-2's central kick) on every platform and precision."""
     m = water8.masses()
     ig = N(2 * unit.femtoseconds, "omelyan-2", system=water8.system, temperature=300, collision_time=0.02,
-           random_seed=9, exact_momentum=exact)
+           random_seed=9, exact_momentum=exact, thermostat_position=position)
     assert ig.thermostat.keep_rotation
     ctx = water8.context(ig, platform, props)
     x0, v0 = _xv(ctx)
@@ -394,8 +396,14 @@ def test_temperature_changes_mid_run_and_the_rest_is_refused_clearly(water8):
         raw.setThermostat(-3, 0.1, 1, 10, False)
     with pytest.raises(mm.OpenMMException, match="collision time is 0 ps"):
         raw.setThermostat(300, 0, 1, 10, False)
-    with pytest.raises(mm.OpenMMException, match="interval is 0 steps"):
+    with pytest.raises(mm.OpenMMException, match=r"interval \(thermostat_interval\) is 0 steps; expected .* from 1 to 2147483647"):
         raw.setThermostat(300, 0.1, 0, 10, False)
+    # issue 27 #5: beyond a 32-bit int, the plugin's own message (not SWIG's OverflowError)
+    with pytest.raises(mm.OpenMMException, match=r"thermostat_interval\) is 1000000000000 steps; expected .* to 2147483647"):
+        raw.setThermostat(300, 0.1, 10**12, 10, False)
+    largest = swig.SymPRKIntegrator(0.001)
+    largest.setThermostat(300, 0.1, 2**31 - 1, 10, False)
+    assert largest.getThermostatInterval() == 2**31 - 1
     with pytest.raises(mm.OpenMMException, match="0 degrees of freedom"):
         raw.setThermostat(300, 0.1, 1, 0, False)
     with pytest.raises(mm.OpenMMException, match="no thermostat"):

@@ -8,7 +8,7 @@ import os
 import pytest
 
 from openmm_symprk.studies.bench import presets, stability
-from openmm_symprk.studies.bench import registry as scenes
+from openmm_symprk.systems.scenes import named as scenes
 from openmm_symprk.studies.bench.runs import RunSpec, execute
 from openmm_symprk.studies.bench.sweep import SweepExistsError, run_sweep
 from openmm_symprk.methods.catalogue import methods

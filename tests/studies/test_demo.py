@@ -15,7 +15,7 @@ def demo():
 
 def test_every_row_runs_in_table_order(demo):
     rows, text = demo
-    assert list(rows) == [label for label, _, _ in ROWS]
+    assert list(rows) == [name for name, _ in ROWS]
     platform, _ = default_platform()
     assert f"on {platform}." in text
     assert rows["OpenMM VerletIntegrator"].seconds_per_step > 0 and rows["symprk yoshida-4"].evals_per_step == 3

@@ -78,9 +78,9 @@ def hmr(tmp_path_factory):
 
 
 def _states(out, scene):
-    from openmm_symprk.studies.drift.scenes import state_key
+    from openmm_symprk.studies.drift.study import scene_state_key
 
-    with np.load(os.path.join(out, "states", f"{scene}-{state_key(presets.hmr(quick=True), scene)}.npz")) as d:
+    with np.load(os.path.join(out, "states", f"{scene}-{scene_state_key(presets.hmr(quick=True), scene)}.npz")) as d:
         return d["x"], d["v"]
 
 
@@ -115,10 +115,9 @@ def test_replicas_are_independent(hmr):
     drifts = [d[0] for d in summary["rows"][0]["per_replica"].values()]
     assert len(set(drifts)) == 3
     # the HMR scene has heavier hydrogens than the plain one
-    from openmm_symprk.studies.drift.scenes import build
+    from openmm_symprk.systems.scenes.named import build
 
-    plain, _, _ = build("villin-vacuum")
-    heavy, _, _ = build("villin-vacuum-hmr")
+    plain, heavy = build("villin-vacuum").system, build("villin-vacuum-hmr").system
     m = [plain.getParticleMass(i)._value for i in range(plain.getNumParticles())]
     mh = [heavy.getParticleMass(i)._value for i in range(heavy.getNumParticles())]
     assert min(mh) == pytest.approx(1.5) and min(m) < 1.1 and sum(m) == pytest.approx(sum(mh))

@@ -14,30 +14,30 @@ from openmm_symprk.studies.nvt import cost, drift, rows
 needs_native = pytest.mark.skipif(not plugin.available(), reason="native plugin not built")
 
 
-def test_every_row_kind_builds_its_integrator():
-    from openmm_symprk.systems.scenes import water_cluster
+def test_every_cost_row_builds_its_integrator():
+    from openmm_symprk.systems.scenes import water_box
 
-    system = water_cluster(4).system
-    expected = {"openmm-langevin": mm.LangevinMiddleIntegrator, "openmm-nosehoover": mm.NoseHooverIntegrator,
-                "openmm-dpd": mm.DPDIntegrator, "openmm-mtslangevin": mm.MTSLangevinIntegrator,
-                "openmm-verlet": mm.VerletIntegrator}
-    for kind, cls in expected.items():
-        ig, evals = rows.build(rows.Row(kind, kind, 2.0), system)
-        assert isinstance(ig, cls) and evals == (3 if kind == "openmm-mtslangevin" else 1)
-    ig, evals = rows.build(rows.Row("v", "symprk", 2.0, "omelyan-2", interval=10), system, backend="custom")
-    assert evals == 2 and ig.getThermostatInterval() == 10
+    system, _, _ = water_box("tip3p", n_waters=64, cutoff_nm=0.5)
+    expected = {"LangevinMiddle": (mm.LangevinMiddleIntegrator, 1), "NoseHoover (chain 3)": (mm.NoseHooverIntegrator, 1),
+                "DPD": (mm.DPDIntegrator, 1), "MTSLangevin 1x1+0x2": (mm.MTSLangevinIntegrator, 3),
+                "OpenMM Verlet (NVE)": (mm.VerletIntegrator, 1), "omelyan-2 + thermostat": (None, 2)}
+    found = {name: row for name, row, _ in cost.default_rows()}
+    for name, (cls, evals) in expected.items():
+        row = found[name]
+        if cls is not None:
+            assert isinstance(row.build(row.system_for(system)), cls)
+        assert row.evals_per_step(True) == evals
+    ig = found["verlet + thermostat /10"].replace(backend="custom").build(system)
+    assert ig.getThermostatInterval() == 10
     assert ig.getTemperature().value_in_unit(mm.unit.kelvin) == rows.TEMPERATURE
-    nve, _ = rows.build(rows.Row("v", "symprk", 2.0, "verlet", nvt=False), system, backend="custom")
-    assert nve.thermostat is None
-    with pytest.raises(ValueError, match="'bogus'.*openmm-langevin"):
-        rows.build(rows.Row("x", "bogus", 2.0), system)
+    assert found["verlet (NVE)"].replace(backend="custom").build(system).thermostat is None
 
 
 @needs_native
 def test_cost_quick_measures_every_row(capsys):
     out = cost.run(scenes=("water",), quick=True, steps=2, rounds=3)
     table = out["water"]
-    names = [r.name for r in cost.default_rows()]
+    names = [name for name, _, _ in cost.default_rows()]
     assert [r["row"] for r in table] == names
     for r in table:
         assert r["s_per_step"] > 0 and math.isfinite(r["ratio"]) and r["ratio"] > 0, r
@@ -70,7 +70,7 @@ def test_drift_quick_gives_estimates_with_errors_and_a_chart(tmp_path, capsys):
     assert symprk(["nvt", "drift", "--quick", "--chart", str(chart), "--json", str(data)]) == 0
     result = json.loads(data.read_text())
     assert result["replicas"] == 1 and result["dof"] == 3 * 648 - 3 * 216 - 3
-    assert [r["nvt_row"] for r in result["rows"]] == [p[0].name for p in drift.default_pairs(quick=True)]
+    assert [r["nvt_row"] for r in result["rows"]] == [p[0][0] for p in drift.default_pairs(quick=True)]
     for r in result["rows"]:
         for key in ("nvt", "nve", "difference"):
             est = r[key]
@@ -94,7 +94,7 @@ def test_bad_options_are_refused_with_their_value(capsys):
         with pytest.raises(SystemExit):
             symprk(["nvt", "drift", "--rows", bad])
         assert said in capsys.readouterr().err
-    assert [p[0].name for p in drift.pairs_from("omelyan-4@4, nosehoover@2")] == ["pefrl 4 fs", "NoseHoover 2 fs"]
+    assert [p[0][0] for p in drift.pairs_from("omelyan-4@4, nosehoover@2")] == ["pefrl 4 fs", "NoseHoover 2 fs"]
 
 
 @needs_native
@@ -107,8 +107,8 @@ def test_every_drift_row_gives_a_full_finite_series():
     sc = water_cluster(8, temperature=300.0)
     series = {}
     for nvt, nve in drift.default_pairs():
-        for row in (nvt, nve):
+        for name, row in (nvt, nve):
             t, e = drift.energy_series(row, sc.system, sc.positions, sc.velocities, 0.048, 12.0, seed=1, threads=1)
             assert len(t) >= 3 and t[-1] == pytest.approx(0.048, abs=row.step_fs * 1e-3) and all(map(math.isfinite, e))
-            series[row.name] = e
+            series[name] = e
     assert not (series["verlet 2 fs"] == series["verlet 2 fs NVE"]).all()

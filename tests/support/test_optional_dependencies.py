@@ -81,7 +81,7 @@ def test_an_installed_but_broken_package_reports_why(tmp_path, monkeypatch):
 
 @pytest.mark.parametrize("module, extra, message", [
     ("numpy", "analysis", "'numpy' is not an optional dependency"),
-    ("tqdm", "analysis", "the extra 'analysis' does not install tqdm (it is in 'studies', 'all')"),
+    ("pymbar", "analysis", "the extra 'analysis' does not install pymbar (it is in 'studies', 'all')"),
     ("MDAnalysis", "analysys", "the extra 'analysys' does not install MDAnalysis"),
 ])
 def test_a_wrong_call_is_a_value_error(module, extra, message):
@@ -209,7 +209,7 @@ FEATURES = {
     "stability_interval": ("from openmm_symprk.methods.stability import stability_interval\n"
                            "stability_interval('verlet')", "scipy", "analysis"),
     "bench charts": ("import openmm_symprk.studies.bench.charts", "matplotlib", "studies"),
-    "bench toys": ("import openmm_symprk.studies.bench.toys", "scipy", "studies"),
+    "bench toys": ("import openmm_symprk.systems.scenes.toys", "scipy", "studies"),
     "equipartition chart": ("from openmm_symprk.studies.equipartition.report import chart\n"
                             "chart({'models': {}}, os.path.join(TMP, 'x.png'))", "matplotlib", "studies"),
     "dask executor": ("from openmm_symprk.studies.core.executors import DaskExecutor\n"
@@ -257,7 +257,9 @@ def test_each_optional_feature_names_its_extra(feature_errors, feature):
 
 
 def test_a_study_command_without_its_extra_fails_in_one_line(tmp_path):
-    res = _run_without_extras(tmp_path, ["-m", "openmm_symprk.cli", "bench", "--help"])
+    res = _run_without_extras(tmp_path, ["-m", "openmm_symprk.cli", "bench", "--quick", "--scenes", "harmonic",
+                                         "--no-stability", "--no-charts", "--no-progress", "--workers", "1",
+                                         "--out", str(tmp_path / "out")])
     assert res.returncode == 2
     assert res.stderr.strip().count("\n") == 0, res.stderr  # one line, no traceback
     assert "needs scipy" in res.stderr and "pip install 'openmm_symprk[studies]'" in res.stderr, res.stderr

@@ -50,7 +50,7 @@ def _check_out(out: str):
 
 
 def build_parser() -> argparse.ArgumentParser:
-    from .registry import SCENES
+    from ...systems.scenes.named import SCENES
 
     p = argparse.ArgumentParser(
         prog="symprk bench",

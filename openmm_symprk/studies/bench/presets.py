@@ -17,7 +17,6 @@ from __future__ import annotations
 
 import copy
 
-from .toys import OMEGA_OH
 
 #: The rows of the default sweep: OpenMM's integrators, then one method per cost/order class.
 DEFAULT_METHODS = ["openmm-verlet", "openmm-langevin", "verlet", "omelyan-2", "yoshida-4", "pefrl",
@@ -29,7 +28,7 @@ REFERENCE = {"method": "kahan-li-8", "factor": 4}
 def _linear(rel_tol):
     from .stability import linear_settings
 
-    return linear_settings(OMEGA_OH, rel_tol)
+    return linear_settings(700.0, rel_tol)  # the harmonic scene's top frequency (toys.OMEGA_OH)
 
 
 def _md_stability(probe_steps, rel_tol=0.02, h0=1.0, grow=1.4, cap=12.0, samples=20):
@@ -144,7 +143,7 @@ def select(config: dict, scenes=None, methods=None, steps_fs=None, length_ps=Non
     if scenes:
         unknown = [s for s in scenes if s not in cfg["scenes"]]
         if unknown:
-            from .registry import SCENES
+            from ...systems.scenes.named import SCENES
 
             known = dict(full()["scenes"], **production()["scenes"])
             extra = {s: known[s] for s in unknown if s in SCENES}

@@ -28,10 +28,8 @@ gives them the same position trajectory as velocity Verlet from (x0, v0).
 from __future__ import annotations
 
 import math
-import re
 import time
 import traceback
-import warnings
 from dataclasses import asdict, dataclass
 
 import numpy as np
@@ -45,10 +43,9 @@ from ...systems.properties import constraint_violation
 from ...stats import drift
 from . import measure
 from .records import RunRecord
-from ...systems.scene import Scene
+from ...systems.scenes import Scene
+from ..core.rows import Row
 
-#: The comparison rows: OpenMM's own integrators.
-OPENMM_ROWS = ("openmm-verlet", "openmm-langevin")
 #: Constraint tolerance for every run (SETTLE ignores it; CCMA iterates to it) ...
 CONSTRAINT_TOLERANCE = 1e-10
 #: ... but production scenes run with OpenMM's default, as users do.
@@ -101,87 +98,51 @@ class Unsupported(Exception):
     """The method cannot run on this system."""
 
 
-#: Rows of multiple time stepping: "<method>[/<inner method>]@mts<n>" runs SymplecticIntegrator with the scene's slow
-#: force group 1 once per step and the fast group 0 n times; "openmm-mts<n>" is OpenMM's MTSIntegrator with the same.
-MTS_ROW = re.compile(r"^(?P<method>[^/@]+)(?:/(?P<inner>[^@]+))?@mts(?P<n>[0-9]+)$")
-OPENMM_MTS_ROW = re.compile(r"^openmm-mts(?P<n>[0-9]+)$")
-
-
-def mts_groups(n: int) -> list:
-    """The ``groups=`` of an MTS row: the scenes put the slow forces (PME reciprocal space) in group 1."""
-    return [(1, 1), (0, int(n))]
+def bench_row(method: str, step_fs: float, scene: Scene | None = None, seed: int = 1, temperature=None) -> Row:
+    """The :class:`~..core.rows.Row` of a bench row name at ``step_fs`` (its thermostat, if any, at the scene's
+    temperature unless ``temperature`` is given).  The bench's names are row labels without the step:
+    ``openmm-verlet``, ``openmm-langevin``, ``openmm-mts<n>``, ``<method>[/<inner>]@mts<n>`` (the scene's slow force
+    group 1 once per step, group 0 n times) or a catalogue name."""
+    row = Row.parse(method, step_fs=step_fs)
+    if row.thermostat:
+        t = temperature if temperature is not None else (scene.temperature if scene is not None else row.temperature)
+        row = row.replace(temperature=float(t), seed=int(seed))
+    return row
 
 
 def canonical_row(name: str) -> str:
     """The canonical name of a bench row (catalogue aliases resolved); ValueError naming what is accepted."""
-    from ...methods.catalogue import get_method
-
-    if name in OPENMM_ROWS or OPENMM_MTS_ROW.match(name):
-        return name
-    m = MTS_ROW.match(name)
-    if m:
-        if int(m["n"]) < 1:
-            raise ValueError(f"row {name!r}: the number of inner steps must be >= 1")
-        inner = f"/{get_method(m['inner']).name}" if m["inner"] else ""
-        return f"{get_method(m['method']).name}{inner}@mts{int(m['n'])}"
     try:
-        return get_method(name).name
-    except Exception as exc:
-        raise ValueError(f"{exc} Bench rows are catalogue names, {', '.join(OPENMM_ROWS)}, openmm-mts<n> (OpenMM's "
-                         f"MTSIntegrator) or <method>[/<inner>]@mts<n> (multiple time stepping)") from None
+        row = Row.parse(name, step_fs=1.0)
+    except ValueError as exc:
+        raise ValueError(f"{exc}. Bench rows are catalogue names, openmm-verlet, openmm-langevin, openmm-mts<n> "
+                         f"(OpenMM's MTSIntegrator) or <method>[/<inner>]@mts<n> (multiple time stepping)") from None
+    if row.who == "langevin":
+        return "openmm-langevin"
+    if row.who == "openmm-mts":
+        return f"openmm-mts{row.mts}"
+    if row.mts:
+        return f"{row.method}{'/' + row.inner if row.inner else ''}@mts{row.mts}"
+    return row.who
 
 
-def make_integrator(method: str, h_ps: float, scene: Scene, seed: int = 1, temperature=None):
-    """(integrator, force evaluations per step, leapfrog?) for a row name."""
+def make_integrator(method: str, step_fs: float, scene: Scene, seed: int = 1, temperature=None):
+    """(integrator, force evaluations per step, row) for a row name; Unsupported when the method cannot run
+    the scene's System."""
+    from ...integrators import ConstraintSupportError
+
     tolerance = PRODUCTION_CONSTRAINT_TOLERANCE if scene.purpose == "production" else CONSTRAINT_TOLERANCE
-    if method == "openmm-verlet":
-        ig, evals, leapfrog = mm.VerletIntegrator(h_ps), 1, True
-    elif method == "openmm-langevin":
-        t = scene.temperature if temperature is None else temperature
-        ig = mm.LangevinMiddleIntegrator(t * unit.kelvin, 1.0 / unit.picosecond, h_ps)
-        ig.setRandomNumberSeed(seed)
-        evals, leapfrog = 1, True
-    elif OPENMM_MTS_ROW.match(method):
-        from openmm.mtsintegrator import MTSIntegrator
-
-        n = int(OPENMM_MTS_ROW.match(method)["n"])
-        ig, evals, leapfrog = MTSIntegrator(h_ps, mts_groups(n)), 1 + n, False
-    else:
-        from ...integrators import ConstraintSupportError, SymplecticIntegrator
-        from ...methods.catalogue import get_method
-
-        mts = MTS_ROW.match(method)
-        m = get_method(mts["method"] if mts else method)
-        options = {} if m.symplectic else {"allow_nonsymplectic": True}
-        if mts:
-            options.update(groups=mts_groups(int(mts["n"])), inner_method=mts["inner"])
-        try:
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore")
-                ig = SymplecticIntegrator(h_ps, m.name, system=scene.system, **options)
-        except ConstraintSupportError as exc:
-            raise Unsupported(str(exc)) from None
-        evals, leapfrog = ig.program_info.force_evals, False
-    ig.setConstraintTolerance(tolerance)
-    return ig, evals, leapfrog
+    row = bench_row(method, step_fs, scene, seed, temperature)
+    try:
+        ig = row.build(scene.system, constraint_tolerance=tolerance)
+    except ConstraintSupportError as exc:
+        raise Unsupported(str(exc)) from None
+    return ig, row.evals_per_step(scene.system.getNumConstraints() > 0), row
 
 
 def make_context(scene: Scene, integrator, platform: str, threads: int = 1):
     plat = mm.Platform.getPlatformByName(platform)
     return mm.Context(scene.system, integrator, plat, platform_properties(platform, threads))
-
-
-def set_initial_state(ctx, scene: Scene, x0, v0, h_ps: float, leapfrog: bool):
-    ctx.setPositions(x0)
-    if leapfrog:
-        f = ctx.getState(getForces=True).getForces(asNumpy=True).value_in_unit(
-            unit.kilojoule_per_mole / unit.nanometer)
-        m = scene.masses()
-        inv = np.where(m > 0, 1.0 / np.where(m > 0, m, 1.0), 0.0)
-        v0 = v0 - 0.5 * h_ps * np.asarray(f) * inv[:, None]
-    ctx.setVelocities(v0)
-    if leapfrog and scene.system.getNumConstraints():
-        ctx.applyVelocityConstraints(CONSTRAINT_TOLERANCE)
 
 
 def base_record(spec: RunSpec, scene: Scene, platform: str) -> RunRecord:
@@ -207,11 +168,11 @@ def execute(spec: RunSpec, scene: Scene) -> tuple[RunRecord, dict]:
     arrays = {}
     t_setup = time.perf_counter()
     try:
-        ig, evals, leapfrog = make_integrator(spec.method, spec.h_ps, scene, spec.seed)
+        ig, evals, row = make_integrator(spec.method, spec.step_fs, scene, spec.seed)
         rec.force_evals_per_step = evals
         rec.force_evals_per_ps = evals / spec.h_ps
         ctx = make_context(scene, ig, platform, spec.threads)
-        set_initial_state(ctx, scene, scene.positions, scene.velocities, spec.h_ps, leapfrog)
+        row.set_state(ctx, scene.positions, scene.velocities, CONSTRAINT_TOLERANCE)
     except Unsupported as exc:
         rec.update(status="unsupported", failure=str(exc).split(". ")[0])
         return rec, arrays
@@ -317,7 +278,7 @@ def _measure(spec, scene, ctx, ig, rec, arrays):
     completed = done == spec.n_steps and not rec.blew_up
     if completed:
         if scene.exact is not None:
-            from .toys import exact_state
+            from ...systems.scenes.toys import exact_state
 
             xe, _ = exact_state(scene.exact, spec.length_ps)
             rec.traj_error = measure.rms_deviation(x, xe)
@@ -344,9 +305,9 @@ def _time(spec, scene, ig, rec, per_step_estimate, rounds=TIMING_ROUNDS):
     it can."""
     n_time = _steps_for(spec.timing_s / (2 * rounds), per_step_estimate)
     platform = spec.platform or scene.platform
-    v_ig, _, _ = make_integrator("openmm-verlet", VERLET_TIMING_STEP_FS * 1e-3, scene)
+    v_ig, _, v_row = make_integrator("openmm-verlet", VERLET_TIMING_STEP_FS, scene)
     v_ctx = make_context(scene, v_ig, platform, spec.threads)
-    set_initial_state(v_ctx, scene, scene.positions, scene.velocities, VERLET_TIMING_STEP_FS * 1e-3, True)
+    v_row.set_state(v_ctx, scene.positions, scene.velocities, CONSTRAINT_TOLERANCE)
     v_ig.step(2)  # warm up (kernels, force cache)
     t0 = time.perf_counter()
     v_ig.step(10)
@@ -372,10 +333,10 @@ def retime(spec: RunSpec, scene: Scene, rec: RunRecord, rounds: int = TIMING_ROU
         raise ValueError(f"run {rec.method} at {rec.step_fs:g} fs on {rec.scene} has no timing to measure again "
                          f"(status {rec.status!r})")
     platform = spec.platform or scene.platform
-    ig, _, leapfrog = make_integrator(spec.method, spec.h_ps, scene, spec.seed)
+    ig, _, row = make_integrator(spec.method, spec.step_fs, scene, spec.seed)
     ctx = make_context(scene, ig, platform, spec.threads)
     try:
-        set_initial_state(ctx, scene, scene.positions, scene.velocities, spec.h_ps, leapfrog)
+        row.set_state(ctx, scene.positions, scene.velocities, CONSTRAINT_TOLERANCE)
         ig.step(2)  # warm up (kernels, force cache)
         t0 = time.perf_counter()
         ig.step(5)

@@ -44,7 +44,7 @@ _probe_systems: dict = {}
 
 
 def _dense_harmonic(omega_max: float):
-    from . import toys
+    from ...systems.scenes import toys
 
     key = float(omega_max)
     if key not in _probe_systems:
@@ -55,7 +55,7 @@ def _dense_harmonic(omega_max: float):
 
 def linear_probe(spec: RunSpec, scene):
     """One step of ``spec.method`` on the dense harmonic spectrum; fails if the one-step map grows."""
-    from ...systems.scene import Scene
+    from ...systems.scenes import Scene
 
     omega_max = scene.linear["omega_max"]
     omega, system = _dense_harmonic(omega_max)
@@ -65,7 +65,7 @@ def linear_probe(spec: RunSpec, scene):
     rec = base_record(spec, probe_scene, platform)
     rec.n_oscillators = len(omega)
     try:
-        ig, evals, _ = make_integrator(spec.method, spec.h_ps, probe_scene, spec.seed, temperature=0.0)
+        ig, evals, _ = make_integrator(spec.method, spec.step_fs, probe_scene, spec.seed, temperature=0.0)
     except Unsupported as exc:
         rec.update(status="unsupported", failure=str(exc).split(". ")[0])
         return rec

@@ -32,7 +32,8 @@ from ..core.executors import make_executor
 from ..core.jobs import Job, run_jobs, single
 from . import presets
 from .records import RunRecord
-from .runs import OPENMM_ROWS, RunSpec, label
+from ..core.rows import Row
+from .runs import RunSpec, label
 from .store import Store, run_key
 
 
@@ -46,21 +47,14 @@ class SweepLockedError(FolderLockedError):
 
 def _evals(method):
     """Force evaluations per step of a row (a cost estimate for scheduling)."""
-    from ...methods.catalogue import get_method
-    from .runs import MTS_ROW, OPENMM_MTS_ROW
-
-    if method in OPENMM_ROWS:
-        return 1
-    mts = MTS_ROW.match(method) or OPENMM_MTS_ROW.match(method)
-    if mts:
-        return 1 + int(mts["n"])
-    return get_method(method).force_evals
+    return Row.parse(method, step_fs=1.0).evals_per_step()
 
 
 # -- scenes --------------------------------------------------------------------------------------
 def prepare_scenes(config: dict, out: str, reuse: bool = True, log=print) -> dict:
     """Build (or, with ``reuse``, load the saved copy of) every scene of ``config``."""
-    from .registry import build, load_scene, save_scene, user_scene
+    from ...systems.scenes import load_scene, save_scene
+    from ...systems.scenes.named import build, user_scene
 
     folder = os.path.join(out, "scenes")
     result = {}
@@ -136,7 +130,7 @@ _scenes: dict = {}
 def work(payload: dict, spec_dict: dict):
     """One spec in whatever process executes it (each scene is rebuilt from its payload once per process);
     returns (record, arrays)."""
-    from ...systems.scene import Scene
+    from ...systems.scenes import Scene
     from .stability import run_spec
 
     key = (payload["info"]["name"], payload["fingerprint"])

@@ -6,20 +6,19 @@ study called again finds exactly the runs it already did, and a changed setting 
 """
 from __future__ import annotations
 
-import hashlib
 import json
 import os
 
 import numpy as np
 
-from .folders import write_json, write_npz
+from ...support.files import content_key, write_json, write_npz
 
 __all__ = ["run_key", "RunStore"]
 
 
 def run_key(obj, length: int = 16) -> str:
     """The key of a run: the SHA-1 of ``obj`` as sorted JSON, cut to ``length`` hex digits."""
-    return hashlib.sha1(json.dumps(obj, sort_keys=True).encode()).hexdigest()[:length]
+    return content_key(obj, length)
 
 
 class RunStore:

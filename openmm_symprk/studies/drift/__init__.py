@@ -8,7 +8,7 @@ Two questions use it (presets in :mod:`.presets`):
   precision (docs/conservation.md)?
 
 Modules: :mod:`.verdict` (pure statistics: drifts per row, paired comparisons, the verdict), :mod:`.presets`
-(configurations), :mod:`.scenes` (the systems and their independent replica states), :mod:`.runs` (one NVE run),
+(configurations), :mod:`openmm_symprk.systems.scenes.replicas` (the named scenes' independent replica states), :mod:`.runs` (one NVE run),
 :mod:`.study` (the study on :mod:`openmm_symprk.studies.core`: resumable, one stored run per key), :mod:`.report`
 (tables) and :mod:`.cli`.
 """

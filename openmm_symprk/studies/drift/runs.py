@@ -9,30 +9,19 @@ computed when the study summarises (:func:`.verdict.run_drift`) and a better est
 from __future__ import annotations
 
 import time
-import warnings
 
 import numpy as np
 import openmm as mm
 import openmm.unit as unit
 
-__all__ = ["make_integrator", "properties", "run_nve"]
+from ..core.rows import Row
+
+__all__ = ["row_of", "properties", "run_nve"]
 
 
-def make_integrator(row: dict, system, tolerance: float):
-    """(integrator, leapfrog?) of a row."""
-    h = float(row["step_fs"]) * 1e-3
-    if row["integrator"] == "openmm-verlet":
-        ig, leapfrog = mm.VerletIntegrator(h), True
-    else:
-        from ...integrators import SymplecticIntegrator
-
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            ig = SymplecticIntegrator(h, row["integrator"], system=system,
-                                      exact_momentum=bool(row.get("exact_momentum", False)))
-        leapfrog = False
-    ig.setConstraintTolerance(float(tolerance))
-    return ig, leapfrog
+def row_of(row: dict) -> Row:
+    """The :class:`~..core.rows.Row` of a drift row (``integrator``, ``step_fs``, ``exact_momentum``)."""
+    return Row(row["integrator"], float(row["step_fs"]), exact_momentum=bool(row.get("exact_momentum", False)))
 
 
 def properties(row: dict, threads: int) -> dict:
@@ -46,24 +35,15 @@ def properties(row: dict, threads: int) -> dict:
 def run_nve(system, x0, v0, row: dict, cfg: dict):
     """(arrays {"t": ps, "e": kJ/mol}, info) of one NVE run; a blow-up is a record (status "blew-up"), not an
     exception."""
-    from ...systems.properties import degrees_of_freedom, masses
+    from ...systems.properties import degrees_of_freedom
 
-    ig, leapfrog = make_integrator(row, system, cfg["constraint_tolerance"])
+    spec = row_of(row)
+    ig = spec.build(system, constraint_tolerance=cfg["constraint_tolerance"])
     plat = mm.Platform.getPlatformByName(row["platform"])
     ctx = mm.Context(system, ig, plat, properties(row, cfg.get("threads", 1)))
     info = {"status": "ok", "n_dof": int(degrees_of_freedom(system)), "platform_used": plat.getName()}
     try:
-        ctx.setPositions(x0)
-        v = np.array(v0, dtype=np.float64)
-        if leapfrog:
-            f = ctx.getState(getForces=True).getForces(asNumpy=True).value_in_unit(unit.kilojoule_per_mole /
-                                                                                    unit.nanometer)
-            m = masses(system)
-            inv = np.where(m > 0, 1.0 / np.where(m > 0, m, 1.0), 0.0)
-            v = v - 0.5 * float(row["step_fs"]) * 1e-3 * np.asarray(f) * inv[:, None]
-        ctx.setVelocities(v)
-        if leapfrog and system.getNumConstraints():
-            ctx.applyVelocityConstraints(1e-10)
+        spec.set_state(ctx, x0, v0)
         h_ps = float(row["step_fs"]) * 1e-3
         n_steps = int(round(float(cfg["length_ps"]) / h_ps))
         every = max(1, int(round(float(cfg["sample_ps"]) / h_ps)))

@@ -11,7 +11,7 @@ from __future__ import annotations
 import os
 
 from ..core import Run, Study, run_key as hash_key, write_json, write_text
-from .scenes import replica_states, state_key
+from ...systems.scenes.replicas import replica_states, state_key
 
 __all__ = ["DriftStudy", "run_study", "run_key", "check"]
 
@@ -21,14 +21,24 @@ _RUN_KEYS = ("length_ps", "sample_ps", "constraint_tolerance", "threads", "tempe
 _ROW_KEYS = ("scene", "integrator", "step_fs", "platform", "precision", "exact_momentum")
 
 
+def scene_state_key(cfg: dict, scene: str) -> str:
+    return state_key(scene, cfg["temperature"], cfg["seed"], cfg["decorrelate_ps"])
+
+
+def states_of(cfg: dict, scene: str, out: str, log=print) -> dict:
+    """The replica states of ``scene`` for ``cfg``, kept in ``<out>/states`` (:func:`~openmm_symprk.systems.scenes.replicas.replica_states`)."""
+    return replica_states(scene, os.path.join(out, "states"), int(cfg["replicas"]), float(cfg["temperature"]),
+                          int(cfg["seed"]), float(cfg["decorrelate_ps"]), int(cfg.get("threads", 1)), log)
+
+
 def run_key(cfg: dict, row: dict, replica: int) -> str:
     return hash_key({"cfg": {k: cfg[k] for k in _RUN_KEYS}, "row": {k: row.get(k) for k in _ROW_KEYS},
-                     "replica": int(replica), "states": state_key(cfg, row["scene"]), "version": RUN_VERSION})
+                     "replica": int(replica), "states": scene_state_key(cfg, row["scene"]), "version": RUN_VERSION})
 
 
 def check(cfg: dict):
     """ValueError naming the bad value and what is accepted."""
-    from .scenes import SCENES
+    from ...systems.scenes.named import SCENES
 
     if int(cfg["replicas"]) < 1:
         raise ValueError(f"replicas must be >= 1, got {cfg['replicas']!r}")
@@ -45,10 +55,9 @@ def check(cfg: dict):
             raise ValueError(f"row {row['name']}: unknown scene {row['scene']!r}; known: {', '.join(SCENES)}")
         if not float(row["step_fs"]) > 0:
             raise ValueError(f"row {row['name']}: step_fs must be positive, got {row['step_fs']!r}")
-        if row["integrator"] != "openmm-verlet":
-            from ...methods.catalogue import get_method
+        from .runs import row_of
 
-            get_method(row["integrator"])  # UnknownMethodError names the catalogue
+        row_of(row)  # ValueError naming the catalogue and OpenMM's integrators
         n = float(cfg["length_ps"]) * 1e3 / float(row["step_fs"])
         if round(n) < 3:
             raise ValueError(f"row {row['name']}: {cfg['length_ps']} ps is under 3 steps of {row['step_fs']} fs")
@@ -109,7 +118,7 @@ class DriftStudy(Study):
     def plan(self) -> list:
         cfg = self.cfg
         rows = self.rows()
-        self.states = {s: replica_states(cfg, s, self.out, self.log) for s in dict.fromkeys(r["scene"] for r in rows)}
+        self.states = {s: states_of(cfg, s, self.out, self.log) for s in dict.fromkeys(r["scene"] for r in rows)}
         runs = []
         for row in rows:
             cost = float(cfg["length_ps"]) / float(row["step_fs"]) * (10.0 if "pme" in row["scene"] else 1.0)

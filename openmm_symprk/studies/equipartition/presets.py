@@ -1,6 +1,6 @@
 """Settings of the equipartition study (data only).
 
-Rows are [method, step in fs]; ``rigid:<method>`` runs the molecules as rigid bodies
+Rows are [method, step in fs] (the who and step of a :class:`~..core.rows.Row`); ``rigid:<method>`` runs the molecules as rigid bodies
 (:class:`openmm_symprk.rigid.bodies.RigidBodies`, ``rigid:verlet`` = NO_SQUISH); any other name is a
 catalogue method run by :class:`~openmm_symprk.SymplecticIntegrator` with RATTLE/SETTLE.
 """
@@ -8,9 +8,7 @@ from __future__ import annotations
 
 import copy
 
-__all__ = ["full", "quick", "RIGID_PREFIX"]
-
-RIGID_PREFIX = "rigid:"
+__all__ = ["full", "quick"]
 
 
 def full() -> dict:

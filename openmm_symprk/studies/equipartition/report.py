@@ -15,7 +15,7 @@ import numpy as np
 
 from ...physics.temperature import R_KJ
 from ...support import require
-from .presets import RIGID_PREFIX
+from ..core.rows import Row
 from .runs import force_evals_per_step
 from ...stats import Estimate, agrees, combine, drift, paired, series_stats
 
@@ -79,7 +79,7 @@ def summarise(cfg: dict, runs: dict, timings: dict | None = None) -> dict:
             good = [(a, i) for a, i in reps if i.get("status") == "ok"]
             failed = [i["status"] for a, i in reps if i.get("status") != "ok"]
             row = {"method": method, "step_fs": h, "label": label(method, h), "replicas": len(good),
-                   "failed": failed, "rigid_body": method.startswith(RIGID_PREFIX),
+                   "failed": failed, "rigid_body": Row(method, h).is_rigid,
                    "evals_per_ps": force_evals_per_step(method) / (h * 1e-3),
                    "s_per_ps": timings.get((model, method, h))}
             if good and min(len(a["t"]) for a, _ in good) >= 3:
@@ -210,7 +210,7 @@ def chart(summary: dict, path: str):
             axes[0].axhspan(m - 2 * s, m + 2 * s, color=col, alpha=0.15)
         for method in sorted({r["method"] for r in rows}):
             rs = sorted((r for r in rows if r["method"] == method), key=lambda r: r["step_fs"])
-            base = method[len(RIGID_PREFIX):] if method.startswith(RIGID_PREFIX) else method
+            base = Row(method, 1.0).method
             style = dict(marker=markers.get(base, "^"), color=col, linestyle="--" if method != base else "-",
                          mfc="none" if method != base else col, capsize=3, label=f"{model} {method}")
             axes[0].errorbar([r["step_fs"] for r in rs], [r["dT"]["mean"] for r in rs],

@@ -13,14 +13,12 @@ import numpy as np
 import openmm as mm
 import openmm.unit as unit
 
-from ...methods.catalogue import get_method
 from ...physics.momenta import kinetic_energy
 from ...physics.temperature import kinetic_temperatures
 from ...rigid.bodies import RigidBodies
 from ...systems.prepare import equilibrate, minimise, without_net_momentum
-from ...systems.scene import Scene
-from ...systems.scenes import WATER_DENSITY_G_CM3, water_box
-from .presets import RIGID_PREFIX
+from ...systems.scenes import WATER_DENSITY_G_CM3, Scene, water_box
+from ..core.rows import Row
 
 __all__ = ["build_box", "replica_states", "run_nve", "steps_per_sample", "force_evals_per_step", "make_engine"]
 
@@ -66,8 +64,8 @@ def replica_states(box: Scene, cfg: dict, log=print, start=None):
 
 
 def force_evals_per_step(method: str) -> int:
-    name = method[len(RIGID_PREFIX):] if method.startswith(RIGID_PREFIX) else method
-    return get_method(name).force_evals
+    """Force evaluations per step of a row's method (``rigid:<method>`` too), under constraints."""
+    return Row(method, 1.0).evals_per_step(constraints=True)
 
 
 def steps_per_sample(step_fs: float, sample_fs: float) -> int:
@@ -75,10 +73,8 @@ def steps_per_sample(step_fs: float, sample_fs: float) -> int:
 
 
 class _Constrained:
-    def __init__(self, box, x, v, method, step_fs, props):
-        from ...integrators import SymplecticIntegrator
-
-        self.integrator = SymplecticIntegrator(step_fs * unit.femtoseconds, method, system=box.system)
+    def __init__(self, box, x, v, row, props):
+        self.integrator = row.build(box.system)
         self.context = mm.Context(box.system, self.integrator, mm.Platform.getPlatformByName("CPU"), props)
         self.context.setPositions(x)
         self.context.setVelocities(v)
@@ -94,8 +90,8 @@ class _Constrained:
 
 
 class _Rigid:
-    def __init__(self, box, x, v, method, step_fs, props):
-        self.engine = RigidBodies(box.system, x, v, box.molecules, step_fs * 1e-3, method, "CPU", props)
+    def __init__(self, box, x, v, row, props):
+        self.engine = RigidBodies(box.system, x, v, box.molecules, row.h_ps, row.method, "CPU", props)
 
     def step(self, n):
         self.engine.step(n)
@@ -105,10 +101,9 @@ class _Rigid:
 
 
 def make_engine(box, x, v, method, step_fs, threads):
-    props = {"Threads": str(threads)}
-    if method.startswith(RIGID_PREFIX):
-        return _Rigid(box, x, v, method[len(RIGID_PREFIX):], step_fs, props)
-    return _Constrained(box, x, v, method, step_fs, props)
+    """The running row ``method`` at ``step_fs`` (``rigid:<method>``: the rigid-body engine) from (x, v)."""
+    row = Row(method, float(step_fs))
+    return (_Rigid if row.is_rigid else _Constrained)(box, x, v, row, {"Threads": str(threads)})
 
 
 def run_nve(box: Scene, x, v, method: str, step_fs: float, cfg: dict):

@@ -114,11 +114,11 @@ def _check(cfg):
         if not float(cfg[k]) > 0:
             raise ValueError(f"{k} must be positive, got {cfg[k]!r}")
     from ...methods.catalogue import get_method
-    from .presets import RIGID_PREFIX
+    from ..core.rows import Row
 
     for model, rows in cfg["models"].items():
         for method, h in rows:
-            m = get_method(method[len(RIGID_PREFIX):] if method.startswith(RIGID_PREFIX) else method)
+            m = get_method(Row(method, 1.0).method)
             if not m.is_splitting:
                 raise ValueError(f"{model}: row {method} is a {m.family} method; rigid water (constraints, or the "
                                  f"rigid-body engine) runs kick/drift splittings and compositions only, e.g. "

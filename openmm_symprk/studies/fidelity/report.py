@@ -16,9 +16,9 @@ import numpy as np
 
 from ...stats import combine, paired
 from ...support import require
-from .diffusion import VISCOSITY_MPAS, yeh_hummer
+from ...analysis.diffusion import VISCOSITY_MPAS, yeh_hummer
 from .extrapolation import extrapolate_h2
-from .observe import OBSERVABLES
+from ...analysis.observe import OBSERVABLES
 from .rowspec import describe
 
 __all__ = ["K_SE", "MATCHED", "summarise", "format_summary", "chart", "claim"]

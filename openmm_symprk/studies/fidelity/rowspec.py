@@ -1,5 +1,5 @@
-"""What a row of the fidelity study is (pure; the rows are data in :mod:`.presets`, and
-:mod:`.simulation.engines` makes them into running OpenMM integrators).
+"""What a row of the fidelity study is: its stored form (a dict, whose fields the runs' keys hash) read as the studies'
+one row type, :class:`~..core.rows.Row` (the rows are data in :mod:`.presets`; :mod:`.simulation.engines` runs them).
 
 :func:`check_row` validates a row and names what is wrong; :func:`label` names it; :func:`describe` gives its
 label, ensemble, force evaluations per step, whether it keeps the total momentum and whether it has a conserved
@@ -8,8 +8,9 @@ effective energy.
 from __future__ import annotations
 
 from ...methods.catalogue import get_method
+from ..core.rows import Row
 
-__all__ = ["KINDS", "UNAVAILABLE_THERMOSTAT", "check_row", "describe", "label"]
+__all__ = ["KINDS", "UNAVAILABLE_THERMOSTAT", "check_row", "describe", "label", "to_row"]
 
 #: Options each kind of row takes (besides kind, step_fs and hmr_da).
 KINDS = {"symprk": {"method", "collision_time_ps"}, "langevin": {"friction_per_ps"},
@@ -43,37 +44,29 @@ def check_row(row: dict) -> dict:
                              f"and compositions only (e.g. verlet, omelyan-2, pefrl)")
     if "inner_steps" in row and int(row["inner_steps"]) != row["inner_steps"]:
         raise ValueError(f"row {row!r}: inner_steps must be a whole number")
+    to_row(row)  # what the row type refuses
     return dict(row, step_fs=float(row["step_fs"]))
 
 
-def _g(x) -> str:
-    return f"{float(x):g}"
+def to_row(row: dict, temperature: float = 300.0) -> Row:
+    """The :class:`~..core.rows.Row` of a fidelity row (a dict of :data:`KINDS`; the study's ``temperature``)."""
+    kind = row["kind"]
+    return Row(row["method"] if kind == "symprk" else kind, float(row["step_fs"]), mts=int(row.get("inner_steps", 0)),
+               tau_ps=row.get("collision_time_ps"), friction_per_ps=row.get("friction_per_ps"),
+               collision_per_ps=row.get("collision_frequency_per_ps"), cutoff_nm=row.get("cutoff_nm"),
+               hmr_da=row.get("hmr_da"), temperature=float(temperature))
 
 
 def label(row: dict) -> str:
-    """e.g. 'verlet 0.5 fs', 'omelyan-2 4 fs SVR 1 ps', 'langevin 4 fs friction 1/ps HMR 3 Da'."""
-    kind, h = row["kind"], _g(row["step_fs"])
-    if kind == "symprk":
-        text = f"{row['method']} {h} fs" + (f" SVR {_g(row['collision_time_ps'])} ps" if "collision_time_ps" in row
-                                            else "")
-    elif kind == "mts-langevin":
-        text = f"mts-langevin {h}/{int(row['inner_steps'])} fs friction {_g(row['friction_per_ps'])}/ps"
-    elif kind == "nose-hoover":
-        text = f"nose-hoover {h} fs {_g(row['collision_frequency_per_ps'])}/ps"
-    else:
-        text = f"{kind} {h} fs friction {_g(row['friction_per_ps'])}/ps"
-    return text + (f" HMR {_g(row['hmr_da'])} Da" if "hmr_da" in row else "")
+    """e.g. 'verlet 0.5 fs', 'omelyan-2 4 fs SVR 1 ps', 'langevin 4 fs friction 1/ps HMR 3 Da' (:attr:`Row.label`)."""
+    return to_row(row).label
 
 
 def describe(row: dict) -> dict:
-    """label; ensemble ("NVE" or "NVT"); evals_per_step (force evaluations; MTS: force-group evaluations, one
-    reciprocal-space and inner_steps direct-space); keeps_momentum; heat_bath (a conserved effective energy:
-    NVE's total energy, or total + heat-bath energy); family ("symprk" or "openmm")."""
-    kind = row["kind"]
-    nvt = kind != "symprk" or "collision_time_ps" in row
-    evals = {"symprk": lambda: get_method(row["method"]).force_evals,
-             "mts-langevin": lambda: 1 + int(row["inner_steps"])}.get(kind, lambda: 1)()
-    return {"label": label(row), "ensemble": "NVT" if nvt else "NVE", "evals_per_step": evals,
-            "keeps_momentum": kind not in ("langevin", "mts-langevin"),
-            "effective_energy": kind in ("symprk", "nose-hoover"), "family": "symprk" if kind == "symprk" else "openmm",
-            "hmr": "hmr_da" in row}
+    """label; ensemble ("NVE" or "NVT"); evals_per_step (force evaluations of the resolved method under constraints;
+    MTS: force-group evaluations, one reciprocal-space and inner_steps direct-space); keeps_momentum; heat_bath (a
+    conserved effective energy: NVE's total energy, or total + heat-bath energy); family ("symprk" or "openmm")."""
+    r = to_row(row)
+    return {"label": r.label, "ensemble": r.ensemble, "evals_per_step": r.evals_per_step(constraints=True),
+            "keeps_momentum": r.keeps_momentum, "effective_energy": r.has_heat_bath,
+            "family": "symprk" if r.is_ours else "openmm", "hmr": r.hmr_da is not None}

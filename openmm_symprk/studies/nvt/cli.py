@@ -8,8 +8,8 @@
 from __future__ import annotations
 
 import argparse
-import json
 
+from ...support.files import write_json
 from ..core.cli import positive
 
 
@@ -46,8 +46,7 @@ def build_parser():
 
 
 def _write_json(path, data):
-    with open(path, "w") as fh:
-        json.dump(data, fh, indent=1)
+    write_json(path, data)
     print(f"wrote {path}")
 
 

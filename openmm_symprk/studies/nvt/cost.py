@@ -22,38 +22,27 @@ import numpy as np
 import openmm as mm
 
 from ..timing import interleaved
-from .rows import MTS_GROUPS, Row, build
+from .rows import cost_rows
 
 BASELINE = "LangevinMiddle"
 
 
 def default_rows() -> list:
-    """The rows of the cost table: OpenMM's thermostats, ours at interval 1 and 10, NVE for reference, MTS."""
-    mts = "+".join(f"{g}x{n}" for g, n in MTS_GROUPS)
-    return [
-        Row(BASELINE, "openmm-langevin", 2.0),
-        Row("NoseHoover (chain 3)", "openmm-nosehoover", 2.0),
-        Row("DPD", "openmm-dpd", 2.0),
-        Row("OpenMM Verlet (NVE)", "openmm-verlet", 2.0),
-        Row("verlet (NVE)", "symprk", 2.0, "verlet", nvt=False, peer="OpenMM Verlet (NVE)"),
-        Row("verlet + thermostat", "symprk", 2.0, "verlet"),
-        Row("verlet + thermostat /10", "symprk", 2.0, "verlet", interval=10),
-        Row("omelyan-2 + thermostat", "symprk", 4.0, "omelyan-2"),
-        Row(f"MTSLangevin {mts}", "openmm-mtslangevin", 4.0),
-        Row(f"verlet MTS {mts} + thermostat", "symprk", 4.0, "verlet", mts=True, peer=f"MTSLangevin {mts}"),
-    ]
+    """The rows of the cost table (:data:`.rows.COST_ROWS`): OpenMM's thermostats, ours at interval 1 and 10, NVE for
+    reference, MTS; (name, Row, peer) each."""
+    return cost_rows()
 
 
 def scene(name: str, quick: bool):
     """(title, system, positions, velocities) of a cost scene; ``quick``: a small water box / short equilibration."""
     from ...systems.forcegroups import split_forces
-    from ..bench import registry
+    from ...systems.scenes import named
 
     if name == "water":
-        sc = registry.water_box_pme(box_nm=2.2 if quick else 3.9)
+        sc = named.water_box_pme(box_nm=2.2 if quick else 3.9)
         split_forces(sc.system, slow="reciprocal")
     elif name == "villin":
-        sc = registry.villin_pme(equilibrate_ps=0.02 if quick else 0.2)
+        sc = named.villin_pme(equilibrate_ps=0.02 if quick else 0.2)
     else:
         raise ValueError(f"unknown cost scene {name!r}; known: water, villin")
     return f"{sc.name}: {sc.description}", sc.system, sc.positions, sc.velocities
@@ -68,13 +57,13 @@ def measure(system, positions, velocities, rows, steps, rounds: int, threads: in
     plat = mm.Platform.getPlatformByName(platform)
     props = {"Threads": str(threads)} if platform == "CPU" else {}
     contexts, evals = {}, {}
-    for row in rows:
-        ig, evals[row.name] = build(row, system, seed=1)
+    for name, row, _ in rows:
+        ig, evals[name] = row.build(system), row.evals_per_step(system.getNumConstraints() > 0)
         ctx = mm.Context(system, ig, plat, props)
         ctx.setPositions(positions)
         ctx.setVelocities(velocities)
         ig.step(3)  # warm-up: neighbour lists, kernels, caches
-        contexts[row.name] = (ctx, ig)
+        contexts[name] = (ctx, ig)
     if isinstance(steps, float):
         per_step = interleaved({k: lambda n, ig=ig: ig.step(n) for k, (_, ig) in contexts.items()}, 2, rounds=1)
         steps = {k: int(min(400, max(2, round(steps / t.best)))) for k, t in per_step.items()}
@@ -101,15 +90,15 @@ def ratios(measured: dict, rows) -> list:
     """One dict per row: seconds per step (fastest block), the ratio to the baseline (median of the round-by-round
     ratios, with quartiles, and fastest over fastest), per ps simulated, and the ratio to its peer."""
     base = measured[BASELINE][0]
-    base_dt = next(r.step_fs for r in rows if r.name == BASELINE)
+    base_dt = next(r.step_fs for name, r, _ in rows if name == BASELINE)
     out = []
-    for r in rows:
-        t, evals = measured[r.name]
+    for name, r, peer in rows:
+        t, evals = measured[name]
         median, q25, q75 = paired_ratio(t, base)
-        out.append({"row": r.name, "step_fs": r.step_fs, "evals": evals, "s_per_step": t.best, "ratio": median,
+        out.append({"row": name, "step_fs": r.step_fs, "evals": evals, "s_per_step": t.best, "ratio": median,
                     "ratio_q25": q25, "ratio_q75": q75, "ratio_best": t.best / base.best,
-                    "ratio_per_ps": median * base_dt / r.step_fs, "peer": r.peer,
-                    "peer_ratio": paired_ratio(t, measured[r.peer][0])[0] if r.peer else None})
+                    "ratio_per_ps": median * base_dt / r.step_fs, "peer": peer,
+                    "peer_ratio": paired_ratio(t, measured[peer][0])[0] if peer else None})
     return out
 
 
@@ -149,7 +138,7 @@ def run(scenes=("water", "villin"), quick: bool = False, steps=None, rounds: int
         raise RuntimeError(f"the native backend is unavailable: {plugin.unavailable_reason()}")
     log(f"openmm {mm.version.full_version}, platform CPU, {threads} threads, load average before "
         f"{os.getloadavg()[0]:.2f} (other processes slow some blocks; each row keeps its fastest)")
-    rows = [r for r in default_rows() if not (no_forces and (r.mts or r.kind == "openmm-mtslangevin"))]  # no groups
+    rows = [r for r in default_rows() if not (no_forces and r[1].mts)]  # no forces, no groups
     out = {}
     for name in scenes:
         title, system, x, v = scene(name, quick)

@@ -26,7 +26,8 @@ import openmm.unit as unit
 
 from ...physics.temperature import R_KJ
 from ...stats import combine, drift, paired
-from .rows import TEMPERATURE, Row, build
+from ..core.rows import Row
+from .rows import TEMPERATURE
 
 KJ = unit.kilojoule_per_mole
 
@@ -40,13 +41,13 @@ def default_pairs(quick: bool = False) -> list:
 
 
 def _ours(method, step):
-    return (Row(f"{method} {step:g} fs", "symprk", step, method),
-            Row(f"{method} {step:g} fs NVE", "symprk", step, method, nvt=False))
+    return ((f"{method} {step:g} fs", Row.parse(f"{method} {step:g} fs SVR 0.1 ps native")),
+            (f"{method} {step:g} fs NVE", Row.parse(f"{method} {step:g} fs native")))
 
 
 def _nose_hoover(step):
-    return (Row(f"NoseHoover {step:g} fs", "openmm-nosehoover", step),
-            Row(f"OpenMM Verlet {step:g} fs", "openmm-verlet", step))
+    return ((f"NoseHoover {step:g} fs", Row.parse(f"nose-hoover {step:g} fs 1/ps")),
+            (f"OpenMM Verlet {step:g} fs", Row.parse(f"openmm-verlet {step:g} fs")))
 
 
 def pairs_from(text: str) -> list:
@@ -84,14 +85,14 @@ def water_box_scene(equilibrate_ps: float, threads: int):
 def energy_series(row: Row, system, x, v, length_ps: float, sample_fs: float, seed: int, threads: int):
     """(t in ps, effective energy in kJ/mol) of one run: total energy, + heat-bath energy for a thermostat that has
     one.  Stops at the first non-finite energy (a blow-up: the series so far is returned)."""
-    ig, _ = build(row, system, seed=seed)
+    ig = row.build(system, seed=seed)
     ctx = mm.Context(system, ig, mm.Platform.getPlatformByName("CPU"), {"Threads": str(threads)})
     try:
         ctx.setPositions(x)
         ctx.setVelocities(v)
         every = max(1, int(round(sample_fs / row.step_fs)))
         samples = int(round(length_ps * 1000.0 / (row.step_fs * every)))
-        heat = ig.computeHeatBathEnergy if row.kind in ("symprk", "openmm-nosehoover") else None
+        heat = ig.computeHeatBathEnergy if row.has_heat_bath else None
         t, e = [], []
         for _ in range(samples):  # from the end of the first block: OpenMM 8.6's NoseHooverIntegrator
             ig.step(every)        # segfaults in computeHeatBathEnergy() before its first step
@@ -121,7 +122,7 @@ def run(quick: bool = False, replicas: int | None = None, length_ps: float | Non
     system, x, v = water_box_scene(0.1 if quick else 2.0, threads)
     dof = thermostat_degrees_of_freedom(system, isolated=False)
     per_dof = 1000.0 / (R_KJ * TEMPERATURE * dof)  # kJ/mol/ps -> kT/ns/DOF
-    raw = {row.name: {} for pair in pairs for row in pair}  # row -> {replica: (slope, se)}
+    raw = {name: {} for pair in pairs for name, _ in pair}  # row -> {replica: (slope, se)}
     failed = {}
     start = time.perf_counter()
     for r in range(replicas):
@@ -129,25 +130,25 @@ def run(quick: bool = False, replicas: int | None = None, length_ps: float | Non
             x, v = equilibrate(system, x, TEMPERATURE, 0.1 if quick else 1.0, seed=100 + r,
                                properties={"Threads": str(threads)})
         for pair in pairs:
-            for row in pair:
+            for name, row in pair:
                 t, e = energy_series(row, system, x, v, length_ps, sample_fs, seed=10 + r, threads=threads)
                 if len(t) < 3 or t[-1] < 0.999 * length_ps - 1e-9:
-                    failed[row.name] = f"non-finite energy at {t[-1] if len(t) else 0:.3g} ps (replica {r})"
+                    failed[name] = f"non-finite energy at {t[-1] if len(t) else 0:.3g} ps (replica {r})"
                     continue
                 d = drift(t, e)
-                raw[row.name][r] = (d.slope * per_dof, d.se * per_dof)
+                raw[name][r] = (d.slope * per_dof, d.se * per_dof)
         log(f"replica {r + 1}/{replicas} done ({time.perf_counter() - start:.0f} s)")
-    evals = {row.name: build(row, system)[1] for pair in pairs for row in pair}
+    evals = {name: row.evals_per_step(True) for pair in pairs for name, row in pair}
     rows = []
-    for nvt, nve in pairs:
-        entry = {"nvt_row": nvt.name, "nve_row": nve.name, "step_fs": nvt.step_fs, "evals": evals[nvt.name],
-                 "evals_per_ps": evals[nvt.name] * 1000.0 / nvt.step_fs}
-        for key, row in (("nvt", nvt), ("nve", nve)):
-            got = raw[row.name]
+    for (nvt, nvt_row), (nve, _) in pairs:
+        entry = {"nvt_row": nvt, "nve_row": nve, "step_fs": nvt_row.step_fs, "evals": evals[nvt],
+                 "evals_per_ps": evals[nvt] * 1000.0 / nvt_row.step_fs}
+        for key, name in (("nvt", nvt), ("nve", nve)):
+            got = raw[name]
             entry[key] = combine([got[k][0] for k in sorted(got)], [got[k][1] for k in sorted(got)]).as_dict() \
-                if got and row.name not in failed else None
-            entry[key + "_failed"] = failed.get(row.name)
-        diff = paired(raw[nvt.name], raw[nve.name])
+                if got and name not in failed else None
+            entry[key + "_failed"] = failed.get(name)
+        diff = paired(raw[nvt], raw[nve])
         entry["difference"] = diff.as_dict() if diff is not None and entry["nvt"] and entry["nve"] else None
         rows.append(entry)
     result = {"scene": f"216 rigid TIP3P waters, PME 0.9 nm, {system.getNumParticles()} atoms, periodic",

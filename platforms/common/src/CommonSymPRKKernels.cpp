@@ -11,6 +11,7 @@
 #include <initializer_list>
 #include <map>
 #include <memory>
+#include <string>
 #include <vector>
 
 using namespace SymPRKPlugin;
@@ -24,7 +25,7 @@ void CommonIntegrateSymPRKStepKernel::initialize(const System& system, const Sym
     projectionBlockSize = 1;
     while (projectionBlockSize*2 <= min(128, cc.getMaxThreadBlockSize()))
         projectionBlockSize *= 2;
-    // The thermostat's reduction leaves its 17 sums in the first 17 threads' slots (kernels/symprk.cc).
+    // The thermostat's reduction leaves its 10 sums in the first 10 threads' slots (kernels/symprk.cc).
     if (plan.hasThermostatEvents() && projectionBlockSize < 32)
         throw OpenMMException("SymPRKIntegrator: the thermostat's device reduction needs work groups of at least 32 "
                               "threads; this device allows " + cc.intToString(cc.getMaxThreadBlockSize()) +
@@ -56,16 +57,18 @@ void CommonIntegrateSymPRKStepKernel::initialize(const System& system, const Sym
     vBefore.initialize(cc, cc.getPaddedNumAtoms(), 4*mixedSize, "symprkVelocitiesBefore");
     badStep.initialize<int>(cc, 1, "symprkBadStep");
     if (plan.hasThermostatEvents()) {
-        thermostatSumsKernel = program->createKernel("symprkThermostatSums");
+        thermostatEventKernel = program->createKernel("symprkThermostatEvent");
         thermostatApplyKernel = program->createKernel("symprkThermostatApply");
-        // the sums' type: double where the device has it (symprk_acc in the device source)
-        thermostatSums.initialize(cc, SymPRKThermostat::NumSums, cc.getSupportsDoublePrecision() ? sizeof(double) : sizeof(float),
-                                  "symprkThermostatSums");
+        // double where the device has it (symprk_acc in the device source)
+        const int accSize = (cc.getSupportsDoublePrecision() ? sizeof(double) : sizeof(float));
+        thermostatEventData.initialize(cc, 11, accSize, "symprkThermostatEvent");
+        thermostatState.initialize(cc, 3, accSize, "symprkThermostatState");
     }
     groupForces.clear();
     groupForcesValid.clear();
     int zero = 0;
     badStep.upload(&zero);
+    hostTransfers++;
     if (blowUpStep != 0)
         setBlowUpStep(*cc.getContextImpl(), blowUpStep);
 }
@@ -120,16 +123,25 @@ void CommonIntegrateSymPRKStepKernel::setKernelArguments(const SymPRKIntegrator&
     addArrayArgs(projectionKernel, {velm, &cc.getLongForceBuffer(), &projection});
     if (plan.hasThermostatEvents()) {
         const int withPositions = integrator.getThermostatKeepsRotation() ? 1 : 0;
-        addPositionArgs(thermostatSumsKernel);
-        thermostatSumsKernel->addArg(*velm);
-        thermostatSumsKernel->addArg(withPositions);
-        thermostatSumsKernel->addArg(thermostatSums);
+        addPositionArgs(thermostatEventKernel);
+        thermostatEventKernel->addArg(*velm);
+        thermostatEventKernel->addArg(withPositions);
+        for (int i = 0; i < 5; i++)
+            thermostatEventKernel->addArg();  // random, its index, dof, target, c: set per event
+        thermostatEventKernel->addArg(thermostatEventData);
+        thermostatEventKernel->addArg(thermostatState);
         addPositionArgs(thermostatApplyKernel);
         thermostatApplyKernel->addArg(*velm);
         thermostatApplyKernel->addArg(withPositions);
-        for (int i = 0; i < 10; i++)
-            thermostatApplyKernel->addArg();  // alpha, V, R, w: set per event
+        thermostatApplyKernel->addArg(thermostatEventData);
     }
+}
+
+void CommonIntegrateSymPRKStepKernel::setAccArg(ComputeKernel& kernel, int index, double value) {
+    if (cc.getSupportsDoublePrecision())
+        kernel->setArg(index, value);
+    else
+        kernel->setArg(index, (float) value);
 }
 
 void CommonIntegrateSymPRKStepKernel::setMixedArg(ComputeKernel& kernel, int index, double value) {
@@ -149,7 +161,11 @@ void CommonIntegrateSymPRKStepKernel::execute(ContextImpl& context, const SymPRK
     const double dt = integrator.getStepSize();
     const double tol = integrator.getConstraintTolerance();
     const bool exact = integrator.getExactMomentum();
-    cc.getIntegrationUtilities().setNextStepSize(dt);
+    if (dt != lastStepSize) {
+        cc.getIntegrationUtilities().setNextStepSize(dt);  // an upload (OpenMM's constraint kernels read it)
+        lastStepSize = dt;
+        hostTransfers++;
+    }
     const int check = (int) min(stepIndex, (long long) INT_MAX);
 
     if (context.updateContextState())
@@ -275,30 +291,98 @@ void CommonIntegrateSymPRKStepKernel::projectVelocities(double tol, bool exact) 
 }
 
 void CommonIntegrateSymPRKStepKernel::thermostatEvent(const SymPRKIntegrator& integrator, double decay) {
-    // One reduction on the device, one download of its sums, the factor and the kept field on the host
-    // (SymPRKThermostat), one kernel applying them.
-    thermostatSumsKernel->execute(projectionBlockSize, projectionBlockSize);
-    vector<double> sums(SymPRKThermostat::NumSums);
-    if (thermostatSums.getElementSize() == sizeof(double))
-        thermostatSums.download(sums);
-    else {
-        vector<float> single(SymPRKThermostat::NumSums);
-        thermostatSums.download(single);
-        for (int i = 0; i < SymPRKThermostat::NumSums; i++)
-            sums[i] = single[i];
-    }
-    const SymPRKThermostat::Event e = thermostat.event(sums.data(), integrator.getThermostatTemperature(), integrator.getThermostatDof(),
-                                                       integrator.getThermostatKeepsRotation(), decay);
-    if (!e.apply)
-        return;
-    const double values[10] = {e.alpha, e.velocity[0], e.velocity[1], e.velocity[2], e.centre[0], e.centre[1], e.centre[2],
-                               e.omega[0], e.omega[1], e.omega[2]};
-    for (int i = 0; i < 10; i++)
-        setMixedArg(thermostatApplyKernel, 4+i, values[i]);
+    // The whole event on the device: the random numbers from OpenMM's generator, one block reducing the particles and
+    // computing the factor and the kept field, one kernel applying them; nothing is read back.
+    IntegrationUtilities& integration = cc.getIntegrationUtilities();
+    const int dof = integrator.getThermostatDof();
+    const int index = integration.prepareRandomNumbers((dof+3)/4);
+    thermostatEventKernel->setArg(4, integration.getRandom());
+    thermostatEventKernel->setArg(5, index);
+    thermostatEventKernel->setArg(6, dof);
+    setAccArg(thermostatEventKernel, 7, 0.5*dof*SymPRKThermostat::boltzmann()*integrator.getThermostatTemperature());
+    setAccArg(thermostatEventKernel, 8, decay);
+    thermostatEventKernel->execute(projectionBlockSize, projectionBlockSize);
     thermostatApplyKernel->execute(cc.getNumAtoms());
 }
 
+void CommonIntegrateSymPRKStepKernel::initializeThermostat(int seed) {
+    // The platform's generator is set up with or without a thermostat, so that the Context's checkpoints have the
+    // same layout (its random state comes before the integrator's block) and an NVE checkpoint loaded into an NVT
+    // Context, or the reverse, meets this integrator's own check.  Where something else in the Context (an
+    // AndersenThermostat) seeded it first with another seed, the thermostat draws from that stream.
+    ContextSelector selector(cc);
+    try {
+        cc.getIntegrationUtilities().initRandomNumberGenerator((unsigned int) seed);
+        hostTransfers++;
+    }
+    catch (OpenMMException&) {
+        // already seeded (with another seed): shared
+    }
+    if (!thermostatState.isInitialized())
+        return;
+    const vector<double> zero(3, 0.0);
+    if (thermostatState.getElementSize() == sizeof(double))
+        thermostatState.upload(zero);
+    else
+        thermostatState.upload(vector<float>(3, 0.0f));
+    hostTransfers++;
+}
+
+vector<double> CommonIntegrateSymPRKStepKernel::downloadThermostatState() {
+    vector<double> values(3, 0.0);
+    if (!thermostatState.isInitialized())
+        return values;
+    ContextSelector selector(cc);
+    if (thermostatState.getElementSize() == sizeof(double))
+        thermostatState.download(values);
+    else {
+        vector<float> single;
+        thermostatState.download(single);
+        for (int i = 0; i < 3; i++)
+            values[i] = single[i];
+    }
+    hostTransfers++;
+    return values;
+}
+
+double CommonIntegrateSymPRKStepKernel::getHeatBathEnergy() {
+    return downloadThermostatState()[0];
+}
+
+void CommonIntegrateSymPRKStepKernel::setHeatBathEnergy(double energy) {
+    if (!thermostatState.isInitialized())
+        return;
+    vector<double> values = downloadThermostatState();
+    values[0] = energy;
+    ContextSelector selector(cc);
+    if (thermostatState.getElementSize() == sizeof(double))
+        thermostatState.upload(values);
+    else
+        thermostatState.upload(vector<float>(values.begin(), values.end()));
+    hostTransfers++;
+}
+
+double CommonIntegrateSymPRKStepKernel::getThermostatKineticEnergy() {
+    return downloadThermostatState()[1];
+}
+
+long long CommonIntegrateSymPRKStepKernel::getSkippedThermostatEvents() {
+    return (long long) downloadThermostatState()[2];
+}
+
+string CommonIntegrateSymPRKStepKernel::getRandomState() {
+    // the generator's state is the platform's (IntegrationUtilities), in the Context's own checkpoint
+    return "device";
+}
+
+void CommonIntegrateSymPRKStepKernel::setRandomState(const string& state) {
+    if (state != "device")
+        throw OpenMMException("SymPRKIntegrator: the checkpoint's thermostat random state was written on the Reference or CPU "
+                              "platform; a checkpoint loads on the platform that wrote it");
+}
+
 double CommonIntegrateSymPRKStepKernel::computeKineticEnergy(ContextImpl& context, const SymPRKIntegrator& integrator) {
+    hostTransfers++;
     return cc.getIntegrationUtilities().computeKineticEnergy(0.0);
 }
 
@@ -307,6 +391,7 @@ long long CommonIntegrateSymPRKStepKernel::getBlowUpStep(ContextImpl& context) {
         ContextSelector selector(cc);
         int value;
         badStep.download(&value);
+        hostTransfers++;
         blowUpStep = value;
     }
     return blowUpStep;
@@ -318,5 +403,6 @@ void CommonIntegrateSymPRKStepKernel::setBlowUpStep(ContextImpl& context, long l
         ContextSelector selector(cc);
         int value = (int) min(step, (long long) INT_MAX);
         badStep.upload(&value);
+        hostTransfers++;
     }
 }

@@ -9,6 +9,7 @@
 #include <memory>
 #include <initializer_list>
 #include <string>
+#include <vector>
 
 namespace SymPRKPlugin {
 
@@ -27,7 +28,8 @@ public:
 class CommonIntegrateSymPRKStepKernel : public IntegrateSymPRKStepKernel {
 public:
     CommonIntegrateSymPRKStepKernel(std::string name, const OpenMM::Platform& platform, OpenMM::ComputeContext& cc) :
-            IntegrateSymPRKStepKernel(name, platform), cc(cc), hasInitializedKernels(false), blowUpStep(0) {
+            IntegrateSymPRKStepKernel(name, platform), cc(cc), hasInitializedKernels(false), blowUpStep(0),
+            hostTransfers(0), lastStepSize(0.0) {
     }
     void initialize(const OpenMM::System& system, const SymPRKIntegrator& integrator, const SymPRKStepPlan& plan);
     void execute(OpenMM::ContextImpl& context, const SymPRKIntegrator& integrator, const SymPRKStepPlan& plan,
@@ -35,7 +37,22 @@ public:
     double computeKineticEnergy(OpenMM::ContextImpl& context, const SymPRKIntegrator& integrator);
     long long getBlowUpStep(OpenMM::ContextImpl& context);
     void setBlowUpStep(OpenMM::ContextImpl& context, long long step);
+    /** The thermostat's state lives on the device (state[] of symprkThermostatEvent); its random numbers come from
+     *  OpenMM's IntegrationUtilities generator, which the Context's own checkpoint carries. */
+    void initializeThermostat(int seed);
+    double getHeatBathEnergy();
+    void setHeatBathEnergy(double energy);
+    double getThermostatKineticEnergy();
+    long long getSkippedThermostatEvents();
+    std::string getRandomState();
+    void setRandomState(const std::string& state);
+    long long getHostTransfers() {
+        return hostTransfers;
+    }
 private:
+    /** The thermostat's device state (heat-bath energy, kinetic energy after the last event, skipped events). */
+    std::vector<double> downloadThermostatState();
+    void setAccArg(OpenMM::ComputeKernel& kernel, int index, double value);
     void setKernelArguments(const SymPRKIntegrator& integrator, const SymPRKStepPlan& plan);
     void addArrayArgs(OpenMM::ComputeKernel& kernel, std::initializer_list<OpenMM::ArrayInterface*> arrays);
     /** Add the arguments posq and posqCorrection (null unless in mixed precision) to kernel. */
@@ -53,8 +70,10 @@ private:
     std::map<int, bool> groupForcesValid;
     int projectionBlockSize;
     long long blowUpStep;
-    OpenMM::ComputeArray projection, badStep, rigid, vBefore, thermostatSums;
-    OpenMM::ComputeKernel thermostatSumsKernel, thermostatApplyKernel;
+    long long hostTransfers;
+    double lastStepSize;
+    OpenMM::ComputeArray projection, badStep, rigid, vBefore, thermostatEventData, thermostatState;
+    OpenMM::ComputeKernel thermostatEventKernel, thermostatApplyKernel;
     OpenMM::ComputeKernel kickKernel, kickProjectedKernel, driftKernel, driftDeltaKernel, driftApplyKernel, projectionKernel,
             rigidSumsKernel, rigidApplyKernel;
 };

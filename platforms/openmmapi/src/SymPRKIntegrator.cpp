@@ -6,6 +6,7 @@
 #include "openmm/OpenMMException.h"
 #include "openmm/KernelFactory.h"
 #include "openmm/internal/ContextImpl.h"
+#include "openmm/serialization/SerializationNode.h"
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -58,8 +59,15 @@ void SymPRKIntegrator::setSubsteps(const vector<int>& newKinds, const vector<dou
     for (size_t i = 0; i < n; i++) {
         stringstream msg;
         msg << "SymPRKIntegrator: sub-step " << i;
-        if (newKinds[i] != Kick && newKinds[i] != Drift)
-            msg << " has kind " << newKinds[i] << "; expected " << Kick << " (kick) or " << Drift << " (drift)";
+        if (newKinds[i] != Kick && newKinds[i] != Drift && newKinds[i] != Thermostat)
+            msg << " has kind " << newKinds[i] << "; expected " << Kick << " (kick), " << Drift << " (drift) or "
+                << Thermostat << " (thermostat event)";
+        else if (newKinds[i] == Thermostat && !(newCoefficients[i] > 0 && std::isfinite(newCoefficients[i])))
+            msg << " is a thermostat event with the coefficient " << newCoefficients[i] << "; expected a finite fraction > 0 "
+                   "of the thermostat's interval (1: one whole event)";
+        else if (newKinds[i] == Thermostat && (newGroups[i] != -1 || newFlags[i] != 0))
+            msg << " is a thermostat event with force-group mask " << newGroups[i] << " and flags " << newFlags[i]
+                << "; a thermostat event takes -1 and 0";
         else if (!std::isfinite(newCoefficients[i]) || newCoefficients[i] == 0.0)
             msg << " has the coefficient " << newCoefficients[i] << "; expected a finite non-zero number (leave a zero sub-step out)";
         else if (newKinds[i] == Kick && (newGroups[i] == 0 || newGroups[i] < -1))
@@ -150,7 +158,7 @@ void SymPRKIntegrator::setExpectedSystem(int numParticles, bool constraints) {
     expectedConstraints = constraints;
 }
 
-void SymPRKIntegrator::setThermostat(double temperature, double tau, int interval, int dof, bool keep) {
+void SymPRKIntegrator::setThermostat(double temperature, double tau, long long interval, int dof, bool keep) {
     if (owner != NULL)
         throw OpenMMException("SymPRKIntegrator: the thermostat cannot be changed once the integrator is bound to a Context");
     stringstream msg;
@@ -159,8 +167,9 @@ void SymPRKIntegrator::setThermostat(double temperature, double tau, int interva
         msg << "the thermostat temperature is " << temperature << " K; expected a finite temperature > 0 K";
     else if (!(tau > 0) || !std::isfinite(tau))
         msg << "the collision time is " << tau << " ps; expected a finite time > 0 ps";
-    else if (interval < 1)
-        msg << "the thermostat interval is " << interval << " steps; expected a whole number >= 1";
+    else if (interval < 1 || interval > INT32_MAX)
+        msg << "the thermostat interval (thermostat_interval) is " << interval << " steps; expected a whole number from 1 to "
+            << INT32_MAX << " (2^31-1)";
     else if (dof < 1)
         msg << "the thermostat has " << dof << " degrees of freedom; a System without degrees of freedom to "
                "thermostat cannot be thermostatted (expected >= 1)";
@@ -168,7 +177,7 @@ void SymPRKIntegrator::setThermostat(double temperature, double tau, int interva
         thermostat = true;
         thermostatTemperature = temperature;
         collisionTime = tau;
-        thermostatInterval = interval;
+        thermostatInterval = (int) interval;
         thermostatDof = dof;
         keepRotation = keep;
         return;
@@ -190,7 +199,25 @@ void SymPRKIntegrator::setThermostatTemperature(double temperature) {
 double SymPRKIntegrator::getHeatBathEnergy() const {
     if (!thermostat || context == NULL)
         return 0.0;
-    return const_cast<Kernel&>(kernel).getAs<IntegrateSymPRKStepKernel>().getThermostat().getHeatBathEnergy();
+    return const_cast<Kernel&>(kernel).getAs<IntegrateSymPRKStepKernel>().getHeatBathEnergy();
+}
+
+double SymPRKIntegrator::getThermostatKineticEnergy() const {
+    if (!thermostat || context == NULL)
+        return 0.0;
+    return const_cast<Kernel&>(kernel).getAs<IntegrateSymPRKStepKernel>().getThermostatKineticEnergy();
+}
+
+long long SymPRKIntegrator::getSkippedThermostatEvents() const {
+    if (!thermostat || context == NULL)
+        return 0;
+    return const_cast<Kernel&>(kernel).getAs<IntegrateSymPRKStepKernel>().getSkippedThermostatEvents();
+}
+
+long long SymPRKIntegrator::getHostTransfers() const {
+    if (context == NULL)
+        return 0;
+    return const_cast<Kernel&>(kernel).getAs<IntegrateSymPRKStepKernel>().getHostTransfers();
 }
 
 vector<double> SymPRKIntegrator::computeRescalingFactor(double kinetic, double target, int dof, double c, double r1, double chi2) {
@@ -291,7 +318,7 @@ void SymPRKIntegrator::initialize(ContextImpl& contextRef) {
     IntegrateSymPRKStepKernel& k = kernel.getAs<IntegrateSymPRKStepKernel>();
     k.initialize(contextRef.getSystem(), *this, plan);
     k.setBlowUpStep(contextRef, blowUpStep);
-    k.getThermostat().initialize(randomSeed);
+    k.initializeThermostat(randomSeed);
     k.getTrace().setEnabled(traceEnabled);
     forcesAreValid = false;
 }
@@ -366,9 +393,9 @@ void SymPRKIntegrator::createCheckpoint(ostream& stream) const {
     int64_t hasBath = thermostat ? 1 : 0;
     stream.write((const char*) &hasBath, sizeof(hasBath));
     if (thermostat) {
-        SymPRKThermostat& bath = const_cast<Kernel&>(kernel).getAs<IntegrateSymPRKStepKernel>().getThermostat();
-        double energy = bath.getHeatBathEnergy();
-        string state = bath.getRandomState();
+        IntegrateSymPRKStepKernel& k = const_cast<Kernel&>(kernel).getAs<IntegrateSymPRKStepKernel>();
+        double energy = k.getHeatBathEnergy();
+        string state = k.getRandomState();
         int64_t size = state.size();
         stream.write((const char*) &energy, sizeof(energy));
         stream.write((const char*) &size, sizeof(size));
@@ -422,13 +449,37 @@ void SymPRKIntegrator::loadCheckpoint(istream& stream) {
     if (!stream || hasBath != (thermostat ? 1 : 0))
         throw OpenMMException("SymPRKIntegrator: the checkpoint is truncated or damaged (its thermostat block)");
     if (thermostat && context != NULL) {
-        SymPRKThermostat& bath = kernel.getAs<IntegrateSymPRKStepKernel>().getThermostat();
-        bath.setRandomState(state);
-        bath.setHeatBathEnergy(energy);
+        IntegrateSymPRKStepKernel& k = kernel.getAs<IntegrateSymPRKStepKernel>();
+        k.setRandomState(state);
+        k.setHeatBathEnergy(energy);
     }
     stepsTaken = values[1];
     blowUpStep = values[2];
     if (context != NULL)
         kernel.getAs<IntegrateSymPRKStepKernel>().setBlowUpStep(*context, blowUpStep);
     forcesAreValid = false;
+}
+
+// A State's integrator parameters: the heat-bath energy, so that a State carries the effective energy's offset as the
+// checkpoint does (the random state stays with checkpoints).
+static const char* STATE_NODE = "SymPRKThermostat";
+
+void SymPRKIntegrator::serializeParameters(SerializationNode& node) const {
+    if (!thermostat || context == NULL)
+        return;
+    node.createChildNode(STATE_NODE).setDoubleProperty("heatBathEnergy", getHeatBathEnergy());
+}
+
+void SymPRKIntegrator::deserializeParameters(const SerializationNode& node) {
+    for (const SerializationNode& child : node.getChildren()) {
+        if (child.getName() != STATE_NODE)
+            throw OpenMMException("SymPRKIntegrator: the State's integrator parameters hold '"+child.getName()+"', which a "
+                                  "SymPRKIntegrator does not have (a State saved with another integrator?)");
+        if (!thermostat)
+            throw OpenMMException("SymPRKIntegrator: the State holds a thermostat's heat-bath energy, but this integrator "
+                                  "has no thermostat (a State saved by an NVT run, loaded into an NVE one): load it with "
+                                  "getIntegratorParameters=False, or into an integrator with temperature=");
+        if (context != NULL)
+            kernel.getAs<IntegrateSymPRKStepKernel>().setHeatBathEnergy(child.getDoubleProperty("heatBathEnergy"));
+    }
 }

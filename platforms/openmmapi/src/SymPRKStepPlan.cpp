@@ -2,10 +2,12 @@
 
 #include "openmm/internal/SymPRKStepPlan.h"
 #include "openmm/SymPRKIntegrator.h"
+#include "openmm/OpenMMException.h"
 #include <cmath>
 #include <cstdio>
 #include <set>
 #include <sstream>
+#include <string>
 
 using namespace SymPRKPlugin;
 using namespace std;
@@ -42,9 +44,19 @@ SymPRKStepPlan::SymPRKStepPlan(const SymPRKIntegrator& integrator, bool hasConst
         if (integrator.getSubstepKind(s) == SymPRKIntegrator::Kick)
             masks.insert(integrator.getSubstepForceGroups(s) == -1 ? integrationForceGroups : integrator.getSubstepForceGroups(s));
     const bool multipleGroups = (masks.size() > 1);
-    // The thermostat: a half event before the first step of every interval (after the Context's state updates, a
-    // barostat's move included) and one after its last step (after the end-of-step projection).
-    const bool ends = integrator.hasThermostat();
+    // The thermostat.  Middle placement: the sequence's Thermostat sub-steps, each an event in the middle step
+    // (phase (interval-1)/2) of every interval.  Ends placement (no Thermostat sub-step): a half event before the
+    // first step of every interval (after the Context's state updates, a barostat's move included) and one after
+    // its last step (after the end-of-step projection).
+    bool middle = false;
+    for (int s = 0; s < n; s++)
+        if (integrator.getSubstepKind(s) == SymPRKIntegrator::Thermostat) {
+            middle = true;
+            if (!integrator.hasThermostat())
+                throw OpenMM::OpenMMException("SymPRKIntegrator: sub-step "+to_string(s)+" is a thermostat event, but the integrator "
+                                      "has no thermostat (setThermostat gives it one)");
+        }
+    const bool ends = integrator.hasThermostat() && !middle;
     const int interval = integrator.getThermostatInterval();
     const double tau = integrator.getCollisionTime();
     if (ends) {
@@ -54,7 +66,11 @@ SymPRKStepPlan::SymPRKStepPlan(const SymPRKIntegrator& integrator, bool hasConst
     for (int s = 0; s < n; s++) {
         const double c = integrator.getSubstepCoefficient(s);
         const int flags = integrator.getSubstepFlags(s);
-        if (integrator.getSubstepKind(s) == SymPRKIntegrator::Kick) {
+        if (integrator.getSubstepKind(s) == SymPRKIntegrator::Thermostat) {
+            operations.push_back(operation(ThermostatEvent, s, c, interval, tau));
+            operations.back().phase = (interval-1)/2;
+        }
+        else if (integrator.getSubstepKind(s) == SymPRKIntegrator::Kick) {
             Operation op = operation(Kick, s, c);
             op.forceGroups = (integrator.getSubstepForceGroups(s) == -1 ? integrationForceGroups : integrator.getSubstepForceGroups(s));
             op.reuseForces = (flags & SymPRKIntegrator::ForcesCached) != 0;

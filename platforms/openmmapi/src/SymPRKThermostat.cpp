@@ -11,7 +11,7 @@ using namespace SymPRKPlugin;
 using namespace OpenMM;
 using namespace std;
 
-SymPRKThermostat::SymPRKThermostat() : heatBathEnergy(0.0) {
+SymPRKThermostat::SymPRKThermostat() : heatBathEnergy(0.0), kineticEnergy(0.0), skippedEvents(0) {
 }
 
 void SymPRKThermostat::initialize(int seed) {
@@ -22,6 +22,8 @@ void SymPRKThermostat::initialize(int seed) {
     else
         rng.seed((uint64_t) (uint32_t) seed);
     heatBathEnergy = 0.0;
+    kineticEnergy = 0.0;
+    skippedEvents = 0;
 }
 
 double SymPRKThermostat::boltzmann() {
@@ -58,7 +60,7 @@ double SymPRKThermostat::rescalingFactor(double kinetic, double target, int dof,
     return alpha;
 }
 
-SymPRKThermostat::Event SymPRKThermostat::event(const double* sums, double temperature, int dof, bool keepRotation, double c) {
+SymPRKThermostat::Event SymPRKThermostat::event(const Sums& sums, double temperature, int dof, bool keepRotation, double c) {
     Event e;
     e.apply = false;
     e.alpha = 1.0;
@@ -71,32 +73,34 @@ SymPRKThermostat::Event SymPRKThermostat::event(const double* sums, double tempe
         gamma_distribution<double> gamma(0.5*(dof-1), 1.0);
         chi2 = 2.0*gamma(rng);
     }
-    const double M = sums[SumMass];
+    const double M = sums.mass;
     if (!(M > 0))
         return e;
-    const Vec3 P(sums[SumMomentum], sums[SumMomentum+1], sums[SumMomentum+2]);
-    e.velocity = P/M;
-    double kinetic = 0.5*sums[SumTwiceKinetic] - 0.5*P.dot(P)/M;
+    e.velocity = sums.momentum/M;
+    const double total = 0.5*sums.twiceKinetic;
+    double kinetic = 0.5*sums.twicePeculiar;
     if (keepRotation) {
-        const Vec3 R = Vec3(sums[SumMomentX], sums[SumMomentX+1], sums[SumMomentX+2])/M;
-        const double* S = sums+SumSecond;
-        // second moments and angular momentum about the centre of mass
-        const Vec3 d(S[0]-M*R[0]*R[0], S[3]-M*R[1]*R[1], S[5]-M*R[2]*R[2]);
-        const Vec3 o(S[1]-M*R[0]*R[1], S[2]-M*R[0]*R[2], S[4]-M*R[1]*R[2]);
-        const Vec3 L = Vec3(sums[SumAngular], sums[SumAngular+1], sums[SumAngular+2]) - R.cross(P);
-        e.centre = R;
-        e.omega = solveInertia(d, o, L, false);
-        kinetic -= 0.5*L.dot(e.omega);
+        e.centre = sums.centre;
+        e.omega = solveInertia(sums.d, sums.o, sums.angular, false);
+        kinetic -= 0.5*sums.angular.dot(e.omega);
+    }
+    if (!std::isfinite(kinetic) || !std::isfinite(total))
+        return e;  // a blown-up state, which the blow-up check reports
+    kineticEnergy = total;
+    if (!(kinetic > negligiblePeculiarFraction()*total)) {
+        skippedEvents++;  // at rest or a rigid motion: only round-off to scale
+        return e;
     }
     const double target = 0.5*dof*BOLTZ*temperature;
     double newKinetic;
     const double alpha = rescalingFactor(kinetic, target, dof, c, r1, chi2, newKinetic);
-    if (!(kinetic > 0) || !std::isfinite(kinetic) || !std::isfinite(alpha) || !std::isfinite(newKinetic))
-        return e;  // nothing to rescale (or a blown-up state, which the blow-up check reports)
+    if (!std::isfinite(alpha) || !std::isfinite(newKinetic))
+        return e;
     e.apply = true;
     e.alpha = alpha;
     e.kinetic = kinetic;
     e.newKinetic = newKinetic;
     heatBathEnergy -= newKinetic-kinetic;
+    kineticEnergy = total-kinetic+newKinetic;
     return e;
 }

@@ -141,58 +141,47 @@ void ReferenceIntegrateSymPRKStepKernel::computeProjection(const vector<Vec3>& p
 }
 
 void ReferenceIntegrateSymPRKStepKernel::thermostatEvent(const SymPRKIntegrator& integrator, double decay) {
-    // The sums in double, serially in particle order (deterministic, whatever the thread count); the host
-    // computes the kept field and the factor (SymPRKThermostat), then every particle with mass is rescaled.
+    // The sums in double, serially in particle order (deterministic, whatever the thread count), in two passes: the
+    // centre of mass (about the first particle with mass, so that nothing cancels far from the origin) and the
+    // momentum, then the moments about the centre of mass; the host computes the kept field and the factor
+    // (SymPRKThermostat), then every particle with mass is rescaled.
     const vector<Vec3>& pos = *data.positions;
     vector<Vec3>& vel = *data.velocities;
     const bool rotation = integrator.getThermostatKeepsRotation();
-    double sums[SymPRKThermostat::NumSums] = {0};
-    double M = 0, px = 0, py = 0, pz = 0, twiceK = 0;
+    SymPRKThermostat::Sums sums;
+    sums.mass = sums.twiceKinetic = sums.twicePeculiar = 0.0;
+    Vec3 origin, moment;
+    bool first = true;
     for (int i = 0; i < numParticles; i++) {
         const double m = masses[i];
         if (m == 0.0)
             continue;
+        if (first) {
+            origin = pos[i];
+            first = false;
+        }
         const Vec3& v = vel[i];
-        M += m;
-        px += m*v[0];
-        py += m*v[1];
-        pz += m*v[2];
-        twiceK += m*(v[0]*v[0]+v[1]*v[1]+v[2]*v[2]);
+        sums.mass += m;
+        moment += (pos[i]-origin)*m;
+        sums.momentum += v*m;
+        sums.twiceKinetic += m*v.dot(v);
     }
-    sums[SymPRKThermostat::SumMass] = M;
-    sums[SymPRKThermostat::SumMomentum] = px;
-    sums[SymPRKThermostat::SumMomentum+1] = py;
-    sums[SymPRKThermostat::SumMomentum+2] = pz;
-    sums[SymPRKThermostat::SumTwiceKinetic] = twiceK;
-    if (rotation) {
-        // the positions' moments and the angular momentum about the origin
-        double mx = 0, my = 0, mz = 0, xx = 0, xy = 0, xz = 0, yy = 0, yz = 0, zz = 0, lx = 0, ly = 0, lz = 0;
+    if (sums.mass > 0) {
+        const Vec3 R = sums.centre = origin+moment/sums.mass;
+        const Vec3 V = sums.momentum/sums.mass;
         for (int i = 0; i < numParticles; i++) {
             const double m = masses[i];
             if (m == 0.0)
                 continue;
-            const Vec3& x = pos[i];
-            const Vec3& v = vel[i];
-            mx += m*x[0];
-            my += m*x[1];
-            mz += m*x[2];
-            xx += m*x[0]*x[0];
-            xy += m*x[0]*x[1];
-            xz += m*x[0]*x[2];
-            yy += m*x[1]*x[1];
-            yz += m*x[1]*x[2];
-            zz += m*x[2]*x[2];
-            lx += m*(x[1]*v[2]-x[2]*v[1]);
-            ly += m*(x[2]*v[0]-x[0]*v[2]);
-            lz += m*(x[0]*v[1]-x[1]*v[0]);
+            const Vec3 u = vel[i]-V;
+            sums.twicePeculiar += m*u.dot(u);
+            if (rotation) {
+                const Vec3 r = pos[i]-R;
+                sums.d += Vec3(m*r[0]*r[0], m*r[1]*r[1], m*r[2]*r[2]);
+                sums.o += Vec3(m*r[0]*r[1], m*r[0]*r[2], m*r[1]*r[2]);
+                sums.angular += r.cross(u)*m;
+            }
         }
-        const double moments[12] = {mx, my, mz, xx, xy, xz, yy, yz, zz, lx, ly, lz};
-        for (int j = 0; j < 3; j++) {
-            sums[SymPRKThermostat::SumMomentX+j] = moments[j];
-            sums[SymPRKThermostat::SumAngular+j] = moments[9+j];
-        }
-        for (int j = 0; j < 6; j++)
-            sums[SymPRKThermostat::SumSecond+j] = moments[3+j];
     }
     const SymPRKThermostat::Event e = thermostat.event(sums, integrator.getThermostatTemperature(), integrator.getThermostatDof(),
                                                        rotation, decay);

@@ -38,7 +38,8 @@ void SymPRKIntegratorProxy::serialize(const void* object, SerializationNode& nod
     SerializationNode& substeps = node.createChildNode("Substeps");
     for (int i = 0; i < integrator.getNumSubsteps(); i++) {
         SerializationNode& s = substeps.createChildNode("Substep");
-        s.setStringProperty("kind", integrator.getSubstepKind(i) == SymPRKIntegrator::Kick ? "kick" : "drift");
+        const int kind = integrator.getSubstepKind(i);
+        s.setStringProperty("kind", kind == SymPRKIntegrator::Kick ? "kick" : kind == SymPRKIntegrator::Drift ? "drift" : "thermostat");
         s.setDoubleProperty("c", integrator.getSubstepCoefficient(i));
         if (integrator.getSubstepForceGroups(i) != -1)
             s.setIntProperty("groups", integrator.getSubstepForceGroups(i));
@@ -62,6 +63,8 @@ void* SymPRKIntegratorProxy::deserialize(const SerializationNode& node) const {
             kinds.push_back(SymPRKIntegrator::Kick);
         else if (kind == "drift")
             kinds.push_back(SymPRKIntegrator::Drift);
+        else if (kind == "thermostat")
+            kinds.push_back(SymPRKIntegrator::Thermostat);
         else
             throw OpenMMException("SymPRKIntegrator: unknown sub-step kind '"+kind+"' in XML");
         coefficients.push_back(s.getDoubleProperty("c"));

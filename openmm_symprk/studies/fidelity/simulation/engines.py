@@ -12,8 +12,8 @@ import openmm as mm
 import openmm.unit as unit
 
 from ....systems.properties import masses
-from ....systems.repartition import repartition_hydrogen_mass, rigid_velocities_for_masses
-from ..rowspec import UNAVAILABLE_THERMOSTAT, describe
+from ....systems.repartition import rigid_velocities_for_masses
+from ..rowspec import UNAVAILABLE_THERMOSTAT, describe, to_row
 
 __all__ = ["RowUnavailable", "availability", "make_integrator", "Engine"]
 
@@ -22,75 +22,25 @@ class RowUnavailable(RuntimeError):
     """This installation cannot run the row (e.g. the integrator does not accept ``temperature=``)."""
 
 
-def _thermostatted(row, system, temperature, seed):
-    """The package's thermostatted integrator, or RowUnavailable when the integrator has no thermostat yet."""
-    from ....integrators import SymplecticIntegrator
-
+def make_integrator(row: dict, system: mm.System, temperature: float, seed: int):
+    """An OpenMM integrator for ``row`` on ``system`` (already :meth:`~..core.rows.Row.system_for` the row);
+    RowUnavailable when this installation lacks an option the row needs (an unknown option of the integrator)."""
     try:
-        return SymplecticIntegrator(row["step_fs"] * unit.femtoseconds, row["method"], system=system,
-                                    temperature=temperature * unit.kelvin,
-                                    collision_time=row["collision_time_ps"] * unit.picoseconds, random_seed=seed)
-    except TypeError as exc:  # an unexpected keyword: the thermostat is not in this installation
+        return to_row(row, temperature).build(system, seed=seed)
+    except TypeError as exc:
+        if not any(k in str(exc) for k in ("unknown option", "unexpected keyword")):
+            raise
         raise RowUnavailable(f"{UNAVAILABLE_THERMOSTAT} ({exc})") from None
-    except ValueError as exc:
-        if any(k in str(exc) for k in ("temperature", "collision_time", "random_seed")):
-            raise RowUnavailable(f"{UNAVAILABLE_THERMOSTAT} ({exc})") from None
-        raise
-
-
-def make_integrator(row: dict, system: mm.System, temperature: float, seed: int, cutoff_nm: float):
-    """An OpenMM integrator for ``row`` on ``system`` (already repartitioned / split in force groups)."""
-    kind, h = row["kind"], row["step_fs"] * unit.femtoseconds
-    T = temperature * unit.kelvin
-    if kind == "symprk":
-        if "collision_time_ps" in row:
-            return _thermostatted(row, system, temperature, seed)
-        from ....integrators import SymplecticIntegrator
-
-        return SymplecticIntegrator(h, row["method"], system=system)
-    if kind == "langevin":
-        integ = mm.LangevinMiddleIntegrator(T, row["friction_per_ps"] / unit.picosecond, h)
-    elif kind == "mts-langevin":
-        integ = mm.MTSLangevinIntegrator(T, row["friction_per_ps"] / unit.picosecond, h,
-                                         [(1, 1), (0, int(row["inner_steps"]))])
-    elif kind == "nose-hoover":
-        return mm.NoseHooverIntegrator(T, row["collision_frequency_per_ps"] / unit.picosecond, h)
-    else:
-        integ = mm.DPDIntegrator(T, row["friction_per_ps"] / unit.picosecond,
-                                 row.get("cutoff_nm", cutoff_nm) * unit.nanometer, h)
-    integ.setRandomNumberSeed(seed)
-    return integ
-
-
-def _system_for(row, scene):
-    """The row's System: HMR repartitioned, and for MTS reciprocal-space PME in force group 1."""
-    system = scene.system
-    if "hmr_da" in row:
-        system = repartition_hydrogen_mass(system, scene.topology, row["hmr_da"])
-    if row["kind"] == "mts-langevin":
-        if system is scene.system:
-            system = mm.XmlSerializer.deserialize(mm.XmlSerializer.serialize(system))
-        for f in system.getForces():
-            if isinstance(f, mm.NonbondedForce):
-                f.setReciprocalSpaceForceGroup(1)
-    return system
 
 
 def availability(row: dict, scene, temperature: float) -> str | None:
     """None when this installation runs ``row`` on ``scene``; else why not (e.g. UNAVAILABLE_THERMOSTAT ...)."""
-    if row["kind"] == "symprk" and "collision_time_ps" in row:
+    if to_row(row).thermostat == "svr":
         try:
-            _thermostatted(row, scene.system, temperature, 1)
+            make_integrator(row, scene.system, temperature, 1)
         except RowUnavailable as exc:
             return str(exc)
     return None
-
-
-def _nonbonded_cutoff(system) -> float:
-    for f in system.getForces():
-        if isinstance(f, mm.NonbondedForce):
-            return f.getCutoffDistance().value_in_unit(unit.nanometer)
-    return 1.0
 
 
 class Engine:
@@ -100,11 +50,11 @@ class Engine:
 
     def __init__(self, scene, x, v, row: dict, temperature: float, seed: int, threads: int = 1):
         self.row, self.info = row, describe(row)
-        self.system = _system_for(row, scene)
+        self.system = to_row(row).system_for(scene.system, scene.topology)
         self.masses = masses(self.system)
         if "hmr_da" in row:
             v = rigid_velocities_for_masses(x, v, scene.masses(), self.masses, scene.molecules)
-        self.integrator = make_integrator(row, self.system, temperature, seed, _nonbonded_cutoff(self.system))
+        self.integrator = make_integrator(row, self.system, temperature, seed)
         self.context = mm.Context(self.system, self.integrator, mm.Platform.getPlatformByName("CPU"),
                                   {"Threads": str(threads)})
         self.context.setPositions(x)

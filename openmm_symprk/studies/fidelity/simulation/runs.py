@@ -16,13 +16,13 @@ import numpy as np
 import openmm as mm
 import openmm.unit as unit
 
+from ....analysis.angular import angular_velocities
+from ....analysis.molecules import centre_of_mass_trajectory
+from ....analysis.observe import observables
+from ....analysis.reorientation import atom_vectors, dipole_vectors
 from ....physics.momenta import kinetic_energy
 from ....physics.temperature import kinetic_temperatures
 from ...equipartition.runs import steps_per_sample
-from ..angular import angular_velocities
-from ..molecules import centre_of_mass_trajectory
-from ..observe import observables
-from ..reorientation import atom_vectors, dipole_vectors
 from ..rowspec import describe
 from .engines import Engine
 

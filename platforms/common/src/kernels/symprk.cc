@@ -375,70 +375,150 @@ KERNEL void symprkRigidApply(GLOBAL const real4* RESTRICT posq, GLOBAL const rea
 }
 
 /*
- * Thermostat (stochastic velocity rescaling), part 1: the sums over particles with mass that the host turns into
- * the kept velocity field and the rescaling factor (SymPRKThermostat::SumIndex): [0] M, [1..3] sum m x,
- * [4..6] P, [7] sum m v.v, [8..13] sum m x x^T about the origin (xx, xy, xz, yy, yz, zz), [14..16] L about the
- * origin; positions only when withPositions (the rotation is kept).  Accumulated in double where the device has
- * it (else in the mixed type), one block of WORK_GROUP_SIZE threads, partial sums added in a fixed order: one
- * buffer, downloaded once per event.
+ * Thermostat (stochastic velocity rescaling), the whole event on the device (no host transfer): the operations of
+ * the host's SymPRKThermostat::event and rescalingFactor.  One block of WORK_GROUP_SIZE threads, sums in symprk_acc
+ * added in a fixed order, in two passes over the particles with mass: (1) M, sum m (x - x_0) (x_0: the first atom's
+ * position, so that nothing cancels far from the origin), P, sum m v.v and the chi-squared variate, (2) about the
+ * centre of mass R: sum m |v - V|^2 and, when the rotation is kept (withPositions), the second moments and
+ * L = sum m r x (v - V).  The noise: the dof standard normals n_k (k < dof) from OpenMM's generator,
+ * component k%4 of random[randomIndex + k/4]: r1 = n_0, chi2 = sum_{k=1}^{dof-1} n_k^2.
+ * Writes event[] = {apply, alpha, V (3), R (3), w (3)} for symprkThermostatApply and updates
+ * state[] = {heat-bath energy, total kinetic energy after the event, skipped events}.
  */
-#define SYMPRK_THERMOSTAT_SUMS 17
+#define SYMPRK_EVENT_SIZE 11
 
-KERNEL void symprkThermostatSums(GLOBAL const real4* RESTRICT posq, GLOBAL const real4* RESTRICT posqCorrection,
-        GLOBAL const mixed4* RESTRICT velm, int withPositions, GLOBAL symprk_acc* RESTRICT sums) {
-    LOCAL symprk_acc partial[SYMPRK_THERMOSTAT_SUMS*WORK_GROUP_SIZE];
-    LOCAL symprk_acc total[SYMPRK_THERMOSTAT_SUMS];
+KERNEL void symprkThermostatEvent(GLOBAL const real4* RESTRICT posq, GLOBAL const real4* RESTRICT posqCorrection,
+        GLOBAL const mixed4* RESTRICT velm, int withPositions, GLOBAL const float4* RESTRICT random, int randomIndex, int dof,
+        symprk_acc target, symprk_acc c, GLOBAL symprk_acc* RESTRICT event, GLOBAL symprk_acc* RESTRICT state) {
+    LOCAL symprk_acc partial[10*WORK_GROUP_SIZE];
+    LOCAL symprk_acc total[10];
     const int tid = LOCAL_ID;
-    symprk_acc s[SYMPRK_THERMOSTAT_SUMS];
-    for (int k = 0; k < SYMPRK_THERMOSTAT_SUMS; k++)
+    const mixed4 origin = symprkLoadPos(posq, posqCorrection, 0);
+    symprk_acc s[10];
+    for (int k = 0; k < 10; k++)
         s[k] = 0;
     for (int index = tid; index < NUM_ATOMS; index += WORK_GROUP_SIZE) {
         mixed4 v = velm[index];
         if (v.w != 0) {
             const symprk_acc m = 1/(symprk_acc) v.w;
+            const mixed4 p = symprkLoadPos(posq, posqCorrection, index);
             const symprk_acc vx = v.x, vy = v.y, vz = v.z;
             s[0] += m;
+            s[1] += m*(symprk_acc) (p.x-origin.x);
+            s[2] += m*(symprk_acc) (p.y-origin.y);
+            s[3] += m*(symprk_acc) (p.z-origin.z);
             s[4] += m*vx;
             s[5] += m*vy;
             s[6] += m*vz;
             s[7] += m*(vx*vx+vy*vy+vz*vz);
+        }
+    }
+    const int numRandom = (dof+3)/4;
+    for (int j = tid; j < numRandom; j += WORK_GROUP_SIZE) {
+        const float4 r = random[randomIndex+j];
+        const float n[4] = {r.x, r.y, r.z, r.w};
+        for (int q = 0; q < 4; q++) {
+            const int k = 4*j+q;
+            if (k >= 1 && k < dof)
+                s[8] += (symprk_acc) n[q]*(symprk_acc) n[q];
+        }
+    }
+    symprkBlockSums(s, 9, partial, total);
+    const symprk_acc M = total[0];
+    const symprk_acc invM = (M == 0 ? (symprk_acc) 0 : 1/M);
+    const symprk_acc Rx = (symprk_acc) origin.x+total[1]*invM, Ry = (symprk_acc) origin.y+total[2]*invM,
+            Rz = (symprk_acc) origin.z+total[3]*invM;
+    const symprk_acc Vx = total[4]*invM, Vy = total[5]*invM, Vz = total[6]*invM;
+    const symprk_acc twiceKinetic = total[7], chi2 = total[8];
+    for (int k = 0; k < 10; k++)
+        s[k] = 0;
+    for (int index = tid; index < NUM_ATOMS; index += WORK_GROUP_SIZE) {
+        mixed4 v = velm[index];
+        if (v.w != 0) {
+            const symprk_acc m = 1/(symprk_acc) v.w;
+            const symprk_acc ux = v.x-Vx, uy = v.y-Vy, uz = v.z-Vz;
+            s[0] += m*(ux*ux+uy*uy+uz*uz);
             if (withPositions) {
-                mixed4 p = symprkLoadPos(posq, posqCorrection, index);
-                const symprk_acc x = p.x, y = p.y, z = p.z;
-                s[1] += m*x;
-                s[2] += m*y;
-                s[3] += m*z;
-                s[8] += m*x*x;
-                s[9] += m*x*y;
-                s[10] += m*x*z;
-                s[11] += m*y*y;
-                s[12] += m*y*z;
-                s[13] += m*z*z;
-                s[14] += m*(y*vz-z*vy);
-                s[15] += m*(z*vx-x*vz);
-                s[16] += m*(x*vy-y*vx);
+                const mixed4 p = symprkLoadPos(posq, posqCorrection, index);
+                const symprk_acc rx = p.x-Rx, ry = p.y-Ry, rz = p.z-Rz;
+                s[1] += m*rx*rx;
+                s[2] += m*ry*ry;
+                s[3] += m*rz*rz;
+                s[4] += m*rx*ry;
+                s[5] += m*rx*rz;
+                s[6] += m*ry*rz;
+                s[7] += m*(ry*uz-rz*uy);
+                s[8] += m*(rz*ux-rx*uz);
+                s[9] += m*(rx*uy-ry*ux);
             }
         }
     }
-    symprkBlockSums(s, SYMPRK_THERMOSTAT_SUMS, partial, total);
-    if (tid < SYMPRK_THERMOSTAT_SUMS)
-        sums[tid] = total[tid];
+    symprkBlockSums(s, 10, partial, total);
+    if (tid == 0) {
+        symprk_acc apply = 0, alpha = 1;
+        symprk_acc3 w = make_symprk_acc3(0, 0, 0);
+        const symprk_acc totalKinetic = (symprk_acc) 0.5*twiceKinetic;
+        symprk_acc kinetic = (symprk_acc) 0.5*total[0];
+        if (withPositions) {
+            const symprk_acc3 L = make_symprk_acc3(total[7], total[8], total[9]);
+            w = symprkSolveInertia(make_symprk_acc3(total[1], total[2], total[3]), make_symprk_acc3(total[4], total[5], total[6]),
+                                   L, 0);
+            kinetic -= (symprk_acc) 0.5*(L.x*w.x+L.y*w.y+L.z*w.z);
+        }
+        if (M > 0 && isfinite(kinetic) && isfinite(totalKinetic)) {
+            state[1] = totalKinetic;
+            if (!(kinetic > (symprk_acc) 1e-10*totalKinetic))
+                state[2] += 1;  // at rest or a rigid motion: only round-off to scale
+            else {
+                // SymPRKThermostat::rescalingFactor
+                const symprk_acc r1 = (symprk_acc) random[randomIndex].x;
+                const symprk_acc sd = target/dof;
+                const symprk_acc knew = c*kinetic + (1-c)*sd*(r1*r1+chi2) + 2*r1*sqrt(c*(1-c)*kinetic*sd);
+                alpha = sqrt((knew > 0 ? knew : (symprk_acc) 0)/kinetic);
+                if (c < 1 && r1+sqrt(c*kinetic/((1-c)*sd)) < 0)
+                    alpha = -alpha;
+                if (isfinite(alpha) && isfinite(knew)) {
+                    apply = 1;
+                    state[0] -= knew-kinetic;
+                    state[1] = totalKinetic-kinetic+knew;
+                }
+                else
+                    alpha = 1;
+            }
+        }
+        event[0] = apply;
+        event[1] = alpha;
+        event[2] = Vx;
+        event[3] = Vy;
+        event[4] = Vz;
+        event[5] = Rx;
+        event[6] = Ry;
+        event[7] = Rz;
+        event[8] = w.x;
+        event[9] = w.y;
+        event[10] = w.z;
+    }
 }
 
 /**
- * Thermostat, part 2: v <- u + alpha (v - u) for particles with mass, with the kept field
- * u = V + w x (x - R) (w = 0 unless the rotation is kept: then withPositions).
+ * Thermostat, part 2: v <- u + alpha (v - u) for particles with mass, with the kept field u = V + w x (x - R)
+ * (w = 0 unless the rotation is kept: then withPositions), as symprkThermostatEvent left it in event[].
  */
 KERNEL void symprkThermostatApply(GLOBAL const real4* RESTRICT posq, GLOBAL const real4* RESTRICT posqCorrection,
-        GLOBAL mixed4* RESTRICT velm, int withPositions, mixed alpha, mixed Vx, mixed Vy, mixed Vz, mixed Rx, mixed Ry,
-        mixed Rz, mixed wx, mixed wy, mixed wz) {
+        GLOBAL mixed4* RESTRICT velm, int withPositions, GLOBAL const symprk_acc* RESTRICT event) {
+    if (event[0] == 0)
+        return;
+    const mixed alpha = event[1];
+    const mixed Vx = event[2], Vy = event[3], Vz = event[4];
+    const symprk_acc Rx = event[5], Ry = event[6], Rz = event[7];
+    const mixed wx = event[8], wy = event[9], wz = event[10];
     for (int index = GLOBAL_ID; index < NUM_ATOMS; index += GLOBAL_SIZE) {
         mixed4 v = velm[index];
         if (v.w != 0) {
             mixed ux = Vx, uy = Vy, uz = Vz;
             if (withPositions) {
                 mixed4 p = symprkLoadPos(posq, posqCorrection, index);
-                mixed rx = p.x-Rx, ry = p.y-Ry, rz = p.z-Rz;
+                mixed rx = (mixed) (p.x-Rx), ry = (mixed) (p.y-Ry), rz = (mixed) (p.z-Rz);
                 ux += wy*rz-wz*ry;
                 uy += wz*rx-wx*rz;
                 uz += wx*ry-wy*rx;

@@ -22,11 +22,22 @@
  * without the per-degree-of-freedom interpreter.
  *
  * An optional thermostat (setThermostat) samples the canonical ensemble by stochastic velocity rescaling of
- * the peculiar velocities (Bussi, Donadio and Parrinello 2007): a half event before the first of every
- * `interval` steps and one after the last, each with c = exp(-interval*dt/(2 tau)).  The centre-of-mass
- * velocity is kept (and the rigid rotation about the centre of mass when keepRotation), so total momentum
- * (and angular momentum) is unchanged; one scalar factor leaves the velocity constraints satisfied.  Without
- * a thermostat a step is exactly the NVE one.
+ * the peculiar velocities (Bussi, Donadio and Parrinello 2007).  Where it sits in the step:
+ *   ends   (no Thermostat sub-step in the sequence): a half event before the first of every `interval` steps and
+ *          one after the last, each with c = exp(-interval*dt/(2 tau));
+ *   middle (Thermostat sub-steps in the sequence, e.g. one between the two halves of Verlet's drift): each such
+ *          sub-step of coefficient f is an event with c = exp(-f*interval*dt/tau), run in the steps whose 0-based
+ *          index i has i mod interval == (interval-1)/2 (the middle step of each block); no ends events then.
+ * The centre-of-mass velocity is kept (and the rigid rotation about the centre of mass when keepRotation), so
+ * total momentum (and angular momentum) is unchanged; one scalar factor leaves the velocity constraints
+ * satisfied.  Where the peculiar kinetic energy is at most 1e-10 of the total (a System at rest or moving as a
+ * rigid whole) an event changes nothing and is counted (getSkippedThermostatEvents).  Without a thermostat a step
+ * is exactly the NVE one.
+ *
+ * Random numbers: Reference/CPU draw them on the host (std::mt19937_64, kept in this integrator's checkpoints);
+ * the Common platforms (OpenCL, CUDA, HIP) draw them on the device from OpenMM's IntegrationUtilities generator
+ * (kept in the Context's checkpoint), and run the whole event there: a step makes no host transfer
+ * (getHostTransfers counts the integrator's own).
  */
 
 #include "openmm/Integrator.h"
@@ -44,7 +55,9 @@ public:
     /** What a sub-step does (openmm_symprk.methods.resolved.SubstepKind has the same numbers). */
     enum SubstepKind {
         Kick = 0,
-        Drift = 1
+        Drift = 1,
+        /** A thermostat event over the fraction `coefficient` of interval*dt (the middle placement; needs setThermostat). */
+        Thermostat = 2
     };
     /** Bits of a sub-step's flags (openmm_symprk.methods.resolved.SubstepFlag has the same numbers). */
     enum SubstepFlag {
@@ -66,9 +79,10 @@ public:
                      const std::vector<int>& groups, const std::vector<int>& flags);
     /**
      * Set the sub-step sequence, run as given: kinds[i] is a SubstepKind, coefficients[i] the fraction of the
-     * step size (finite, non-zero), groups[i] a kick's force groups as a bit mask (as in Context::getState), or
-     * -1 for the integrator's integration force groups (drifts: -1), flags[i] a combination of SubstepFlag bits
-     * (ProjectVelocitiesBefore on drifts only, ForcesCached on kicks only).  Kicks of different groups make a
+     * step size (finite, non-zero; a Thermostat sub-step's fraction of interval*dt/tau, > 0), groups[i] a kick's
+     * force groups as a bit mask (as in Context::getState), or -1 for the integrator's integration force groups
+     * (drifts and thermostat events: -1), flags[i] a combination of SubstepFlag bits (ProjectVelocitiesBefore on
+     * drifts only, ForcesCached on kicks only, none on thermostat events).  Kicks of different groups make a
      * multiple-time-step method; the forces of every group are kept until the positions change.  Cannot be
      * called once the integrator is bound to a Context.
      */
@@ -134,13 +148,14 @@ public:
     }
     /**
      * Add the stochastic velocity-rescaling thermostat: target temperature (K, > 0), collision time tau (ps,
-     * > 0), an event every `interval` steps (>= 1; half events around each block of interval steps), the
+     * > 0), an event every `interval` steps (1 to 2^31-1; half events around each block of interval steps, or the
+     * Thermostat sub-steps in its middle step), the
      * degrees of freedom it samples (>= 1: 3 per particle with mass, less constraints, less 3 for the kept
      * centre-of-mass velocity, less 3 more when the rotation is kept) and whether the rigid rotation about the
      * centre of mass is kept (only right for an isolated System).  Cannot be called once the integrator is
      * bound to a Context.
      */
-    void setThermostat(double temperature, double collisionTime, int interval, int dof, bool keepRotation);
+    void setThermostat(double temperature, double collisionTime, long long interval, int dof, bool keepRotation);
     bool hasThermostat() const {
         return thermostat;
     }
@@ -179,6 +194,25 @@ public:
      * energy.  0 when not bound or without a thermostat.
      */
     double getHeatBathEnergy() const;
+    /**
+     * The total kinetic energy (kJ/mol) just after the last thermostat event (the event's peculiar kinetic energy
+     * K' plus the kept centre-of-mass and rotation part): the temperature the thermostat samples.  With the middle
+     * placement the on-step velocities of a State are not Maxwell-Boltzmann, these are.  0 before the first event
+     * (and when not bound or without a thermostat).
+     */
+    double getThermostatKineticEnergy() const;
+    /**
+     * Thermostat events that changed nothing because the peculiar kinetic energy was at most 1e-10 of the total
+     * (a System at rest, or moving only as a rigid whole: velocity rescaling has nothing to scale), since bound.
+     */
+    long long getSkippedThermostatEvents() const;
+    /**
+     * Host-device transfers (downloads and uploads) this integrator's kernel has made since bound: 0 on
+     * Reference/CPU; on the Common platforms a step makes none (reading the blow-up record, the heat-bath energy
+     * or the kinetic energy above, checkpoints and States make one each).  OpenMM's own force computation is not
+     * counted.
+     */
+    long long getHostTransfers() const;
     /**
      * (alpha, K'): the rescaling factor and the new peculiar kinetic energy for a peculiar kinetic energy
      * `kinetic` (kJ/mol), a target dof*kT/2, c = exp(-t/tau), a standard normal r1 and a chi-squared variable
@@ -228,6 +262,9 @@ protected:
     }
     void createCheckpoint(std::ostream& stream) const;
     void loadCheckpoint(std::istream& stream);
+    /** A State's integrator parameters: the heat-bath energy (with a thermostat). */
+    void serializeParameters(OpenMM::SerializationNode& node) const;
+    void deserializeParameters(const OpenMM::SerializationNode& node);
 
 private:
     /** index, after checking that it names a sub-step. */

@@ -71,9 +71,36 @@ public:
     virtual long long getBlowUpStep(OpenMM::ContextImpl& context) = 0;
     /** Restore the value returned by getBlowUpStep() (checkpoints). */
     virtual void setBlowUpStep(OpenMM::ContextImpl& context, long long step) = 0;
-    /** The host side of the thermostat (random state, heat-bath energy), per Context. */
-    SymPRKThermostat& getThermostat() {
-        return thermostat;
+    /**
+     * The thermostat's run-time state, per Context.  The defaults hold it in the host-side SymPRKThermostat
+     * (Reference/CPU); a kernel that runs the events on the device keeps it there and overrides these.
+     */
+    virtual void initializeThermostat(int seed) {
+        thermostat.initialize(seed);
+    }
+    virtual double getHeatBathEnergy() {
+        return thermostat.getHeatBathEnergy();
+    }
+    virtual void setHeatBathEnergy(double energy) {
+        thermostat.setHeatBathEnergy(energy);
+    }
+    /** The total kinetic energy just after the last event (0 before the first). */
+    virtual double getThermostatKineticEnergy() {
+        return thermostat.getKineticEnergy();
+    }
+    virtual long long getSkippedThermostatEvents() {
+        return thermostat.getSkippedEvents();
+    }
+    /** The random state a checkpoint of the integrator carries (text), and back. */
+    virtual std::string getRandomState() {
+        return thermostat.getRandomState();
+    }
+    virtual void setRandomState(const std::string& state) {
+        thermostat.setRandomState(state);
+    }
+    /** Host-device transfers the kernel has made (0 where the data is on the host). */
+    virtual long long getHostTransfers() {
+        return 0;
     }
     SymPRKExecutionTrace& getTrace() {
         return trace;

@@ -1,15 +1,16 @@
 #ifndef OPENMM_SYMPRK_THERMOSTAT_H_
 #define OPENMM_SYMPRK_THERMOSTAT_H_
 
-/* openmm_symprk native plugin: the host side of a thermostat event, shared by every kernel.
+/* openmm_symprk native plugin: the host side of a thermostat event (the Reference/CPU kernel's; the Common
+ * kernel runs the same operations on the device, symprkThermostatEvent in common/src/kernels/symprk.cc).
  *
  * Stochastic velocity rescaling (Bussi, Donadio and Parrinello, J. Chem. Phys. 126, 014101, 2007) of the
- * peculiar velocities.  A kernel reduces the particles' velocities (and, when the rotation is kept, their
- * positions) to the NumSums sums below, over particles with mass; event() turns them into the kept velocity
- * field u_i = V + w x (x_i - R) and the factor alpha, and the kernel then sets v_i <- u_i + alpha (v_i - u_i)
- * for every particle with mass.  Random numbers are drawn here, on the host, from a std::mt19937_64 whose
- * state is the whole random state (the distributions are created afresh for every event), so a checkpoint
- * holding it continues bit for bit.  The expression for alpha is
+ * peculiar velocities.  A kernel reduces the particles with mass to the Sums below in two passes -- the centre
+ * of mass first, then the moments about it, so that nothing cancels far from the origin -- and event() turns
+ * them into the kept velocity field u_i = V + w x (x_i - R) and the factor alpha; the kernel then sets
+ * v_i <- u_i + alpha (v_i - u_i) for every particle with mass.  Random numbers are drawn here from a
+ * std::mt19937_64 whose state is the whole random state (the distributions are created afresh for every
+ * event), so a checkpoint holding it continues bit for bit.  The expression for alpha is
  * openmm_symprk.physics.velocity_rescaling.rescaling_factor, operation for operation.
  */
 
@@ -22,15 +23,15 @@ namespace SymPRKPlugin {
 
 class OPENMM_EXPORT_SYMPRK SymPRKThermostat {
 public:
-    /** Layout of the sums a kernel provides (all over particles with mass m > 0; positions x, velocities v). */
-    enum SumIndex {
-        SumMass = 0,         // M = sum m
-        SumMomentX = 1,      // sum m x (3: x, y, z)
-        SumMomentum = 4,     // P = sum m v (3)
-        SumTwiceKinetic = 7, // sum m v.v
-        SumSecond = 8,       // sum m x x^T about the origin (6: xx, xy, xz, yy, yz, zz)
-        SumAngular = 14,     // L = sum m x cross v about the origin (3)
-        NumSums = 17
+    /** What a kernel sums over the particles with mass m > 0 (positions x, velocities v). */
+    struct Sums {
+        double mass;              // M = sum m
+        OpenMM::Vec3 centre;      // R, the centre of mass (first pass)
+        OpenMM::Vec3 momentum;    // P = sum m v
+        double twiceKinetic;      // sum m v.v
+        double twicePeculiar;     // sum m |v - P/M|^2 (second pass)
+        OpenMM::Vec3 d, o;        // rotation kept: (sum m rx^2, ry^2, rz^2), (sum m rx ry, rx rz, ry rz), r = x - R
+        OpenMM::Vec3 angular;     // rotation kept: L = sum m r x v about R
     };
     /** What a kernel applies: v <- u + alpha (v - u), u = velocity + omega x (x - centre), particles with mass only. */
     struct Event {
@@ -39,20 +40,33 @@ public:
         OpenMM::Vec3 velocity, centre, omega;  // omega = 0 unless the rotation is kept
         double kinetic, newKinetic;    // peculiar kinetic energy before and after (kJ/mol)
     };
+    /** The fraction of the total kinetic energy at or below which the peculiar part counts as none (round-off). */
+    static double negligiblePeculiarFraction() {
+        return 1e-10;
+    }
     SymPRKThermostat();
-    /** Seed the generator (0: a seed from std::random_device) and zero the heat-bath energy. */
+    /** Seed the generator (0: a seed from std::random_device) and zero the heat-bath energy and the counters. */
     void initialize(int seed);
     /**
      * One event with relaxation factor c = exp(-t/tau) for a target temperature (K), the degrees of freedom and
      * whether the rotation is kept: draws r1 ~ N(0,1) and chi2 ~ chi^2(dof-1), and subtracts K' - K_pec from the
-     * heat-bath energy.  A (nearly) singular inertia tensor is regularised by 1e-12 of its trace (solveInertia).
+     * heat-bath energy.  A (nearly) singular inertia tensor is regularised (solveInertia).  Where K_pec is at most
+     * negligiblePeculiarFraction() of the total kinetic energy nothing is applied and the event is counted as
+     * skipped (the noise is drawn all the same: one draw per event).
      */
-    Event event(const double* sums, double temperature, int dof, bool keepRotation, double c);
+    Event event(const Sums& sums, double temperature, int dof, bool keepRotation, double c);
     double getHeatBathEnergy() const {
         return heatBathEnergy;
     }
     void setHeatBathEnergy(double energy) {
         heatBathEnergy = energy;
+    }
+    /** The total kinetic energy just after the last event (0 before the first). */
+    double getKineticEnergy() const {
+        return kineticEnergy;
+    }
+    long long getSkippedEvents() const {
+        return skippedEvents;
     }
     /** The generator's state as text (std::mt19937_64's operator<<), and back. */
     std::string getRandomState() const;
@@ -66,7 +80,8 @@ public:
     static double boltzmann();
 private:
     std::mt19937_64 rng;
-    double heatBathEnergy;
+    double heatBathEnergy, kineticEnergy;
+    long long skippedEvents;
 };
 
 } // namespace SymPRKPlugin

@@ -1,19 +1,17 @@
-"""The bench's scene registry: each scene models no more than the question it answers.
+"""The named scenes of the bench and the studies: each models no more than the question it answers.
 
-A scene (:class:`openmm_symprk.systems.scene.Scene`, the package's one scene type) is a System plus one shared
-initial state (positions and velocities, nm and nm/ps) and what the bench may measure on it: which quantities
-are invariants, whether an exact solution exists, whether it is for accuracy or for speed only.  Scenes are
-built once per sweep, saved in the output folder (:func:`save_scene`) and shipped to the workers as a
-:meth:`~openmm_symprk.systems.scene.Scene.payload`, so every run of a sweep (and of a resumed sweep) starts
-from bit-identical coordinates.
+A scene (:class:`.scene.Scene`, the package's one scene type) is a System plus one shared initial state (positions
+and velocities, nm and nm/ps) and what may be measured on it: which quantities are invariants, whether an exact
+solution exists, whether it is for accuracy, speed or production-shaped runs.  A study builds its scenes once,
+stores them in its output folder (:func:`.scene.save_scene`, or with their replica states,
+:func:`.replicas.replica_states`) and ships them to the workers as a :meth:`~.scene.Scene.payload`, so every run
+(and every run of a resumed study) starts from bit-identical coordinates.
 
-``SCENES`` maps the registry names to their builders; each builder's docstring says why its model is
-enough for its question and no more.  :func:`user_scene` wraps a System of your own.
+``SCENES`` maps the names to their builders; each builder's docstring says why its model is enough for its
+question and no more.  :func:`user_scene` wraps a System of your own.
 """
 from __future__ import annotations
 
-import json
-import os
 import warnings
 
 import numpy as np
@@ -21,47 +19,27 @@ import openmm as mm
 import openmm.app as app
 import openmm.unit as unit
 
-from ...systems.forcegroups import split_forces
-from ...systems.prepare import equilibrate, maxwell_boltzmann, minimise
-from ...systems.scene import Scene
-from ...systems.scenes import water_box
-from ..core.folders import write_json, write_npz, write_text
-from . import toys
-
-def save_scene(scene: Scene, folder: str) -> str:
-    """Write the scene's payload as <folder>/<name>.xml + .npz + .json (atomically); returns the JSON path."""
-    os.makedirs(folder, exist_ok=True)
-    p = scene.payload()
-    base = os.path.join(folder, scene.name)
-    write_text(base + ".xml", p["xml"])
-    write_npz(base + ".npz", {"positions": p["positions"], "velocities": p["velocities"]})
-    write_json(base + ".json", {"info": p["info"], "fingerprint": p["fingerprint"]})
-    return base + ".json"
-
-
-def load_scene(folder: str, name: str) -> Scene:
-    base = os.path.join(folder, name)
-    with open(base + ".json") as fh:
-        meta = json.load(fh)
-    with open(base + ".xml") as fh:
-        xml = fh.read()
-    with np.load(base + ".npz") as arrays:
-        return Scene.from_payload({"xml": xml, "positions": arrays["positions"], "velocities": arrays["velocities"],
-                                   "info": meta["info"]})
-
+from ..forcegroups import split_forces
+from ..prepare import equilibrate, maxwell_boltzmann, minimise
+from ..repartition import repartition_hydrogen_mass
+from .builders import openmm_data, protein_vacuum, water_box, water_cluster
+from .scene import Scene
 
 def _why(fn) -> str:
     return " ".join((fn.__doc__ or "").split())
 
 
 # -- the analytic toys ---------------------------------------------------------------------------
-def harmonic(n: int = 256, omega_max: float = toys.OMEGA_OH, seed: int = 11) -> Scene:
+def harmonic(n: int = 256, omega_max: float | None = None, seed: int = 11) -> Scene:
     """Independent harmonic oscillators, frequencies spread evenly up to an O-H stretch (700/ps).
 
     Linear forces have an exact solution, so every error is the integrator's own; a spectrum reaching
     down to zero is enough to turn "largest stable step" into the linear stability interval (stable for
     every h*omega up to the limit), and nothing else is needed for that question.  External wells:
     energy and angular momentum about the origin are invariants, linear momentum is not."""
+    from . import toys
+
+    omega_max = toys.OMEGA_OH if omega_max is None else omega_max
     omega = toys.harmonic_frequencies(n, omega_max)
     x0, v0 = toys.harmonic_initial_state(omega, seed)
     return Scene("harmonic", toys.harmonic_system(omega), x0, v0,
@@ -77,6 +55,8 @@ def anharmonic(n: int = 64, seed: int = 13) -> Scene:
     Nonlinear forces reach the order conditions that a harmonic force cannot see (on q'' = -q every
     consistent splitting of a given symmetric structure looks alike), and the cn-function solution keeps
     the answer exact.  Separable quartic wells: energy is the only invariant."""
+    from . import toys
+
     a, b, amp = toys.duffing_parameters(n)
     x0, v0, u0 = toys.duffing_initial_state(a, b, amp, seed)
     return Scene("anharmonic", toys.duffing_system(a, b), x0, v0,
@@ -98,8 +78,6 @@ def water_rigid(n_waters: int = 64) -> Scene:
     this is where 2-4 fs steps are used.  In vacuum, without a box, energy, linear momentum and angular
     momentum are all invariants; a cluster of 64 molecules has a liquid-like local structure and costs
     little on the Reference platform."""
-    from ...systems.scenes import water_cluster
-
     return _from_core(water_cluster(n_waters, rigid=True), "water-rigid", _why(water_rigid))
 
 
@@ -108,8 +86,6 @@ def water_flexible(n_waters: int = 64) -> Scene:
 
     The O-H stretch (period about 9 fs) is the fastest motion in biomolecular MD: this is where large
     steps fail and where the stability of a method per force evaluation decides what step it can take."""
-    from ...systems.scenes import water_cluster
-
     return _from_core(water_cluster(n_waters, rigid=False), "water-flexible", _why(water_flexible))
 
 
@@ -120,9 +96,27 @@ def villin() -> Scene:
     tolerance 1e-10), the case where compositions keep their order under constraints and other
     splittings drop to order 2.  Vacuum and no cutoff keep every invariant and the cost at a few ms per
     force evaluation on the Reference platform; solvent would only add cost here."""
-    from ...systems.scenes import protein_vacuum
-
     return _from_core(protein_vacuum(), "villin", _why(villin))
+
+
+def villin_vacuum_hmr(hydrogen_mass: float = 1.5) -> Scene:
+    """Villin in vacuum (:func:`villin`) with the hydrogen masses repartitioned to 1.5 Da: the seconds-long stand-in of
+    ``villin-pme-hmr`` in quick drift studies."""
+    sc = protein_vacuum()
+    system = repartition_hydrogen_mass(sc.system, sc.topology, hydrogen_mass)
+    return Scene("villin-vacuum-hmr", system, np.array(sc.positions), np.array(sc.velocities),
+                 sc.description + f", HMR {hydrogen_mass:g} Da", sc.topology, why=_why(villin_vacuum_hmr))
+
+
+def water_box_216(seed: int = 3) -> Scene:
+    """216 rigid TIP3P waters in a periodic box (648 atoms), PME with a 0.9 nm cutoff, minimised, velocities at
+    300 K: the NVT drift study's box (a study's replica states start from it, :mod:`.replicas`), small enough that
+    20-ps runs take minutes on the CPU platform."""
+    system, topology, x = water_box("tip3p", n_waters=216, cutoff_nm=0.9)
+    pos = minimise(system, x, "CPU", tolerance=10.0, max_iterations=200)
+    return Scene("water-box-216", system, pos, maxwell_boltzmann(system, pos, 300.0, seed),
+                 f"216 rigid TIP3P waters, PME 0.9 nm, {system.getNumParticles()} atoms, periodic", topology,
+                 purpose="production", platform="CPU", invariants=("energy", "momentum"), why=_why(water_box_216))
 
 
 def water_box_pme(box_nm: float = 3.9, seed: int = 17) -> Scene:
@@ -139,10 +133,6 @@ def water_box_pme(box_nm: float = 3.9, seed: int = 17) -> Scene:
                       purpose="speed", platform="CPU", invariants=("energy", "momentum"), why=_why(water_box_pme))
 
 
-def _openmm_data(name: str) -> str:
-    return os.path.join(os.path.dirname(app.__file__), "data", name)
-
-
 def villin_pme(hmr: bool = False, equilibrate_ps: float = 10.0, seed: int = 29) -> Scene:
     """OpenMM's test.pdb as shipped: the villin headpiece in 2,761 TIP3P waters (8,867 atoms), amber14, PME with a
     0.9 nm cutoff, HBonds and rigid water, no CMMotionRemover; with ``hmr`` the hydrogen masses are repartitioned
@@ -152,7 +142,7 @@ def villin_pme(hmr: bool = False, equilibrate_ps: float = 10.0, seed: int = 29) 
     the unit of OpenMM's published validation), energy fluctuation per DOF and ns/day, against OpenMM's
     VerletIntegrator on the same masses.  The reciprocal space of PME is in force group 1 (all else in group 0),
     for the multiple-time-step rows; the single-level rows integrate both groups."""
-    pdb = app.PDBFile(_openmm_data("test.pdb"))
+    pdb = app.PDBFile(openmm_data("test.pdb"))
     ff = app.ForceField("amber14-all.xml", "amber14/tip3p.xml")
     system = ff.createSystem(pdb.topology, nonbondedMethod=app.PME, nonbondedCutoff=0.9 * unit.nanometer,
                              constraints=app.HBonds, rigidWater=True, removeCMMotion=False,
@@ -189,6 +179,9 @@ SCENES = {
     "water-rigid": water_rigid,
     "water-flexible": water_flexible,
     "villin": villin,
+    "villin-vacuum": villin,
+    "villin-vacuum-hmr": villin_vacuum_hmr,
+    "water-box-216": water_box_216,
     "water-box-pme": water_box_pme,
     "villin-pme": villin_pme,
     "villin-pme-hmr": lambda **kw: villin_pme(hmr=True, **kw),
@@ -209,7 +202,7 @@ def build(name: str, **params) -> Scene:
 
 # -- helpers and user scenes ---------------------------------------------------------------------
 def _invariants_of(system) -> tuple:
-    from ...systems.checks import conservation_issues
+    from ..checks import conservation_issues
 
     keys = {k for k, _ in conservation_issues(system)}
     inv = []

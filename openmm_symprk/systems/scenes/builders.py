@@ -1,4 +1,4 @@
-"""Minimal scenes: each models no more than the effect it is there to show.
+"""Scene builders: each models no more than the effect it is there to show.
 
 * :func:`water_cluster` -- TIP3P waters in vacuum (no box, no cutoff, no CMMotionRemover), rigid
   (SETTLE) or flexible, spun up about the centre of mass.  Isolated, so energy, linear momentum and
@@ -19,7 +19,7 @@ import openmm as mm
 import openmm.app as app
 import openmm.unit as unit
 
-from .prepare import constrain_velocities, maxwell_boltzmann, minimise
+from ..prepare import constrain_velocities, maxwell_boltzmann, minimise
 from .scene import Scene
 
 #: TIP3P geometry (nm, radians)
@@ -147,7 +147,8 @@ def constrained_molecule(seed: int = 3) -> Scene:
                  "4-atom chain with 3 distance constraints, angle and 1-4 terms (nonlinear, constrained)", sc.topology)
 
 
-def _openmm_data(name):
+def openmm_data(name: str) -> str:
+    """The path of a file in OpenMM's bundled data folder (e.g. test.pdb)."""
     import os
 
     return os.path.join(os.path.dirname(app.__file__), "data", name)
@@ -158,7 +159,7 @@ def protein_vacuum(constraints=app.HBonds, temperature: float = 300.0, angular_v
     """The villin headpiece from OpenMM's bundled test.pdb, solvent removed, in vacuum (amber14, no
     cutoff, no CMMotionRemover), HBonds constrained by default: a real protein whose conservation
     exercises CCMA constraints, with no periodic box to break rotational symmetry."""
-    pdb = app.PDBFile(_openmm_data("test.pdb"))
+    pdb = app.PDBFile(openmm_data("test.pdb"))
     mod = app.Modeller(pdb.topology, pdb.positions)
     mod.deleteWater()
     mod.delete([r for r in mod.topology.residues() if len(r) == 1])  # counter-ions

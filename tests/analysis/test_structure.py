@@ -3,7 +3,7 @@ thermal displacements has its first peak at the lattice constant with the height
 import numpy as np
 import pytest
 
-from openmm_symprk.studies.fidelity.structure import first_peak, radial_distribution
+from openmm_symprk.analysis.structure import first_peak, radial_distribution
 
 
 def test_ideal_gas_gives_one_within_the_counting_noise():
@@ -44,7 +44,7 @@ def test_simple_cubic_lattice_first_peak_at_the_lattice_constant():
 
 def test_parabola_refines_the_peak_between_bins():
     """A Gaussian peak centred between bin centres is found at its centre, closer than half a bin."""
-    from openmm_symprk.studies.fidelity.structure import Rdf
+    from openmm_symprk.analysis.structure import Rdf
 
     r = np.arange(0.0025, 1.0, 0.005)
     g = 1 + 2 * np.exp(-0.5 * ((r - 0.2817) / 0.02) ** 2)

@@ -8,16 +8,13 @@ computed in O(n log n) with a zero-padded FFT (Wiener-Khinchin) instead of the O
 lags average few origins (n - m): they are noisy, and the callers stop at a stated maximum lag.
 
 Error bars of figures computed from a molecule-averaged correlation function (a correlation time, a first
-minimum) come from :func:`jackknife_over_molecules`: the molecules are cut into G disjoint groups, the figure
-recomputed from the average over all groups but one, G times, and SE = sqrt((G - 1) / G sum (f_(g) - mean)^2).
-The figures are non-linear functions of the curve, which the jackknife handles better than the scatter of
-the figures of small groups.
+minimum) come from the delete-one-group jackknife over molecules, :func:`openmm_symprk.stats.jackknife`.
 """
 from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["origin_averaged_correlation", "check_max_lag", "jackknife_over_molecules"]
+__all__ = ["origin_averaged_correlation", "check_max_lag"]
 
 
 def check_max_lag(n_frames: int, max_lag: int | None) -> int:
@@ -46,22 +43,3 @@ def origin_averaged_correlation(a, max_lag: int | None = None) -> np.ndarray:
     c = np.fft.irfft(f * np.conj(f), size, axis=0)[:max_lag + 1]
     counts = (n - np.arange(max_lag + 1)).reshape((-1,) + (1,) * (a.ndim - 1))
     return c / counts
-
-
-def jackknife_over_molecules(per_molecule, statistic, n_groups: int = 20):
-    """(statistic of the molecule average, its delete-one-group jackknife standard error).
-
-    ``per_molecule``: (L, n) or (L, n, ...) - a quantity per molecule on axis 1; ``statistic``: a function of
-    the average over molecules (shape (L, ...)) returning a float or an array of floats; ``n_groups``: the
-    number of disjoint groups of consecutive molecules (at most one per molecule, at least 2)."""
-    c = np.asarray(per_molecule, dtype=np.float64)
-    n = c.shape[1] if c.ndim >= 2 else 0
-    if n_groups < 2 or n < 2:
-        raise ValueError(f"the jackknife needs n_groups >= 2 and at least 2 molecules, got {n_groups} and {n}")
-    groups = np.array_split(np.arange(n), min(int(n_groups), n))
-    total = c.sum(axis=1)
-    value = statistic(total / n)
-    jack = np.array([statistic((total - c[:, g].sum(axis=1)) / (n - len(g))) for g in groups], dtype=np.float64)
-    g = len(groups)
-    se = np.sqrt((g - 1) / g * ((jack - jack.mean(axis=0)) ** 2).sum(axis=0))
-    return value, (float(se) if np.ndim(se) == 0 else se)

@@ -19,8 +19,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ...physics.temperature import R_KJ
-from ...stats import drift, series_stats
+from ..physics.temperature import R_KJ
+from ..stats import drift, series_stats
 from . import angular, diffusion, reorientation, structure
 
 __all__ = ["OBSERVABLES", "observables"]

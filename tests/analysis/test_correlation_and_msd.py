@@ -2,8 +2,8 @@
 import numpy as np
 import pytest
 
-from openmm_symprk.studies.fidelity.correlation import origin_averaged_correlation
-from openmm_symprk.studies.fidelity.diffusion import mean_squared_displacement
+from openmm_symprk.analysis.correlation import origin_averaged_correlation
+from openmm_symprk.analysis.diffusion import mean_squared_displacement
 
 
 def test_fft_correlation_equals_the_double_loop():

@@ -22,7 +22,7 @@ with ``components=True``).  Its summary (:func:`acf_summary`): the first zero cr
 minimum (time and value) and the trapezoidal integral of C from 0 to the last computed lag (ps; it
 oscillates with the librations, so the integral is stated together with its upper limit).
 :func:`omega_correlation` gives both, with the summary's standard errors from the delete-one-group
-jackknife over groups of molecules (:func:`~.correlation.jackknife_over_molecules`).
+jackknife over groups of molecules (:func:`openmm_symprk.stats.jackknife`).
 """
 from __future__ import annotations
 
@@ -30,8 +30,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .correlation import jackknife_over_molecules, origin_averaged_correlation
-from .molecules import trajectory_frames
+from ..stats import jackknife
+from .correlation import origin_averaged_correlation
+from .molecules import make_whole, molecule_index, trajectory_frames
 
 __all__ = ["angular_velocities", "angular_velocity_acf", "AcfSummary", "acf_summary", "omega_correlation"]
 
@@ -56,12 +57,16 @@ def _body_axes(inertia, r):
     return axes
 
 
-def angular_velocities(x, v, m, molecules, frame: str = "space") -> np.ndarray:
+def angular_velocities(x, v, m, molecules, frame: str = "space", box=None) -> np.ndarray:
     """Angular velocity (F, n, 3) rad/ps of each molecule at each frame, about its centre of mass, from
-    positions ``x`` (F, N, 3) nm (molecules whole), velocities ``v`` (F, N, 3) nm/ps and masses ``m`` (N,)
-    Da; components in the ``frame`` "space" or "body" (see the module docstring)."""
+    positions ``x`` (F, N, 3) nm (molecules whole, or made whole in the orthorhombic ``box``: 3 edges nm or
+    (F, 3)), velocities ``v`` (F, N, 3) nm/ps and masses ``m`` (N,) Da; components in the ``frame`` "space"
+    or "body" (see the module docstring)."""
     if frame not in ("space", "body"):
         raise ValueError(f"frame must be 'space' or 'body', got {frame!r}")
+    if box is not None:
+        x = np.array(x, dtype=np.float64)
+        x[:, molecule_index(molecules)] = make_whole(x, molecules, box)
     fr = trajectory_frames(x, v, m, molecules)
     if np.any(fr.M <= 0):
         raise ValueError("a molecule has no mass: no angular velocity")
@@ -142,6 +147,6 @@ def omega_correlation(omega, dt_ps: float, max_lag: int | None = None, n_groups:
         return np.array([s.t_zero, s.c_min, s.integral])
 
     summary = acf_summary(c, dt_ps)
-    _, se = jackknife_over_molecules(per, figures, n_groups)
+    _, se = jackknife(per, figures, n_groups)
     summary.t_zero_se, summary.c_min_se, summary.integral_se = (float(e) for e in se)
     return c, summary

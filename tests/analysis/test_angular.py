@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from openmm_symprk.studies.fidelity.angular import (acf_summary, angular_velocities, angular_velocity_acf,
+from openmm_symprk.analysis.angular import (acf_summary, angular_velocities, angular_velocity_acf,
                                                    omega_correlation)
 
 BODY = np.array([[0.0, 0.0, -0.0065], [0.0816, 0.0, 0.0512], [-0.0816, 0.0, 0.0512]])  # O, H, H about ~com, nm
@@ -154,7 +154,7 @@ def test_rotational_energy_from_omega_is_the_temperature_modules():
     """1/2 omega . I omega summed over molecules equals physics.temperature's rotational kinetic energy
     (one definition of the molecule's frame behind both), for random rigid-water velocities."""
     from openmm_symprk.physics.temperature import molecule_kinetics
-    from openmm_symprk.studies.fidelity.molecules import trajectory_frames
+    from openmm_symprk.analysis.molecules import trajectory_frames
 
     rng = np.random.default_rng(25)
     xs, vs = [], []

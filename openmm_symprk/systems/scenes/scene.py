@@ -1,6 +1,8 @@
 """The one scene type: an OpenMM System with one shared initial state, and what may be measured on it.
 
-Tests, the demo, the bench and the studies all take a :class:`Scene`.  A scene travels to worker processes as
+Tests, the demo, the bench and the studies all take a :class:`Scene`.  A scene, or a set of states of one System
+(the replica states of a study), is stored one way: ``<base>.xml`` (the System), ``<base>.npz`` (the arrays) and,
+for a scene, ``<base>.json`` (its info and fingerprint), each written atomically (:func:`save_states`).  A scene travels to worker processes as
 its :meth:`Scene.payload` (plain, picklable data: the System as XML), whose fingerprint hashes everything a run
 on it depends on, so every run of a study (and of a resumed study) starts from bit-identical coordinates and a
 changed scene never reuses stale runs.
@@ -9,15 +11,17 @@ from __future__ import annotations
 
 import hashlib
 import json
+import os
 from dataclasses import dataclass, field
 
 import numpy as np
 import openmm as mm
 import openmm.app as app
 
-from .properties import constraint_arrays, degrees_of_freedom, masses
+from ...support.files import write_json, write_npz, write_text
+from ..properties import constraint_arrays, degrees_of_freedom, masses
 
-__all__ = ["Scene", "ALL_INVARIANTS"]
+__all__ = ["Scene", "ALL_INVARIANTS", "save_scene", "load_scene", "save_states", "load_states"]
 
 #: Every invariant an isolated system has.
 ALL_INVARIANTS = ("energy", "momentum", "angular_momentum")
@@ -112,3 +116,48 @@ def _plain(obj):
     if isinstance(obj, np.generic):
         return obj.item()
     return obj
+
+
+def save_states(base: str, xml: str, arrays: dict, info: dict | None = None):
+    """Store a System (its XML) with arrays of states: ``<base>.xml``, ``<base>.npz`` and, given ``info``,
+    ``<base>.json``; each file atomically, the ``.npz`` last, so that one on disk means a complete set."""
+    os.makedirs(os.path.dirname(os.path.abspath(base)), exist_ok=True)
+    write_text(base + ".xml", xml)
+    if info is not None:
+        write_json(base + ".json", info)
+    write_npz(base + ".npz", arrays)
+
+
+def load_states(base: str, with_info: bool = False):
+    """(xml, arrays[, info]) stored by :func:`save_states`, or None when the set is not there (or incomplete)."""
+    paths = [base + ".xml", base + ".npz"] + ([base + ".json"] if with_info else [])
+    if not all(os.path.exists(p) for p in paths):
+        return None
+    with open(base + ".xml") as fh:
+        xml = fh.read()
+    with np.load(base + ".npz") as data:
+        arrays = {k: data[k] for k in data.files}
+    if not with_info:
+        return xml, arrays
+    with open(base + ".json") as fh:
+        return xml, arrays, json.load(fh)
+
+
+def save_scene(scene: Scene, folder: str) -> str:
+    """Store the scene's payload as <folder>/<name>.xml + .npz + .json (:func:`save_states`); returns the JSON
+    path."""
+    p = scene.payload()
+    base = os.path.join(folder, scene.name)
+    save_states(base, p["xml"], {"positions": p["positions"], "velocities": p["velocities"]},
+                {"info": p["info"], "fingerprint": p["fingerprint"]})
+    return base + ".json"
+
+
+def load_scene(folder: str, name: str) -> Scene:
+    """The scene :func:`save_scene` stored in ``folder``."""
+    found = load_states(os.path.join(folder, name), with_info=True)
+    if found is None:
+        raise FileNotFoundError(f"no stored scene {name!r} in {folder}")
+    xml, arrays, meta = found
+    return Scene.from_payload({"xml": xml, "positions": arrays["positions"], "velocities": arrays["velocities"],
+                               "info": meta["info"]})

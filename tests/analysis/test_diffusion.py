@@ -3,7 +3,7 @@ motion, unwrapping across periodic boundaries, and the Yeh-Hummer correction by 
 import numpy as np
 import pytest
 
-from openmm_symprk.studies.fidelity.diffusion import (NM2_PER_PS_IN_1E5_CM2_PER_S, VISCOSITY_MPAS,
+from openmm_symprk.analysis.diffusion import (NM2_PER_PS_IN_1E5_CM2_PER_S, VISCOSITY_MPAS,
                                                       mean_squared_displacement, remove_drift, self_diffusion,
                                                       unwrap, yeh_hummer)
 

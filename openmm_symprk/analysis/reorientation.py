@@ -25,8 +25,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .correlation import jackknife_over_molecules, origin_averaged_correlation
-from .molecules import molecule_index
+from ..stats import jackknife
+from .correlation import origin_averaged_correlation
+from .molecules import make_whole, molecule_index
 
 __all__ = ["atom_vectors", "bisector_vectors", "dipole_vectors", "legendre_correlation", "correlation_time",
            "CorrelationTime", "reorientation_time"]
@@ -34,17 +35,7 @@ __all__ = ["atom_vectors", "bisector_vectors", "dipole_vectors", "legendre_corre
 
 def _positions(x, molecules, box):
     """(F, n, k, 3) positions of the molecules' atoms, made whole from the first atom when ``box`` is given."""
-    x = np.asarray(x, dtype=np.float64)
-    if x.ndim != 3 or x.shape[2] != 3:
-        raise ValueError(f"x must have shape (n_frames, n_atoms, 3) in nm, got {x.shape}")
-    xg = x[:, molecule_index(molecules)]
-    if box is not None:
-        box = np.asarray(box, dtype=np.float64)
-        if box.shape != (3,) or not np.all(box > 0):
-            raise ValueError(f"box must be the 3 edge lengths (nm) of an orthorhombic box, got {box.tolist()}")
-        d = xg - xg[:, :, :1]
-        xg = xg[:, :, :1] + d - box * np.round(d / box)
-    return xg
+    return make_whole(x, molecules, box)
 
 
 def _unit(u):
@@ -143,9 +134,9 @@ def reorientation_time(u, order: int, dt_ps: float, *, n_groups: int = 20, max_l
                        c_cut: float = 0.1, c_fit: float = 0.5) -> tuple:
     """(C_l averaged over molecules (max_lag + 1,), :class:`CorrelationTime` tau_l in ps with its standard
     error) for unit vectors ``u`` (F, n, 3) every ``dt_ps``.  The error is the delete-one-group jackknife over
-    ``n_groups`` disjoint groups of molecules (:func:`~.correlation.jackknife_over_molecules`)."""
+    ``n_groups`` disjoint groups of molecules (:func:`openmm_symprk.stats.jackknife`)."""
     c = legendre_correlation(u, order, max_lag)
     mean = c.mean(axis=1)
     result = correlation_time(mean, dt_ps, c_cut, c_fit)
-    _, result.se = jackknife_over_molecules(c, lambda m: correlation_time(m, dt_ps, c_cut, c_fit).tau, n_groups)
+    _, result.se = jackknife(c, lambda m: correlation_time(m, dt_ps, c_cut, c_fit).tau, n_groups)
     return mean, result

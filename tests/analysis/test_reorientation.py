@@ -3,7 +3,7 @@ tau_1 = 1/(2 D_r) and tau_2 = 1/(6 D_r); the correlation time's integral-plus-ta
 import numpy as np
 import pytest
 
-from openmm_symprk.studies.fidelity.reorientation import (atom_vectors, bisector_vectors, correlation_time,
+from openmm_symprk.analysis.reorientation import (atom_vectors, bisector_vectors, correlation_time,
                                                           dipole_vectors, legendre_correlation,
                                                           reorientation_time)
 

@@ -1,4 +1,4 @@
-"""Analytic toy systems for the bench: independent oscillators whose exact solution is known.
+"""Analytic toy systems (the bench's ``harmonic`` and ``anharmonic`` scenes): independent oscillators whose exact solution is known.
 
 Both toys are sets of unit-mass particles in an external potential, one independent 1-D oscillator per
 Cartesian axis, so that the exact state at any time is a closed formula and every error the bench reports
@@ -20,13 +20,14 @@ from __future__ import annotations
 import numpy as np
 import openmm as mm
 
+from ...physics.temperature import R_KJ
 from ...support import require
 
-special = require("scipy.special", "studies", "openmm_symprk.studies.bench.toys")
+special = require("scipy.special", "studies", "openmm_symprk.systems.scenes.toys")
 ellipj, ellipkinc = special.ellipj, special.ellipkinc
 
 #: kT at 300 K in kJ/mol: the toys hold about this much energy per degree of freedom.
-KT300 = 0.0083144626 * 300.0
+KT300 = R_KJ * 300.0
 #: O-H stretch angular frequency (1/ps), the top of the harmonic toy's spectrum.
 OMEGA_OH = 700.0
 

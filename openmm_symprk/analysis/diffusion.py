@@ -30,6 +30,9 @@ import numpy as np
 
 from .correlation import origin_averaged_correlation
 from .literature import K_BOLTZMANN, NM2_PER_PS_IN_1E5_CM2_PER_S, VISCOSITY_MPAS, XI_CUBIC
+from .molecules import check_box
+
+
 
 __all__ = ["unwrap", "remove_drift", "mean_squared_displacement", "DiffusionFit", "self_diffusion", "yeh_hummer",
            "VISCOSITY_MPAS", "XI_CUBIC", "NM2_PER_PS_IN_1E5_CM2_PER_S", "K_BOLTZMANN"]
@@ -37,21 +40,15 @@ __all__ = ["unwrap", "remove_drift", "mean_squared_displacement", "DiffusionFit"
 _UNWRAP_LIMIT = 0.4  # a stored step beyond this fraction of an edge cannot be unwrapped safely
 
 
-def _box(box):
-    box = np.asarray(box, dtype=np.float64)
-    if box.shape != (3,) or not np.all(box > 0):
-        raise ValueError(f"box must be the 3 edge lengths (nm, all > 0) of an orthorhombic box, got {box.tolist()}")
-    return box
-
-
 def unwrap(r, box) -> np.ndarray:
     """Continuous trajectories from periodic ones: ``r`` (F, n, 3) nm wrapped into an orthorhombic ``box``
-    (3 edges, nm, fixed), the first frame kept, each step replaced by its minimum image.  ValueError when a
-    step exceeds 0.4 of an edge (frames stored too far apart to tell which image the molecule went to)."""
+    (3 edges nm, or (F, 3) one per frame: each step taken in the later frame's box), the first frame kept, each
+    step replaced by its minimum image.  ValueError when a step exceeds 0.4 of an edge (frames stored too far
+    apart to tell which image the molecule went to)."""
     r = np.asarray(r, dtype=np.float64)
     if r.ndim != 3 or r.shape[2] != 3:
         raise ValueError(f"r must have shape (n_frames, n_molecules, 3) in nm, got {r.shape}")
-    box = _box(box)
+    box = check_box(box, r.shape[0])[1:, None, :]
     step = np.diff(r, axis=0)
     step -= box * np.round(step / box)
     worst = np.abs(step / box).max() if step.size else 0.0
@@ -125,7 +122,7 @@ def _slopes(t, y):
 
 def _window(window_ps, dt_ps, max_lag):
     t_min, t_max = (float(w) for w in window_ps)
-    lo, hi = int(np.ceil(t_min / dt_ps - 1e-9)), int(np.floor(t_max / dt_ps + 1e-9))
+    lo, hi = int(np.ceil(t_min / dt_ps - 1e-6)), int(np.floor(t_max / dt_ps + 1e-6))  # dt from a float32 header
     if not 0 <= t_min < t_max or hi > max_lag or hi - lo < 2:
         raise ValueError(f"fit window {window_ps} ps must satisfy 0 <= t_min < t_max <= the longest lag "
                          f"{max_lag * dt_ps:g} ps and hold at least 3 lags of {dt_ps:g} ps")

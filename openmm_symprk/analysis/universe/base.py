@@ -1,0 +1,151 @@
+"""What every trajectory analysis of water shares: finding the waters of a Universe, reading their frames in the
+package's units (nm, ps, Da, e), and the time between frames.
+
+Waters (:func:`find_waters`): the residues of the atom group with exactly one oxygen and two hydrogens among
+their atoms of non-zero mass (the element, else the name's first letter: OW, OH2, O; HW1, H1, H), any
+massless sites (TIP4P's M, TIP5P's lone pairs) kept after them.  Each molecule's atoms are ordered O, H, H,
+massless sites; every water must have the same number of sites (one model).  Masses are the topology's (an
+OpenMM System's through ``masses=``), charges the topology's where it has them.
+
+Frames (:class:`WaterFrames`): each frame's water positions (and velocities where asked) are copied as
+float32 (what the file stores), with the box; every computation runs once over all frames at the end, in
+float64, vectorised over frames and molecules (no Python loop per molecule).  Memory: 12 bytes per site and
+frame for positions, as much again for velocities (1000 frames of 216 waters: 7.8 MB).  Boxes must be
+orthorhombic; without a box, positions are taken as continuous and molecules as whole.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ...conservation.analysis import group_masses
+from ...support import require
+
+AnalysisBase = require("MDAnalysis.analysis.base", "analysis", "openmm_symprk.analysis.universe").AnalysisBase
+
+__all__ = ["Waters", "find_waters", "WaterFrames", "ANGSTROM_IN_NM"]
+
+#: 1 Angstrom (MDAnalysis' length unit) in nm.
+ANGSTROM_IN_NM = 0.1
+_MASSLESS = 0.5  # amu: sites lighter than this are virtual sites
+_TIME_TOL = 1e-3  # relative spread of the time steps accepted as uniform
+
+
+class Waters:
+    """The waters of an atom group: ``atoms`` (the AtomGroup of every water site, molecule by molecule),
+    ``molecules`` (n, k) indices into ``atoms`` ordered O, H, H, massless sites; ``masses`` (N,) amu and
+    ``charges`` (N,) e or None, both of ``atoms``."""
+
+    def __init__(self, atoms, molecules, masses, charges):
+        self.atoms, self.molecules, self.masses, self.charges = atoms, molecules, masses, charges
+
+    @property
+    def n_molecules(self) -> int:
+        return len(self.molecules)
+
+
+def _symbol(atom) -> str:
+    element = getattr(atom, "element", "") if hasattr(atom, "element") else ""
+    if element:
+        return str(element).strip().upper()
+    name = str(atom.name).lstrip("0123456789")
+    return name[:1].upper()
+
+
+def find_waters(atomgroup, masses=None) -> Waters:
+    """The waters (:class:`Waters`) among ``atomgroup``'s residues (see the module docstring); ValueError naming
+    what was found when there are none or they are not all of one model.  ``masses``: None (the topology's), an
+    array (one per atom of the group or of the Universe) or an ``openmm.System``."""
+    if not hasattr(atomgroup, "residues"):
+        raise TypeError(f"expected an MDAnalysis AtomGroup or Universe, got {type(atomgroup).__name__}")
+    atomgroup = getattr(atomgroup, "atoms", atomgroup)
+    try:
+        all_masses = group_masses(atomgroup.universe.atoms, masses)
+    except Exception as exc:  # noqa: BLE001 - a topology without masses: say so below
+        if masses is not None:
+            raise
+        raise ValueError(f"the topology has no masses ({exc}); pass masses=") from exc
+    in_group = np.zeros(atomgroup.universe.atoms.n_atoms, dtype=bool)
+    in_group[atomgroup.indices] = True
+    mols, sizes = [], set()
+    for res in atomgroup.residues:
+        idx = [i for i in res.atoms.indices if in_group[i]]
+        massive = [i for i in idx if all_masses[i] > _MASSLESS]
+        symbols = [_symbol(atomgroup.universe.atoms[i]) for i in massive]
+        if len(massive) != 3 or sorted(symbols) != ["H", "H", "O"]:
+            continue
+        o = massive[symbols.index("O")]
+        hs = [i for i in massive if i != o]
+        mols.append([o] + hs + [i for i in idx if i not in massive])
+        sizes.add(len(idx))
+    if not mols:
+        names = sorted(set(atomgroup.residues.resnames))[:8]
+        raise ValueError(f"no water in the selection ({atomgroup.n_atoms} atoms, residues {', '.join(names)}): "
+                         f"these analyses need water residues of one O and two H atoms (plus massless sites)")
+    if len(sizes) != 1:
+        raise ValueError(f"the waters have different numbers of sites {sorted(sizes)}: analyse one water model "
+                         f"at a time (select its residues)")
+    flat = np.asarray(mols, dtype=int)
+    atoms = atomgroup.universe.atoms[flat.ravel()]
+    molecules = np.arange(flat.size).reshape(flat.shape)
+    charges = None
+    if hasattr(atomgroup.universe.atoms, "charges"):
+        q = np.asarray(atoms.charges, dtype=np.float64)
+        charges = q if np.any(q != 0) else None
+    return Waters(atoms, molecules, all_masses[flat.ravel()], charges)
+
+
+class WaterFrames(AnalysisBase):
+    """Base of the water analyses: collects the waters' positions (and, with ``velocities=True``, velocities)
+    at every analysed frame, then :meth:`_analyse` works on them in nm, ps.  ``atomgroup``: a Universe or an
+    AtomGroup holding the waters; ``masses``: see :func:`find_waters`."""
+
+    _needs_velocities = False
+
+    def __init__(self, atomgroup, masses=None, **kwargs):
+        universe = getattr(atomgroup, "universe", atomgroup)
+        super().__init__(universe.trajectory, **kwargs)
+        self.waters = find_waters(atomgroup, masses)
+
+    def _prepare(self):
+        n = self.waters.atoms.n_atoms
+        self._x = np.empty((self.n_frames, n, 3), dtype=np.float32)
+        self._v = np.empty((self.n_frames, n, 3), dtype=np.float32) if self._needs_velocities else None
+        self._box = np.full((self.n_frames, 3), np.nan)
+
+    def _single_frame(self):
+        i, ts = self._frame_index, self._ts
+        self._x[i] = self.waters.atoms.positions
+        if self._v is not None:
+            if not ts.has_velocities:
+                raise ValueError(f"{type(self).__name__} needs velocities and frame {ts.frame} of the trajectory "
+                                 f"has none (DCD, XTC and PDB store positions only: use a TRR, NetCDF or H5MD "
+                                 f"trajectory written with velocities)")
+            self._v[i] = self.waters.atoms.velocities
+        dims = ts.dimensions
+        if dims is not None and np.all(np.asarray(dims[:3]) > 0):
+            if np.any(np.abs(np.asarray(dims[3:]) - 90.0) > 1e-3):
+                raise ValueError(f"frame {ts.frame} has a triclinic box (angles {np.round(dims[3:], 3).tolist()}): "
+                                 f"these analyses need an orthorhombic box")
+            self._box[i] = dims[:3]
+
+    def _conclude(self):
+        x = self._x.astype(np.float64) * ANGSTROM_IN_NM
+        v = None if self._v is None else self._v.astype(np.float64) * ANGSTROM_IN_NM
+        box = None if np.isnan(self._box).any() else self._box * ANGSTROM_IN_NM
+        self._x = self._v = None  # the float64 copies are all that is kept, for the computation only
+        self._analyse(x, v, box)
+
+    def frame_interval_ps(self) -> float:
+        """The time between analysed frames (ps); ValueError unless they are evenly spaced."""
+        t = np.asarray(self.times, dtype=np.float64)
+        if len(t) < 2:
+            raise ValueError(f"{type(self).__name__} needs at least 2 frames, got {len(t)}")
+        steps = np.diff(t)
+        dt = float(np.median(steps))
+        if not dt > 0 or np.abs(steps - dt).max() > _TIME_TOL * dt:
+            raise ValueError(f"the analysed frames are not evenly spaced in time (steps from {steps.min():g} to "
+                             f"{steps.max():g} ps): a time correlation needs a constant interval")
+        return dt
+
+    def _analyse(self, x, v, box):  # pragma: no cover - every analysis defines it
+        raise NotImplementedError

@@ -1,0 +1,347 @@
+"""Where the thermostat sits in the step (thermostat_position): the resolved sub-steps, the programs, and the
+known answers of N independent harmonic oscillators (docs/thermostat.md, "Placement").
+
+Known answer, q'' = -w^2 q with a velocity thermostat, stable h: the ends placement samples
+w^2 <q^2>/kT = 1/(1 - h^2 w^2/4) with Verlet, and on-step <v^2>/kT = 1; the middle placement samples
+w^2 <q^2>/kT = 1 and on-step <v^2>/kT = 1 - h^2 w^2/4, while the velocities at the thermostat point read 1.
+:func:`openmm_symprk.methods.placement.harmonic_sampling` gives the same numbers exactly for any kick/drift
+sequence (omelyan-2's included).  Fixed seeds; every statistical bound is 3 standard errors of the mean of
+20 blocks."""
+import copy
+import pickle
+import warnings
+
+import numpy as np
+import openmm as mm
+import openmm.unit as unit
+import pytest
+
+from openmm_symprk import SymplecticIntegrator, plugin
+from openmm_symprk.integrators import deserialize
+from openmm_symprk.integrators.thermostat import MAX_INTERVAL
+from openmm_symprk.methods import placement
+from openmm_symprk.methods.resolved import SubstepKind, resolve
+from openmm_symprk.physics.temperature import R_KJ
+from openmm_symprk.stats import drift
+from openmm_symprk.systems.prepare import equilibrate, maxwell_boltzmann
+from openmm_symprk.systems.properties import masses
+from openmm_symprk.systems.scenes import water_cluster
+
+REF = "Reference"
+pytestmark = pytest.mark.filterwarnings("ignore::openmm_symprk.systems.checks.ConservationWarning")
+
+
+def _native_middle_reason():
+    if not plugin.available():
+        return f"native backend unavailable: {plugin.unavailable_reason()}"
+    s = mm.System()
+    for _ in range(3):
+        s.addParticle(1.0)
+    try:
+        ig = SymplecticIntegrator(0.001, "verlet", system=s, backend="native", temperature=300,
+                                  thermostat_position="middle")
+        ctx = mm.Context(s, ig, mm.Platform.getPlatformByName(REF))
+        ctx.setPositions(np.eye(3))
+        ig.step(1)
+        ig.thermostat_kinetic_energy()
+    except Exception as exc:  # noqa: BLE001 - any failure means: not there yet
+        return f"the native backend does not run thermostat_position='middle' yet ({type(exc).__name__}: {exc})"
+    return None
+
+
+NATIVE_REASON = _native_middle_reason()
+BACKENDS = ["custom", pytest.param("native", marks=pytest.mark.skipif(NATIVE_REASON is not None,
+                                                                        reason=str(NATIVE_REASON)))]
+
+
+def context(system, ig, x, v, platform=REF):
+    ctx = mm.Context(system, ig, mm.Platform.getPlatformByName(platform))
+    ctx.setPositions(x)
+    ctx.setVelocities(v)
+    return ctx
+
+
+def arrays(ctx):
+    st = ctx.getState(getPositions=True, getVelocities=True)
+    return (np.asarray(st.getPositions(asNumpy=True).value_in_unit(unit.nanometer)),
+            np.asarray(st.getVelocities(asNumpy=True).value_in_unit(unit.nanometer / unit.picosecond)))
+
+
+# -- resolve ------------------------------------------------------------------------------------------------------
+def _seq(r):
+    return [(s.label, float(s.coefficient)) for s in r.substeps]
+
+
+def test_substep_kind_of_the_thermostat_is_2():
+    assert SubstepKind.THERMOSTAT == 2
+
+
+def test_middle_splits_the_central_drift_or_kick():
+    assert _seq(resolve("verlet", thermostat_position="middle")) == [
+        ("kick", 0.5), ("drift", 0.5), ("thermostat", 1.0), ("drift", 0.5), ("kick", 0.5)]
+    om = resolve("omelyan-2", thermostat_position="middle")  # BABAB: the centre is a kick
+    plain = resolve("omelyan-2")
+    centre = float(plain.substeps[2].coefficient)
+    assert _seq(om)[2:5] == [("kick", centre / 2), ("thermostat", 1.0), ("kick", centre / 2)]
+    assert not om.substeps[2].forces_cached and om.substeps[4].forces_cached  # no drift between the halves
+    assert om.force_evals == plain.force_evals and om.splitting == plain.splitting
+    # multiple time stepping: the very middle of the outer step
+    mts = resolve("verlet", groups=[(1, 1), (0, 3)], thermostat_position="middle")
+    seq = _seq(mts)
+    i = seq.index(("thermostat", 1.0))
+    assert seq[:i][::-1] == seq[i + 1:] and seq[i - 1] == ("drift", 1 / 6)
+    # ends: the method's own sub-steps (the backends add the two half events)
+    assert _seq(resolve("verlet", thermostat_position="ends")) == _seq(resolve("verlet"))
+    assert resolve("verlet", thermostat_position="ends").thermostat_position == "ends"
+
+
+def test_auto_follows_the_harmonic_measurement():
+    """"auto" takes the middle where it samples the oscillators' configurations better (verlet), the ends where
+    those are already nearly exact (omelyan-2, pefrl, yoshida-4, blanes-moan) or where there is no centre."""
+    expected = {"verlet": "middle", "omelyan-2": "ends", "pefrl": "ends", "yoshida-4": "ends",
+                "blanes-moan-srkn6b-4": "ends", "ruth3": "ends", "gauss-2": "ends"}
+    for method, where in expected.items():
+        assert resolve(method, thermostat_position="auto").thermostat_position == where, method
+    errors = {m: placement.placement_errors(resolve(m).splitting.steps) for m in ("verlet", "omelyan-2")}
+    assert errors["verlet"]["middle"] < 1e-12 < 0.06 < errors["verlet"]["ends"]
+    assert errors["omelyan-2"]["ends"] < 0.005 < 0.05 < errors["omelyan-2"]["middle"]
+
+
+def test_middle_refused_where_the_step_has_no_centre(cluster_system):
+    with pytest.raises(ValueError, match="does not.*use thermostat_position='ends'"):
+        resolve("ruth3", thermostat_position="middle")  # not symmetric
+    from openmm_symprk.systems.scenes import morse_molecule
+
+    with pytest.raises(ValueError, match="'gauss-2' is a general .* PRK tableau: use thermostat_position='ends'"):
+        SymplecticIntegrator(0.001, "gauss-2", system=morse_molecule().system, temperature=300,
+                             thermostat_position="middle")
+
+
+@pytest.fixture(scope="module")
+def cluster_system():
+    return water_cluster(8).system
+
+
+# -- options -------------------------------------------------------------------------------------------------------
+ALL_BACKENDS = ["custom", pytest.param("native", marks=pytest.mark.skipif(
+    not plugin.available(), reason=f"native backend unavailable: {plugin.unavailable_reason()}"))]
+
+
+@pytest.mark.parametrize("backend", ALL_BACKENDS)
+@pytest.mark.parametrize("options, error, message", [
+    (dict(temperature=300, thermostat_position="centre"), ValueError,
+     "thermostat_position must be one of 'ends', 'middle', 'auto', got 'centre'"),
+    (dict(temperature=300, thermostat_position=1), ValueError, "thermostat_position must be one of .* got 1"),
+    (dict(thermostat_position="middle"), ValueError, "thermostat_position was given without temperature"),
+    (dict(temperature=300, thermostat_interval=10**12), ValueError,
+     f"thermostat_interval must be at most {MAX_INTERVAL}.* got 1000000000000"),
+    (dict(temperature=300, thermostat_interval=2**31), ValueError, f"thermostat_interval must be at most {MAX_INTERVAL}"),
+])
+def test_bad_placement_and_interval_are_clear_errors(backend, cluster_system, options, error, message):
+    with pytest.raises(error, match=message):
+        SymplecticIntegrator(0.001, "verlet", system=cluster_system, backend=backend, **options)
+
+
+def test_largest_interval_is_accepted(cluster_system):
+    ig = SymplecticIntegrator(0.001, "verlet", system=cluster_system, backend="custom", temperature=300,
+                              thermostat_interval=MAX_INTERVAL)
+    assert ig.getThermostatInterval() == MAX_INTERVAL
+
+
+# -- the program ----------------------------------------------------------------------------------------------------
+def _gaussians(ig):
+    return sum("gaussian" in ig.getComputationStep(i)[2] for i in range(ig.getNumComputations()))
+
+
+def test_middle_program_has_one_event_per_step(cluster_system):
+    ends = SymplecticIntegrator(0.002, "verlet", system=cluster_system, backend="custom", temperature=300,
+                                thermostat_position="ends")
+    middle = SymplecticIntegrator(0.002, "verlet", system=cluster_system, backend="custom", temperature=300,
+                                  thermostat_position="middle")
+    assert (_gaussians(ends), _gaussians(middle)) == (4, 2)  # r1 and chi2: two half events against one event
+    assert ends.thermostat_position == "ends" and middle.thermostat_position == "middle"
+    assert "one event at the centre of the step" in middle.describe()
+    assert "half events around the step" in ends.describe()
+    # the event's relaxation: c = exp(-n dt/tau) for the whole event
+    exprs = [middle.getComputationStep(i)[2] for i in range(middle.getNumComputations())]
+    assert any(e.startswith("exp(-1.0*dt/") for e in exprs)
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_interval_fires_in_the_middle_step_of_each_n(backend, cluster_system):
+    """thermostat_interval=3, middle: one event in steps 1, 4, 7 (i mod 3 = (3 - 1)//2); interval 4: steps 1, 5."""
+    scene = water_cluster(8)
+    for n, expected in ((3, [1, 4, 7]), (4, [1, 5])):
+        ig = SymplecticIntegrator(0.002, "verlet", system=scene.system, backend=backend, temperature=400,
+                                  thermostat_interval=n, random_seed=4, thermostat_position="middle")
+        ctx = context(scene.system, ig, scene.positions, scene.velocities)
+        heat = [ig.computeHeatBathEnergy()._value]
+        for _ in range(9):
+            ig.step(1)
+            heat.append(ig.computeHeatBathEnergy()._value)
+        assert [k for k in range(9) if heat[k + 1] != heat[k]] == expected
+        del ctx
+
+
+# -- harmonic oscillators: the known answers ------------------------------------------------------------------------
+N_OSC = 600
+TEMPERATURE = 300.0
+
+
+def oscillators(k: float, seed: int = 1):
+    """N_OSC independent 3-d harmonic oscillators of mass 1 and force constant k, started canonical with the
+    centre of mass at rest at the origin (the thermostat keeps the centre-of-mass velocity, so it stays there and
+    the 3 N - 3 other degrees of freedom are the thermostatted ones)."""
+    system = mm.System()
+    force = mm.CustomExternalForce("0.5*k*(x*x + y*y + z*z)")
+    force.addGlobalParameter("k", k)
+    for i in range(N_OSC):
+        system.addParticle(1.0)
+        force.addParticle(i, [])
+    system.addForce(force)
+    rng = np.random.default_rng(seed)
+    kT = R_KJ * TEMPERATURE
+    x = rng.normal(0.0, np.sqrt(kT / k), (N_OSC, 3))
+    v = rng.normal(0.0, np.sqrt(kT), (N_OSC, 3))
+    return system, x - x.mean(0), v - v.mean(0)
+
+
+def _blocks(series, n=20):
+    a = np.asarray(series)
+    b = a[: len(a) // n * n].reshape(n, -1).mean(1)
+    return b.mean(), b.std(ddof=1) / np.sqrt(n)
+
+
+def sample_oscillators(backend, method, position, h_omega, steps=1600, h=0.002):
+    """(w^2<q^2>/kT, on-step <v^2>/kT, <v^2>/kT at the thermostat point), each (mean, standard error)."""
+    w = h_omega / h
+    k = w * w
+    system, x, v = oscillators(k)
+    ig = SymplecticIntegrator(h, method, system=system, backend=backend, temperature=TEMPERATURE,
+                              collision_time=0.02, random_seed=3, thermostat_position=position)
+    ctx = context(system, ig, x, v)
+    ig.step(100)
+    dof_kT = (3 * N_OSC - 3) * R_KJ * TEMPERATURE
+    q2, v2, event = [], [], []
+    for _ in range(steps):
+        ig.step(1)
+        X, V = arrays(ctx)
+        q2.append(k * np.sum(X ** 2) / dof_kT)
+        v2.append(np.sum(V ** 2) / dof_kT)
+        event.append(2 * ig.thermostat_kinetic_energy().value_in_unit(unit.kilojoule_per_mole) / dof_kT)
+    return _blocks(q2), _blocks(v2), _blocks(event)
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+@pytest.mark.parametrize("h_omega", [0.5, 1.0])
+@pytest.mark.parametrize("position", ["ends", "middle"])
+def test_verlet_oscillators_sample_the_known_answer(backend, position, h_omega):
+    (q, q_se), (v, v_se), (ev, ev_se) = sample_oscillators(backend, "verlet", position, h_omega)
+    shrink = 1 - h_omega ** 2 / 4
+    q_exact, v_exact = (1 / shrink, 1.0) if position == "ends" else (1.0, shrink)
+    assert abs(q - q_exact) < 3 * q_se, (q, q_se, q_exact)
+    assert abs(v - v_exact) < 3 * v_se, (v, v_se, v_exact)
+    assert abs(ev - 1.0) < 3 * ev_se, (ev, ev_se)  # the temperature at the thermostat point is the target
+    # and the two placements are resolved: the ends' configurational error is at least 6 standard errors
+    assert 6 * q_se < 1 / shrink - 1
+
+
+@pytest.mark.parametrize("position", ["ends", "middle"])
+def test_omelyan2_oscillators_match_the_exact_stationary_moments(position):
+    """omelyan-2 at h w = 1: the ends placement nearly exact (0.996), the middle one (inside the central kick)
+    6% hot, as placement.harmonic_sampling computes for the Langevin version of the same event."""
+    (q, q_se), (v, v_se), _ = sample_oscillators("custom", "omelyan-2", position, 1.0)
+    seq = placement.with_thermostat(resolve("omelyan-2").splitting.steps, position)
+    q_exact, v_exact = placement.harmonic_sampling(seq, 1.0)
+    assert abs(q - q_exact) < 3 * q_se, (q, q_se, q_exact)
+    assert abs(v - v_exact) < 3 * v_se, (v, v_se, v_exact)
+
+
+# -- what the placement keeps ---------------------------------------------------------------------------------------
+@pytest.mark.parametrize("backend", BACKENDS)
+@pytest.mark.parametrize("method, options", [("verlet", {}), ("omelyan-2", {"exact_momentum": True}),
+                                             ("pefrl", {"exact_momentum": True})])
+def test_middle_keeps_momentum_and_angular_momentum(backend, method, options):
+    scene = water_cluster(8)
+    system = scene.system
+    ig = SymplecticIntegrator(0.002, method, system=system, backend=backend, temperature=330,
+                              collision_time=0.01, random_seed=2, thermostat_position="middle", **options)
+    ctx = context(system, ig, scene.positions, scene.velocities)
+    m = masses(system)
+    x0, v0 = arrays(ctx)
+    P0, L0 = (m[:, None] * v0).sum(0), (m[:, None] * np.cross(x0, v0)).sum(0)
+    ig.step(300)
+    x, v = arrays(ctx)
+    P, L = (m[:, None] * v).sum(0), (m[:, None] * np.cross(x, v)).sum(0)
+    assert np.linalg.norm(P - P0) < 1e-12 * float(np.sum(m[:, None] * np.abs(v)))
+    assert np.linalg.norm(L - L0) < 1e-11 * np.linalg.norm(L0)
+    assert ig.computeHeatBathEnergy().value_in_unit(unit.kilojoule_per_mole) != 0
+    i, j = np.array([system.getConstraintParameters(k)[:2] for k in range(system.getNumConstraints())]).T
+    r, dv = x[i] - x[j], v[i] - v[j]
+    assert np.max(np.abs(np.sum(r * dv, axis=1)) / (np.linalg.norm(r, axis=1) * np.linalg.norm(dv, axis=1))) < 1e-6
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_middle_effective_energy_drift_equals_the_nve_drift(backend):
+    """27 rigid waters in vacuum equilibrated at 300 K, verlet at 1 fs, six 1-ps replicas each of NVE and of NVT
+    with the thermostat in the middle: the mean slopes of total (+ heat-bath) energy agree within 3 combined
+    standard errors from the replicas' spread."""
+    scene = water_cluster(27, temperature=300.0, angular_velocity=(0.0, 0.0, 0.0))
+    system = scene.system
+    x, _ = equilibrate(system, scene.positions, 300.0, 2.0, seed=7, platform=REF)
+    slopes = {"nve": [], "nvt": []}
+    for replica in range(6):
+        v = maxwell_boltzmann(system, x, 300.0, 200 + replica)
+        for kind, options in (("nve", {}), ("nvt", {"temperature": 300, "random_seed": 60 + replica,
+                                                      "thermostat_position": "middle"})):
+            ig = SymplecticIntegrator(0.001, "verlet", system=system, backend=backend, **options)
+            ctx = context(system, ig, x, v)
+            t, e = [], []
+            for _ in range(50):
+                ig.step(20)
+                st = ctx.getState(getEnergy=True)
+                t.append(st.getTime().value_in_unit(unit.picosecond))
+                e.append((st.getPotentialEnergy() + st.getKineticEnergy() + ig.computeHeatBathEnergy())
+                         .value_in_unit(unit.kilojoule_per_mole))
+            slopes[kind].append(drift(t, e).slope)
+            del ctx
+    nve, nvt = (np.array(slopes[k]) for k in ("nve", "nvt"))
+    se = np.hypot(nve.std(ddof=1), nvt.std(ddof=1)) / np.sqrt(len(nve))
+    assert abs(nvt.mean() - nve.mean()) < 3 * se, (nve, nvt)
+
+
+# -- checkpoints and copies keep the middle placement ------------------------------------------------------------------
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_middle_checkpoint_and_copies_continue_bit_for_bit(backend):
+    scene = water_cluster(8)
+
+    def make():
+        return SymplecticIntegrator(0.002, "verlet", system=scene.system, backend=backend, temperature=350,
+                                    collision_time=0.02, random_seed=12, thermostat_position="middle",
+                                    thermostat_interval=2)
+
+    ig = make()
+    ctx = context(scene.system, ig, scene.positions, scene.velocities)
+    ig.step(31)
+    chk = ctx.createCheckpoint()
+    ig.step(30)
+    x1, v1 = arrays(ctx)
+    heat1 = ig.computeHeatBathEnergy()
+    ctx.loadCheckpoint(chk)
+    ig.step(30)
+    x2, v2 = arrays(ctx)
+    assert (x2.tobytes(), v2.tobytes(), ig.computeHeatBathEnergy()) == (x1.tobytes(), v1.tobytes(), heat1)
+    del ctx
+    fresh = make()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        copies = [deserialize(mm.XmlSerializer.serialize(fresh)), pickle.loads(pickle.dumps(fresh)),
+                  copy.deepcopy(fresh)]
+    runs = []
+    for integrator in (fresh, *copies):
+        assert integrator.thermostat_position == "middle"
+        c = context(scene.system, integrator, scene.positions, scene.velocities)
+        integrator.step(10)
+        runs.append((arrays(c)[1].tobytes(), integrator.computeHeatBathEnergy()))
+        del c
+    assert all(r == runs[0] for r in runs[1:])

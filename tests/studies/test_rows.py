@@ -1,0 +1,139 @@
+"""The studies' one row type: labels read back to the same row, the earlier grammars map onto it, bad labels are
+refused naming the bad part, evaluations come from the resolved method, and each row builds its integrator."""
+import numpy as np
+import openmm as mm
+import openmm.unit as unit
+import pytest
+
+from openmm_symprk.integrators import SymplecticIntegrator
+from openmm_symprk.integrators.options import NATIVE_OPTIONS
+from openmm_symprk.methods.resolved import resolve
+from openmm_symprk.studies.core.rows import Row, split_groups
+
+LABELS = ["verlet 0.5 fs", "omelyan-2 4 fs SVR 1 ps", "langevin 4 fs friction 1/ps HMR 3 Da",
+          "mts-langevin 3/2 fs friction 1/ps", "nose-hoover 2 fs 1/ps", "dpd 2 fs friction 1/ps cutoff 0.9 nm",
+          "omelyan-2/verlet 6/2 fs", "openmm-mts 4/2 fs", "rigid:omelyan-2 4 fs", "openmm-verlet 2 fs",
+          "verlet 2 fs SVR 0.1 ps every 10 middle T 310 K exact-momentum native seed 4", "pefrl 4 fs custom"]
+
+
+@pytest.mark.parametrize("label", LABELS)
+def test_label_round_trips(label):
+    row = Row.parse(label)
+    assert row.label == label
+    assert Row.parse(row.label) == row
+
+
+def test_preset_tables_are_rows():
+    """Every row of the preset tables reads as a Row whose label reads back to it."""
+    from openmm_symprk.studies.bench import presets as bench
+    from openmm_symprk.studies.fidelity.presets import ROWS
+    from openmm_symprk.studies.fidelity.rowspec import to_row
+    from openmm_symprk.studies.nvt.rows import COST_ROWS
+
+    rows = [Row.parse(label) for _, label, _ in COST_ROWS] + [to_row(r) for r in ROWS]
+    for sc in bench.production()["scenes"].values():
+        rows += [Row.parse(name, step_fs=h) for name, h in sc["rows"]]
+    for row in rows:
+        assert Row.parse(row.label) == row
+
+
+@pytest.mark.parametrize("old, step, label", [
+    ("verlet@mts2", 4.0, "verlet 4/2 fs"), ("omelyan-2/verlet@mts1", 4.8, "omelyan-2/verlet 4.8/1 fs"),
+    ("openmm-mts4", 6.0, "openmm-mts 6/4 fs"), ("openmm-langevin", 2.0, "langevin 2 fs friction 1/ps"),
+    ("openmm-nosehoover", 2.0, "nose-hoover 2 fs 1/ps"), ("omelyan-2@4", None, "omelyan-2 4 fs"),
+    ("nosehoover@2", None, "nose-hoover 2 fs 1/ps"), ("yoshida4", 1.0, "yoshida-4 1 fs")])
+def test_earlier_grammars(old, step, label):
+    assert Row.parse(old, step_fs=step).label == label
+
+
+@pytest.mark.parametrize("label, says", [
+    ("verlt 2 fs", "unknown method 'verlt'"), ("verlet", "no step"), ("verlet 2 fs foo", "'foo' not understood"),
+    ("langevin 2 fs SVR 1 ps", "SVR does not apply"), ("verlet 2 fs every 3", "need a thermostat"),
+    ("verlet 0 fs", "positive"), ("openmm-mts 2 fs", "inner steps"), ("openmm-verlet 2 fs native", "backend"),
+    ("verlet 2 fs SVR x ps", "SVR needs a number")])
+def test_bad_labels_are_refused(label, says):
+    with pytest.raises(ValueError, match=says):
+        Row.parse(label)
+
+
+def test_evaluations_come_from_the_resolved_method():
+    for label in ("verlet 2 fs", "yoshida-4 2 fs", "omelyan-2/verlet 6/2 fs", "kahan-li-8 1 fs"):
+        row = Row.parse(label)
+        expect = resolve(row.method, True, groups=split_groups(row.mts) if row.mts else None,
+                         inner_method=row.inner or None).force_evals
+        assert row.evals_per_step(True) == expect
+        assert row.evals_per_ps(True) == pytest.approx(expect / row.h_ps)
+    assert Row.parse("yoshida-4 1 fs").evals_per_step() == 3
+    assert Row.parse("openmm-mts 4/3 fs").evals_per_step() == 4
+    assert Row.parse("langevin 2 fs").evals_per_step() == 1
+
+
+def test_what_a_row_knows():
+    svr, lang, nh, verlet = (Row.parse(t) for t in ("verlet 2 fs SVR 0.1 ps", "langevin 2 fs", "nose-hoover 2 fs",
+                                                     "openmm-verlet 2 fs"))
+    assert (svr.thermostat, svr.ensemble, svr.has_heat_bath, svr.keeps_momentum, svr.leapfrog) == \
+        ("svr", "NVT", True, True, False)
+    assert (lang.thermostat, lang.has_heat_bath, lang.keeps_momentum, lang.leapfrog) == \
+        ("langevin", False, False, True)
+    assert nh.has_heat_bath and not nh.leapfrog and nh.conserves_effective_energy
+    assert verlet.ensemble == "NVE" and verlet.leapfrog and not verlet.has_heat_bath and verlet.conserves_effective_energy
+
+
+def _system(n=4):
+    system = mm.System()
+    force = mm.CustomExternalForce("0.5*k*(x^2+y^2+z^2)")
+    force.addGlobalParameter("k", 100.0)
+    for i in range(n):
+        system.addParticle(2.0)
+        force.addParticle(i, [])
+    system.addForce(force)
+    return system
+
+
+def test_build_openmm_integrators():
+    system = _system()
+    cases = {"openmm-verlet 2 fs": mm.VerletIntegrator, "langevin 2 fs friction 3/ps T 250 K": mm.LangevinMiddleIntegrator,
+             "nose-hoover 1 fs 2/ps": mm.NoseHooverIntegrator, "dpd 2 fs cutoff 0.8 nm": mm.DPDIntegrator}
+    for label, cls in cases.items():
+        ig = Row.parse(label).build(system, seed=5, constraint_tolerance=1e-7)
+        assert isinstance(ig, cls)
+        assert ig.getStepSize().value_in_unit(unit.picosecond) == pytest.approx(Row.parse(label).h_ps)
+        assert ig.getConstraintTolerance() == pytest.approx(1e-7)
+    lang = Row.parse("langevin 2 fs friction 3/ps T 250 K").build(system, seed=5)
+    assert lang.getFriction().value_in_unit(unit.picosecond ** -1) == pytest.approx(3.0)
+    assert lang.getTemperature().value_in_unit(unit.kelvin) == pytest.approx(250.0)
+    assert lang.getRandomNumberSeed() == 5
+
+
+def test_build_ours():
+    system = _system()
+    ig = Row.parse("omelyan-2 4 fs SVR 0.5 ps every 3 T 310 K custom seed 9").build(system)
+    assert isinstance(ig, SymplecticIntegrator) and ig.method_name == "omelyan-2" and ig.backend == "custom"
+    th = ig.options.thermostat
+    assert (th.temperature, th.collision_time, th.interval, th.seed) == (310.0, 0.5, 3, 9)
+    assert Row.parse("verlet 2 fs").build(system).options.thermostat is None
+
+
+def test_thermostat_position_is_passed_only_when_asked():
+    system = _system()
+    if "thermostat_position" not in NATIVE_OPTIONS:
+        with pytest.raises(TypeError, match="thermostat_position"):
+            Row.parse("verlet 2 fs SVR 0.1 ps middle").build(system)
+        pytest.skip("SymplecticIntegrator has no thermostat_position yet")
+    ig = Row.parse("verlet 2 fs SVR 0.1 ps middle custom").build(system)
+    assert ig.options.thermostat.position == "middle"
+    assert Row.parse("verlet 2 fs SVR 0.1 ps custom").build(system).options.thermostat.position == "ends"
+
+
+def test_leapfrog_state_lags_half_a_step():
+    """A leapfrog row starts from v(-h/2) = v - (h/2) F/m; an on-step row from v itself."""
+    system = _system()
+    x = np.array([[0.1, 0.0, 0.0], [0.0, 0.2, 0.0], [0.0, 0.0, -0.1], [0.05, 0.05, 0.0]])
+    v = np.ones((4, 3))
+    for label, lag in (("openmm-verlet 2 fs", True), ("verlet 2 fs", False)):
+        row = Row.parse(label)
+        ctx = mm.Context(system, row.build(system), mm.Platform.getPlatformByName("Reference"))
+        row.set_state(ctx, x, v)
+        got = ctx.getState(getVelocities=True).getVelocities(asNumpy=True).value_in_unit(unit.nanometer / unit.picosecond)
+        expect = v + 0.5 * row.h_ps * 100.0 * x / 2.0 if lag else v
+        np.testing.assert_allclose(got, expect, rtol=1e-12)
