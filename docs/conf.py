@@ -8,6 +8,7 @@ from the docstrings of every module of openmm_symprk (autodoc, with an autosumma
 errors.  There is no network for intersphinx, so names of other packages (numpy, OpenMM, MDAnalysis, the standard
 library) are ignored by ``nitpick_ignore_regex``; names of this package are never ignored.
 """
+import enum
 import importlib
 import inspect
 import os
@@ -124,7 +125,7 @@ def _write_api_pages(app):
                 first = [doc.split("\n\n")[0].replace("\n", " ").strip()]
                 first[0] = _ROLE.sub(lambda m: f"``{m.group(2).lstrip('.')}``", first[0])  # relative to the child
                 _norm_bars(app, "module", child, None, None, first)
-                first = first[0]
+                first = first[0].removesuffix("::").rstrip(":") + ("." if first[0].endswith("::") else "")
                 lines.append(f"* :mod:`{child}`" + (f" -- {first}" if first else ""))
             lines += ["", ".. toctree::", "   :hidden:", ""] + [f"   {c}" for c in children] + [""]
         pages[name] = "\n".join(lines)
@@ -139,9 +140,10 @@ def _write_api_pages(app):
 
 
 def _include_undocumented(app, what, name, obj, skip, options):
-    """Every public class, function and method is listed, with or without a docstring (imported ones are still
-    left to the module that defines them); undocumented data stays out."""
-    if skip and not name.startswith("_") and (inspect.isclass(obj) or inspect.isfunction(obj)):
+    """Every public class, function, method and enumeration member is listed, with or without a docstring
+    (imported ones are still left to the module that defines them); other undocumented data stays out."""
+    if skip and not name.startswith("_") and (inspect.isclass(obj) or inspect.isfunction(obj)
+                                               or (what in ("class", "exception") and isinstance(obj, enum.Enum))):
         return False
     return None
 
@@ -207,6 +209,11 @@ def _resolve_existing(app, env, node, contnode):
         if len(inside) == 1:
             entry = py.objects[inside[0]]
             return make_refnode(app.builder, node["refdoc"], entry.docname, entry.node_id, contnode, inside[0])
+        mod = _import(module)
+        if target.rpartition(".")[2].startswith("_") and inspect.ismodule(mod):
+            for c in vars(mod).values():  # a private member of a class of this module: it exists, undocumented
+                if inspect.isclass(c) and _import(f"{c.__module__}.{c.__qualname__}.{target}") is not _MISSING:
+                    return contnode
     return None
 
 
