@@ -48,6 +48,8 @@ CONFIGS = {
     "nvt-omelyan2-box": ("box", 1.0, "omelyan-2", {"temperature": 300, "random_seed": 7}),
     "nvt-verlet-box-int5": ("box", 1.0, "verlet", {"temperature": 300, "collision_time": 0.5, "thermostat_interval": 5,
                                                    "random_seed": 9}),
+    "nvt-verlet-middle": ("cluster", 1.0, "verlet", {"temperature": 300, "random_seed": 5, "thermostat_interval": 3,
+                                                    "thermostat_position": "middle"}),
     "mts-verlet": ("mts", 2.0, "verlet", {"groups": [(1, 1), (0, 2)]}),
     "mts-omelyan2-nvt": ("mts", 2.0, "omelyan-2", {"groups": [(1, 1), (0, 2)], "inner_method": "verlet",
                                                    "temperature": 300, "random_seed": 3}),
