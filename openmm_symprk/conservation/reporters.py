@@ -17,7 +17,7 @@ the largest relative constraint violation, and the translational and rotational 
 molecules (:mod:`openmm_symprk.physics.temperature`); every figure is computed in float64 from the State
 (:mod:`openmm_symprk.physics`).  At its first report it warns once, with the reason, about
 anything that keeps the system from conserving what is reported (:mod:`openmm_symprk.systems.checks`:
-the System's issues and thermostatting integrators, one :class:`ConservationWarning` per kind).
+the System's issues and thermostatting integrators, one :class:`~openmm_symprk.systems.checks.ConservationWarning` per kind).
 
 :class:`VelocityTRRReporter` writes positions (nm), velocities (nm/ps), step and time to a GROMACS TRR
 file with MDAnalysis' XDR library (no extra dependency); MDAnalysis reads it back with velocities.

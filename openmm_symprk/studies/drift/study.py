@@ -1,6 +1,6 @@
 """The drift study on the studies' skeleton: replica states per scene, one stored run per (row, replica).
 
-``<out>/states/`` holds the scenes and their replica states (:mod:`.scenes`), ``<out>/runs/<key>.json`` + ``.npz``
+``<out>/states/`` holds the scenes and their replica states (:mod:`openmm_symprk.systems.scenes`), ``<out>/runs/<key>.json`` + ``.npz``
 one finished run each.  A run's key hashes everything it depends on (the row, the replica, the run length, the
 sampling, the constraint tolerance, the threads and the key of its replica states), so calling the study again
 reuses every finished run, and a changed setting never reuses a stale one.  ``summary.txt`` and ``results.json``
