@@ -19,7 +19,7 @@ thermostat point (``T at the thermostat``: the velocities just after its last ev
 ``thermostat_position="middle"`` are not the State's on-step ones); every figure is computed in float64 from the State
 (:mod:`openmm_symprk.physics`).  At its first report it warns once, with the reason, about
 anything that keeps the system from conserving what is reported (:mod:`openmm_symprk.systems.checks`:
-the System's issues and thermostatting integrators, one :class:`ConservationWarning` per kind).
+the System's issues and thermostatting integrators, one :class:`~openmm_symprk.systems.checks.ConservationWarning` per kind).
 
 :class:`VelocityTRRReporter` writes positions (nm), velocities (nm/ps), step and time to a GROMACS TRR
 file with MDAnalysis' XDR library (no extra dependency); MDAnalysis reads it back with velocities.
@@ -42,7 +42,7 @@ from ..physics import momenta
 from ..physics.temperature import R_KJ, kinetic_temperatures
 from ..physics.velocity_rescaling import kept_velocities
 from ..support import require
-from ..stats.drift import RunningLine
+from ..stats.slope import RunningLine
 from ..systems.checks import conservation_issues, integrator_issues, warn_conservation, warn_once
 from ..systems.properties import constraint_arrays, constraint_violation, degrees_of_freedom, masses, molecules
 from ..systems.virtual_sites import VirtualSiteVelocities

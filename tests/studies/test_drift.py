@@ -10,7 +10,8 @@ from openmm_symprk.studies.drift import presets
 from openmm_symprk.studies.drift.cli import main
 from openmm_symprk.studies.drift.report import format_summary
 from openmm_symprk.studies.drift.study import run_study
-from openmm_symprk.studies.drift.verdict import (R_KJ, claim_verdict, cost_verdict, magnitude, ratio, row_estimate,
+from openmm_symprk.physics.temperature import R_KJ
+from openmm_symprk.studies.drift.verdict import (claim_verdict, cost_verdict, magnitude, ratio, row_estimate,
                                                  run_drift)
 
 

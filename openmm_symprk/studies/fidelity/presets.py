@@ -1,4 +1,4 @@
-"""Settings and rows of the fidelity study (data only; :mod:`.rows` builds them).
+"""Settings and rows of the fidelity study (data only; :mod:`.simulation.engines` builds them).
 
 A row is a dict: ``kind`` (who integrates), ``step_fs`` and the kind's options:
 
