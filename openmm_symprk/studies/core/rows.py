@@ -205,6 +205,17 @@ class Row:
             return resolve(self.method, constraints, groups=split_groups(self.mts), inner_method=self.inner or None)
         return resolve(self.method, constraints)
 
+    def require_kick_drift(self, where: str):
+        """ValueError unless this package's method of the row is a kick/drift splitting or composition, which is what
+        ``where`` runs (constraints keep RATTLE; the rigid-body engine takes no other); OpenMM's rows pass."""
+        from ...methods.catalogue import get_method
+
+        m = get_method(self.method) if self.is_ours else None
+        if m is not None and not m.is_splitting:
+            raise ValueError(f"row {self.label!r}: {m.name} is a {m.family} method; {where} runs kick/drift splittings "
+                             f"and compositions only, e.g. verlet, omelyan-2, pefrl, yoshida-4 (symprk methods lists "
+                             f"their families)")
+
     def evals_per_step(self, constraints: bool | None = None) -> int:
         """Force (group) evaluations per step: from the resolved method; OpenMM's MTS: 1 + N, otherwise 1."""
         if self.is_ours:
