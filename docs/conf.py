@@ -10,6 +10,7 @@ library) are ignored by ``nitpick_ignore_regex``; names of this package are neve
 """
 import enum
 import importlib
+import logging as std_logging
 import inspect
 import os
 import pkgutil
@@ -23,6 +24,7 @@ from sphinx.util import logging
 from sphinx.util.nodes import make_refnode
 
 _LOG = logging.getLogger("openmm_symprk.docs")
+std_logging.getLogger("MDAnalysis").setLevel(std_logging.ERROR)  # its import-time notes are not the site's warnings
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.dirname(HERE))  # document the checkout, whatever is installed
 
@@ -78,7 +80,6 @@ nitpick_ignore_regex = [
 ]
 
 
-
 def _modules():
     """Every module of the package, packages before their modules, in name order (build outputs left out)."""
     pkg = importlib.import_module(PACKAGE)
@@ -101,9 +102,13 @@ def _defined_here(module):
 _ROLE = re.compile(r":[\w:]+:`(~?)([^`<]+)`")
 
 
+#: Per module: the lines that follow its docstring on its page (its submodules, and a table of what it defines).
+_SUMMARIES = {}
+
+
 def _write_api_pages(app):
-    """One page per module: its docstring, a table of the classes and functions it defines, their docstrings
-    (autodoc), and its submodules.  Written here, not by autosummary's recursive mode, because that one imports
+    """One page per module: its docstring, its submodules, a table of the classes and functions it defines, and
+    their docstrings (autodoc).  Written here, not by autosummary's recursive mode, because that one imports
     ``a.b.c`` as attribute ``c`` of ``a.b``, and in this package a function can share its module's name
     (``openmm_symprk.stats.drift`` is both), which makes it document the function in place of the module."""
     out = os.path.join(app.srcdir, API_DIR)
@@ -114,20 +119,22 @@ def _write_api_pages(app):
         module = importlib.import_module(name)
         title = f"``{name}``"
         lines = [title, "=" * len(title), "", f".. automodule:: {name}", ""]
-        members = _defined_here(module)
-        if members:
-            lines += [".. rubric:: Defined here", "", ".. autosummary::", ""] + [f"   {m}" for m in members] + [""]
+        summary = []
         children = [n for n in names if n.rpartition(".")[0] == name]
         if children:
-            lines += [".. rubric:: Modules", ""]
+            summary += ["", ".. rubric:: Modules", ""]
             for child in children:
                 doc = inspect.getdoc(importlib.import_module(child)) or ""
                 first = [doc.split("\n\n")[0].replace("\n", " ").strip()]
                 first[0] = _ROLE.sub(lambda m: f"``{m.group(2).lstrip('.')}``", first[0])  # relative to the child
                 _norm_bars(app, "module", child, None, None, first)
                 first = first[0].removesuffix("::").rstrip(":") + ("." if first[0].endswith("::") else "")
-                lines.append(f"* :mod:`{child}`" + (f" -- {first}" if first else ""))
-            lines += ["", ".. toctree::", "   :hidden:", ""] + [f"   {c}" for c in children] + [""]
+                summary.append(f"* :mod:`{child}`" + (f" -- {first}" if first else ""))
+            lines += [".. toctree::", "   :hidden:", ""] + [f"   {c}" for c in children] + [""]
+        members = _defined_here(module)
+        if members:
+            summary += ["", ".. rubric:: Defined here", "", ".. autosummary::", ""] + [f"   {m}" for m in members]
+        _SUMMARIES[name] = summary + [""]
         pages[name] = "\n".join(lines)
     for name, text in pages.items():
         path = os.path.join(out, name + ".rst")
@@ -137,6 +144,13 @@ def _write_api_pages(app):
                 fh.write(text)
     for stale in set(os.listdir(out)) - {n + ".rst" for n in pages}:
         os.remove(os.path.join(out, stale))
+
+
+def _module_summary(app, what, name, obj, options, lines):
+    """A module's submodules and the table of what it defines, right after its docstring (before autodoc's
+    entries of its members)."""
+    if what == "module" and name in _SUMMARIES:
+        lines.extend(_SUMMARIES[name])
 
 
 def _include_undocumented(app, what, name, obj, skip, options):
@@ -292,6 +306,7 @@ def setup(app):
     app.connect("missing-reference", _resolve_existing)
     app.connect("autodoc-process-docstring", _numpy_sections)
     app.connect("autodoc-process-docstring", _norm_bars)
+    app.connect("autodoc-process-docstring", _module_summary)
 
 
 # -- output ------------------------------------------------------------------------------------------------

@@ -7,7 +7,6 @@ effective energy.
 """
 from __future__ import annotations
 
-from ...methods.catalogue import get_method
 from ..core.rows import Row
 
 __all__ = ["KINDS", "UNAVAILABLE_THERMOSTAT", "check_row", "describe", "label", "to_row"]
@@ -37,14 +36,9 @@ def check_row(row: dict) -> dict:
     for k, v in row.items():
         if k not in ("kind", "method") and (isinstance(v, bool) or not float(v) > 0):
             raise ValueError(f"row {row!r}: {k} must be a positive number, got {v!r}")
-    if kind == "symprk":
-        m = get_method(row["method"])
-        if not m.is_splitting:
-            raise ValueError(f"row {row!r}: {m.name} is a {m.family} method; rigid water runs kick/drift splittings "
-                             f"and compositions only (e.g. verlet, omelyan-2, pefrl)")
     if "inner_steps" in row and int(row["inner_steps"]) != row["inner_steps"]:
         raise ValueError(f"row {row!r}: inner_steps must be a whole number")
-    to_row(row)  # what the row type refuses
+    to_row(row).require_kick_drift("rigid water")  # and what the row type refuses
     return dict(row, step_fs=float(row["step_fs"]))
 
 
