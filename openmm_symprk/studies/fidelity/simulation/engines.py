@@ -22,7 +22,7 @@ class RowUnavailable(RuntimeError):
     """This installation cannot run the row (e.g. the integrator does not accept ``temperature=``)."""
 
 
-def make_integrator(row: dict, system: mm.System, temperature: float, seed: int):
+def make_integrator(row, system: mm.System, temperature: float, seed: int):
     """An OpenMM integrator for ``row`` on ``system`` (already :meth:`~..core.rows.Row.system_for` the row);
     RowUnavailable when this installation lacks an option the row needs (an unknown option of the integrator)."""
     try:
@@ -33,11 +33,13 @@ def make_integrator(row: dict, system: mm.System, temperature: float, seed: int)
         raise RowUnavailable(f"{UNAVAILABLE_THERMOSTAT} ({exc})") from None
 
 
-def availability(row: dict, scene, temperature: float) -> str | None:
+def availability(row, scene, temperature: float) -> str | None:
     """None when this installation runs ``row`` on ``scene``; else why not (e.g. UNAVAILABLE_THERMOSTAT ...)."""
-    if to_row(row).thermostat == "svr":
+    r = to_row(row)
+    if r.thermostat == "svr":
+        system = r.system_for(scene.system, scene.topology) if r.mts or r.hmr_da is not None else scene.system
         try:
-            make_integrator(row, scene.system, temperature, 1)
+            make_integrator(row, system, temperature, 1)
         except RowUnavailable as exc:
             return str(exc)
     return None
@@ -48,17 +50,18 @@ class Engine:
     ``masses``: the row's masses (HMR changes them; the velocities are carried over by
     :func:`~openmm_symprk.systems.repartition.rigid_velocities_for_masses`)."""
 
-    def __init__(self, scene, x, v, row: dict, temperature: float, seed: int, threads: int = 1):
-        self.row, self.info = row, describe(row)
-        self.system = to_row(row).system_for(scene.system, scene.topology)
+    def __init__(self, scene, x, v, row, temperature: float, seed: int, threads: int = 1):
+        self.row, self.info = to_row(row, temperature), describe(row)
+        self.system = self.row.system_for(scene.system, scene.topology)
         self.masses = masses(self.system)
-        if "hmr_da" in row:
+        if self.row.hmr_da is not None:
             v = rigid_velocities_for_masses(x, v, scene.masses(), self.masses, scene.molecules)
         self.integrator = make_integrator(row, self.system, temperature, seed)
         self.context = mm.Context(self.system, self.integrator, mm.Platform.getPlatformByName("CPU"),
                                   {"Threads": str(threads)})
-        self.context.setPositions(x)
-        self.context.setVelocities(v)
+        # a leapfrog integrator (OpenMM's Verlet, LangevinMiddle, DPD) starts from v(-h/2): the positions of
+        # velocity Verlet from the replica state (x, v), so NVE rows of OpenMM keep the replica's energy
+        self.row.set_state(self.context, x, v)
 
     def step(self, n: int):
         self.integrator.step(int(n))
