@@ -1,4 +1,4 @@
-"""Settings and rows of the fidelity study (data only).
+"""Settings and rows of the fidelity study (data only; :mod:`.simulation.engines` builds them).
 
 A row is one label of the studies' row type (:class:`openmm_symprk.studies.core.rows.Row`; the grammar is in
 that module's docstring), e.g. ``"verlet 2 fs"``, ``"omelyan-2 4 fs SVR 0.1 ps"`` (the package's stochastic velocity

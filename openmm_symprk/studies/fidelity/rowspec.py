@@ -32,13 +32,7 @@ def check_row(row) -> str:
     if r.is_rigid:
         raise ValueError(f"row {row!r}: the fidelity study runs OpenMM integrators on a constrained System, not "
                          f"rigid-body engines")
-    if r.is_ours:
-        from ...methods.catalogue import get_method
-
-        m = get_method(r.method)
-        if not m.is_splitting:
-            raise ValueError(f"row {row!r}: {m.name} is a {m.family} method; rigid water runs kick/drift splittings "
-                             f"and compositions only (e.g. verlet, omelyan-2, pefrl)")
+    r.require_kick_drift("rigid water")
     return r.label
 
 

@@ -6,7 +6,7 @@ then samples every ``sample_fs`` for ``length_ps``: the kinetic temperatures (:m
 3 N - 3 translational degrees of freedom when the row keeps the total momentum), potential and effective energy
 (total + heat bath), the molecules' centres of mass, dipole and H-H unit vectors, and every ``rdf_every``-th
 frame's oxygen positions.  Frames are reduced in the worker; what is kept is each observable with its error
-(:mod:`..observe`), the time series of the equipartition study (t, T_trans, T_rot, pe, etot) and the curves.
+(:mod:`openmm_symprk.analysis.observe`), the time series of the equipartition study (t, T_trans, T_rot, pe, etot) and the curves.
 """
 from __future__ import annotations
 
