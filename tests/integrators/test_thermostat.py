@@ -194,7 +194,7 @@ def test_accessors_and_their_errors(backend, cluster):
 # -- the event is physics.velocity_rescaling's, bit for bit (CustomIntegrator program) ---------------------------
 def test_custom_event_computes_rescaling_factor_exactly(cluster):
     ig = SymplecticIntegrator(0.002, "verlet", system=cluster.system, backend="custom", temperature=300,
-                              random_seed=3)
+                              random_seed=3, thermostat_position="ends")
     ctx = context(cluster.system, ig, cluster.positions, cluster.velocities)
     m = masses(cluster.system)
     settings = ig.thermostat
@@ -281,7 +281,9 @@ def _add_other(ig, kind, var, expr):
                                              ("yoshida-4", {"groups": [(0, 2)]})])
 def test_thermostat_off_is_the_nve_program_bit_for_bit(cluster, method, options):
     nve = SymplecticIntegrator(0.002, method, system=cluster.system, backend="custom", **options)
-    nvt = SymplecticIntegrator(0.002, method, system=cluster.system, backend="custom", temperature=300, **options)
+    # the ends placement adds its events around the unchanged NVE step (the middle one splits the central drift)
+    nvt = SymplecticIntegrator(0.002, method, system=cluster.system, backend="custom", temperature=300,
+                               thermostat_position="ends", **options)
     xml = mm.XmlSerializer.serialize(nve)
     assert tp.PREFIX not in xml and "gaussian" not in xml and nve.thermostat is None
     # the thermostat only adds its own computations (two half events) and variables to the NVE program
