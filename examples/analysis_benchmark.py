@@ -38,7 +38,8 @@ parser.add_argument("--quick", action="store_true", help="64 waters, 100 frames 
 parser.add_argument("--waters", type=int, default=None, help="default 216 (64 with --quick)")
 parser.add_argument("--frames", type=int, default=None, help="default 1000 (100 with --quick)")
 parser.add_argument("--lags", type=int, default=None, help="waterdynamics' dtmax, frames (default 10; 2 with --quick)")
-parser.add_argument("--repeat", type=int, default=None, help="timed runs of each, best kept (default 3; 1 with --quick)")
+parser.add_argument("--repeat", type=int, default=None,
+                    help="timed runs of each, best kept (default 3; 1 with --quick)")
 parser.add_argument("--out", default=None, help="folder for the trajectory (default: a temporary folder)")
 args = parser.parse_args()
 n_waters = args.waters or (64 if args.quick else 216)
@@ -51,7 +52,6 @@ import openmm as mm  # noqa: E402
 import openmm.app as app  # noqa: E402
 import openmm.unit as unit  # noqa: E402
 from MDAnalysis.analysis.msd import EinsteinMSD  # noqa: E402
-from MDAnalysis.analysis.rdf import InterRDF  # noqa: E402
 from MDAnalysis.coordinates.memory import MemoryReader  # noqa: E402
 from MDAnalysis.transformations.nojump import NoJump  # noqa: E402
 from waterdynamics import WaterOrientationalRelaxation  # noqa: E402
@@ -163,30 +163,35 @@ os.makedirs(folder, exist_ok=True)
 pdb, dcd = write_trajectory(folder)
 u = universe(pdb, dcd)
 print(f"{u.residues.n_residues} waters, {u.trajectory.n_frames} frames every {u.trajectory.dt:g} ps "
-      f"({dcd}); best of {repeat}, peak memory by tracemalloc")
-rows = []
+      f"({dcd}); best of {repeat}, peak memory by tracemalloc", flush=True)
+HEADER = (f"{'analysis':38s} {'peer':50s} {'ours s':>8s} {'MiB':>7s} {'peer s':>8s} {'MiB':>7s} "
+          f"{'speed':>7s} {'memory':>7s}")
+print("\n" + HEADER, flush=True)
+
+
+def row(what, peer, ot, om, pt, pm, note):
+    """One line of the table, printed as soon as it is measured."""
+    print(f"{what:38s} {peer:50s} {ot:8.3f} {om:7.1f} {pt:8.3f} {pm:7.1f} {pt / ot:6.1f}x {pm / om:6.2f}x  {note}",
+          flush=True)
+
+
 same = lambda: u  # noqa: E731 - every analysis reads the same in-memory Universe
 ours_t, ours_m, res = measure(ours_reorientation, same)
 peer_t, peer_m, ref = measure(waterdynamics_reorientation, same)
 agree = np.abs(res.C["HH"]["C2"][1:lags + 1] - np.array([r[1] for r in ref])).max()
-rows.append(("reorientation C2 (dipole, H-H, O-H)", "waterdynamics WaterOrientationalRelaxation", ours_t, ours_m,
-             peer_t, peer_m, f"|dC2(H-H)| <= {agree:.3f}"))
+row("reorientation C2 (dipole, H-H, O-H)", "waterdynamics WaterOrientationalRelaxation", ours_t, ours_m, peer_t,
+    peer_m, f"|dC2(H-H)| <= {agree:.3f}")
 ours_t, ours_m, res = measure(ours_diffusion, same)
 peer_t, peer_m, ref = measure(einstein_msd_nojump, u.copy)
-rows.append(("diffusion (COM MSD, fit, error)", "EinsteinMSD on O + NoJump (per atom)", ours_t, ours_m, peer_t,
-             peer_m, f"D = {res.D:.2f} ± {res.se:.2f}"))
+row("diffusion (COM MSD, fit, error)", "EinsteinMSD on O + NoJump (per atom)", ours_t, ours_m, peer_t, peer_m,
+    f"D = {res.D:.2f} ± {res.se:.2f}")
 peer_t, peer_m, ref = measure(einstein_msd_com, same)
 ours_nodrift = SelfDiffusion(u, drift=False).run().results.msd
 gap = np.abs(ref[:len(ours_nodrift)] / 100.0 - ours_nodrift).max()
-rows.append(("", "center_of_mass per frame + NoJump + EinsteinMSD", ours_t, ours_m, peer_t, peer_m,
-             f"|dMSD| <= {gap:.1e} nm2 (drift left in)"))
+row("", "center_of_mass per frame + NoJump + EinsteinMSD", ours_t, ours_m, peer_t, peer_m,
+    f"|dMSD| <= {gap:.1e} nm2 (drift left in)")
 ours_t, ours_m, res = measure(ours_rdf, same)
 peer_t, peer_m, ref = measure(numpy_rdf, same)
-rows.append(("g(r) O-O: InterRDF (used)", "numpy all-pairs histogram", ours_t, ours_m, peer_t, peer_m,
-             f"peak {res.peak.r:.3f} nm" if res.peak is not None else "-"))
-
-print(f"\n{'analysis':38s} {'peer':50s} {'ours s':>8s} {'MiB':>7s} {'peer s':>8s} {'MiB':>7s} "
-      f"{'speed':>7s} {'memory':>7s}")
-for what, peer, ot, om, pt, pm, note in rows:
-    print(f"{what:38s} {peer:50s} {ot:8.3f} {om:7.1f} {pt:8.3f} {pm:7.1f} {pt / ot:6.1f}x {pm / om:6.2f}x  {note}")
+row("g(r) O-O: InterRDF (used)", "numpy all-pairs histogram", ours_t, ours_m, peer_t, peer_m,
+    f"peak {res.peak.r:.3f} nm" if res.peak is not None else "-")
 print("\nspeed: the peer's time / ours (above 1: ours is faster); memory: the peer's peak / ours")
