@@ -271,6 +271,8 @@ EXTRAS = {
     "studies": ["matplotlib>=3.7", "tqdm>=4.60", "pymbar>=4", "scipy>=1.10", "MDAnalysis>=2.7"],
     "cluster": ["dask[distributed]>=2023.1"],
     "cuda12": ["openmm-cuda-12>=8.6,<8.7"],
+    # the documentation site (docs/conf.py subclasses Sphinx's Python domain: Sphinx's major version is pinned)
+    "docs": ["sphinx>=8,<10", "myst-parser>=4", "furo>=2024.1"],
 }
 EXTRAS["all"] = sorted(set(EXTRAS["analysis"] + EXTRAS["studies"]))
 #: The test-suite cross-checks the analyses against MDAnalysis' test files and the MDAKits that compute the same.

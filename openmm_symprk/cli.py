@@ -9,7 +9,7 @@ from __future__ import annotations
 import argparse
 import sys
 
-from .studies.core.cli import positive
+from .studies.core.cli import positive, run_command
 
 
 class CommandError(Exception):
@@ -162,22 +162,10 @@ DELEGATED_HELP = {"bench": "work-precision and stability sweeps (symprk bench --
                   "fidelity": "rigid water: diffusion, reorientation, omega ACF, g(r), energies per integrator, step and "
                               "thermostat (symprk fidelity --help)",
                   "nvt": "thermostat: cost vs LangevinMiddleIntegrator, effective-energy drift (symprk nvt --help)",
-                  "drift": "NVE energy drift over replicas, paired rows, verdict at 3 SE: hmr, exact-momentum "
+                  "drift": "energy drift over replicas, paired rows, verdict at 3 SE: hmr, exact-momentum, nvt "
                            "(symprk drift --help)",
                   "observe": "water observables of any trajectory (diffusion, reorientation, omega ACF, T_trans/T_rot, "
                              "g(r)) with errors (symprk observe --help)"}
-
-
-def _user_errors():
-    """The exception types that mean "the input was wrong" rather than "the package has a bug"."""
-    import openmm as mm
-
-    from .integrators import SimulationBlowUpError
-    from .methods import TableauError, UnknownMethodError
-    from .support import MissingDependencyError
-
-    return (CommandError, UnknownMethodError, TableauError, SimulationBlowUpError, mm.OpenMMException, ValueError,
-            TypeError, OSError, MissingDependencyError)
 
 
 def main(argv=None):
@@ -193,17 +181,7 @@ def main(argv=None):
             print(f"symprk {argv[0]}: error: {exc}", file=sys.stderr)
             return 2
     args = build_parser().parse_args(argv)
-    try:
-        rc = args.func(args)
-    except KeyboardInterrupt:
-        print("symprk: interrupted", file=sys.stderr)
-        return 130
-    except Exception as exc:  # one line for what the user can fix, a traceback for a bug
-        if isinstance(exc, _user_errors()):
-            print(f"symprk {args.command}: error: {exc}", file=sys.stderr)
-            return 2
-        raise
-    return rc or 0
+    return run_command(f"symprk {args.command}", lambda: args.func(args), (CommandError,))
 
 
 if __name__ == "__main__":

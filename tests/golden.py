@@ -48,10 +48,18 @@ CONFIGS = {
     "nvt-omelyan2-box": ("box", 1.0, "omelyan-2", {"temperature": 300, "random_seed": 7}),
     "nvt-verlet-box-int5": ("box", 1.0, "verlet", {"temperature": 300, "collision_time": 0.5, "thermostat_interval": 5,
                                                    "random_seed": 9}),
+    "nvt-verlet-middle": ("cluster", 1.0, "verlet", {"temperature": 300, "random_seed": 5, "thermostat_interval": 3,
+                                                    "thermostat_position": "middle"}),
     "mts-verlet": ("mts", 2.0, "verlet", {"groups": [(1, 1), (0, 2)]}),
     "mts-omelyan2-nvt": ("mts", 2.0, "omelyan-2", {"groups": [(1, 1), (0, 2)], "inner_method": "verlet",
                                                    "temperature": 300, "random_seed": 3}),
     "custom-gauss2": ("flexible", 1.0, "gauss-2", {"backends": ("custom",)}),
+    # the thermostat in the middle of the step (native: once the plugin runs the THERMOSTAT sub-step)
+    "nvt-verlet-cluster-middle": ("cluster", 1.0, "verlet", {"temperature": 300, "random_seed": 5,
+                                                             "thermostat_position": "middle", "backends": ("custom",)}),
+    "nvt-omelyan2-box-middle-int3": ("box", 1.0, "omelyan-2", {"temperature": 300, "random_seed": 7,
+                                                               "thermostat_position": "middle", "thermostat_interval": 3,
+                                                               "backends": ("custom",)}),
 }
 
 
@@ -88,8 +96,17 @@ def compute(names=None) -> dict:
 
 
 if __name__ == "__main__":
+    # python tests/golden.py            rewrites every entry
+    # python tests/golden.py NAME ...   rewrites the entries of those configurations only
     sys.path.insert(0, os.path.join(os.path.dirname(__file__), ".."))
-    result = compute()
+    names = sys.argv[1:]
+    unknown = [n for n in names if n not in CONFIGS]
+    if unknown:
+        sys.exit(f"unknown configuration(s) {', '.join(unknown)}; known: {', '.join(CONFIGS)}")
+    result = compute(names or None)
+    if names:
+        with open(DATA) as fh:
+            result = {**json.load(fh), **result}
     with open(DATA, "w") as fh:
         json.dump(result, fh, indent=1, sort_keys=True)
         fh.write("\n")

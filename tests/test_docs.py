@@ -2,9 +2,11 @@
 
 A document's blocks run in order in one namespace, in a scratch folder, like a script that copies them
 one after the other; a block preceded by ``<!-- docs-test: skip (reason) -->`` is left out (none is today).
-The examples run in a subprocess with ``--quick``.
+The examples run in a subprocess with ``--quick``.  The documentation site (docs/conf.py) builds with warnings as
+errors and every cross-reference checked, where Sphinx is installed (the ``docs`` extra; .ci/run builds it too).
 """
 import glob
+import importlib.util
 import os
 import re
 import subprocess
@@ -54,3 +56,38 @@ def test_examples_run(script, tmp_path):
     res = subprocess.run([sys.executable, script, "--quick"], capture_output=True, text=True, cwd=tmp_path,
                          timeout=600)
     assert res.returncode == 0, res.stdout[-2000:] + res.stderr[-3000:]
+
+
+@pytest.mark.skipif(importlib.util.find_spec("sphinx") is None or importlib.util.find_spec("myst_parser") is None,
+                    reason="the documentation site needs the docs extra: pip install -e '.[docs]'")
+def test_the_site_builds_without_warnings_and_every_reference_resolves(tmp_path):
+    """sphinx-build -W -n: a docstring or page that points at a name or page that does not exist fails here."""
+    res = subprocess.run([sys.executable, "-m", "sphinx", "-W", "-n", "-E", "-q", "-b", "html",
+                          "-d", str(tmp_path / "doctrees"), os.path.join(REPO, "docs"), str(tmp_path / "html")],
+                         capture_output=True, text=True, cwd=REPO, timeout=900)
+    assert res.returncode == 0, res.stdout[-3000:] + res.stderr[-5000:]
+    html = tmp_path / "html"
+    pages = {p.stem for p in (html / "_api").glob("*.html")}
+    # every module of the package has its page, and the re-exported entry point is documented where it is defined
+    assert {"openmm_symprk", "openmm_symprk.integrators.symplectic", "openmm_symprk.studies.demo"} <= pages
+    assert 'id="openmm_symprk.integrators.symplectic.SymplecticIntegrator"' in \
+        (html / "_api" / "openmm_symprk.integrators.symplectic.html").read_text(encoding="utf-8")
+    for page in ("index", "theory", "thermostat", "api"):
+        assert (html / f"{page}.html").exists(), page
+
+
+@pytest.mark.skipif(importlib.util.find_spec("sphinx") is None, reason="docs/conf.py needs Sphinx (the docs extra)")
+def test_the_site_ignores_only_names_of_other_packages():
+    """nitpick_ignore_regex lets references to numpy, OpenMM, ... through unchecked (no intersphinx offline), never
+    one to a name of this package."""
+    spec = importlib.util.spec_from_file_location("docs_conf", os.path.join(REPO, "docs", "conf.py"))
+    conf = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(conf)
+
+    def ignored(target):
+        return any(re.fullmatch(t, "py:class") and re.fullmatch(n, target) for t, n in conf.nitpick_ignore_regex)
+
+    assert ignored("numpy.ndarray") and ignored("openmm.System") and ignored("mm.Context") and ignored("float")
+    for name in ("openmm_symprk.NoSuchIntegrator", "openmm_symprk.integrators.base.IntegratorBase",
+                 "SymplecticIntegrator", ".options.IntegratorOptions", "openmm_symprkx"):
+        assert not ignored(name), name

@@ -13,11 +13,13 @@ momentum that is being reported.
 total energy (plus the heat-bath energy for an integrator of this package run with ``temperature=``: the
 conserved effective energy of NVT, and the column says so), its drift (slope of a least-squares line through all reports so far, in kJ/mol per ns
 per degree of freedom; :class:`openmm_symprk.stats.RunningLine`, constant work per report), |P - P0|, |L - L0|/|L0| (L about the centre of mass, or about the origin),
-the largest relative constraint violation, and the translational and rotational kinetic temperatures of the
-molecules (:mod:`openmm_symprk.physics.temperature`); every figure is computed in float64 from the State
+the largest relative constraint violation, the translational and rotational kinetic temperatures of the
+molecules (:mod:`openmm_symprk.physics.temperature`), and with the package's thermostat the temperature at the
+thermostat point (``T at the thermostat``: the velocities just after its last event, which with
+``thermostat_position="middle"`` are not the State's on-step ones); every figure is computed in float64 from the State
 (:mod:`openmm_symprk.physics`).  At its first report it warns once, with the reason, about
 anything that keeps the system from conserving what is reported (:mod:`openmm_symprk.systems.checks`:
-the System's issues and thermostatting integrators, one :class:`ConservationWarning` per kind).
+the System's issues and thermostatting integrators, one :class:`~openmm_symprk.systems.checks.ConservationWarning` per kind).
 
 :class:`VelocityTRRReporter` writes positions (nm), velocities (nm/ps), step and time to a GROMACS TRR
 file with MDAnalysis' XDR library (no extra dependency); MDAnalysis reads it back with velocities.
@@ -37,9 +39,10 @@ import openmm.app as app
 import openmm.unit as unit
 
 from ..physics import momenta
-from ..physics.temperature import kinetic_temperatures
+from ..physics.temperature import R_KJ, kinetic_temperatures
+from ..physics.velocity_rescaling import kept_velocities
 from ..support import require
-from ..stats.drift import RunningLine
+from ..stats.slope import RunningLine
 from ..systems.checks import conservation_issues, integrator_issues, warn_conservation, warn_once
 from ..systems.properties import constraint_arrays, constraint_violation, degrees_of_freedom, masses, molecules
 from ..systems.virtual_sites import VirtualSiteVelocities
@@ -132,10 +135,13 @@ class ConservationReporter:
                "dL_rel": float(np.linalg.norm(L - self._L0) / nL0) if nL0 > 0 else float("nan"),
                "constraint_error": constraint_violation(x, self._constraints),
                "T_trans": temps.translational, "T_rot": temps.rotational}
-        self.records.append(rec)
         vals = [str(step), f"{t:.6g}", f"{total:.10g}", f"{drift:.4g}", f"{rec['dP']:.4g}",
                 f"{rec['dL_rel']:.4g}", f"{rec['constraint_error']:.4g}", f"{rec['T_trans']:.5g}",
                 f"{rec['T_rot']:.5g}"]
+        if self._thermostat is not None:
+            rec["T_thermostat"] = self._thermostat_temperature(simulation.integrator, x, v, m)
+            vals.append(f"{rec['T_thermostat']:.5g}")
+        self.records.append(rec)
         print(self._sep.join(vals), file=self._out)
         try:
             self._out.flush()
@@ -143,6 +149,17 @@ class ConservationReporter:
             pass
 
     # -- helpers ----------------------------------------------------------------------------------
+    def _thermostat_temperature(self, integrator, x, v, m) -> float:
+        """The temperature of the velocities at the thermostat point, just after its last event: 2 K_pec/(N_f k),
+        the kept part (centre-of-mass motion, and rigid rotation of an isolated System; unchanged by events and
+        conserved between them) taken from the State.  With the thermostat in the middle of the step the State's
+        on-step velocities read lower for stiff modes (T (1 - h^2 w^2/4)); this is the temperature sampled."""
+        settings = self._thermostat
+        event = float(integrator.thermostat_kinetic_energy().value_in_unit(_KJ))
+        u = kept_velocities(x, v, m, settings.keep_rotation)
+        kept = momenta.kinetic_energy(u, m)
+        return 2.0 * (event - kept) / (settings.dof * R_KJ)
+
     @staticmethod
     def _heat_bath(simulation) -> float:
         """The heat-bath energy (kJ/mol) of an integrator of this package run with ``temperature=``, else 0."""
@@ -164,10 +181,14 @@ class ConservationReporter:
             warn_conservation(self._system, context="ConservationReporter")
             for key, msg in integrator_issues(simulation.integrator):
                 warn_once(key, f"ConservationReporter: {msg}")
+        self._thermostat = getattr(simulation.integrator, "thermostat", None)
+        if self._thermostat is not None and not hasattr(simulation.integrator, "thermostat_kinetic_energy"):
+            self._thermostat = None
         if not self._append:
             columns = list(self.COLUMNS)
-            if getattr(simulation.integrator, "thermostat", None) is not None:
+            if self._thermostat is not None:
                 columns[2] = "Total + heat-bath energy (kJ/mol)"
+                columns.append("T at the thermostat (K)")
             print("#" + self._sep.join(f'"{c}"' for c in columns), file=self._out)
         self._initialised = True
 

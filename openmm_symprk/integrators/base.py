@@ -32,6 +32,7 @@ from __future__ import annotations
 
 import math
 import operator
+import warnings
 
 import openmm as mm
 import openmm.unit as unit
@@ -113,7 +114,32 @@ class IntegratorBase:
                 self._clear_blowup()
                 raise self._blow_up(bad, self._blowup_what())
         self._after_step()
+        self._check_skipped_events()
         return result
+
+    def _check_skipped_events(self):
+        """Warn once per integrator where thermostat events found no peculiar kinetic energy to scale."""
+        if self.thermostat is None or self.__dict__.get("_warned_no_peculiar"):
+            return
+        n = self._skipped_thermostat_events()
+        if n and self._still():  # (a 1-dof vibration passes through K_pec ~ 0 at its turning points, then goes on)
+            self._warned_no_peculiar = True
+            kept = "translation and rotation" if self.thermostat.keep_rotation else "translation"
+            warnings.warn(
+                f"{type(self).__name__}({self.method_name}): {n} thermostat event(s) found no peculiar kinetic energy "
+                f"to scale: the velocities are all zero, or one rigid motion (centre-of-mass {kept}), which the "
+                f"thermostat keeps, so it cannot bring the system to {self.thermostat.temperature:g} K (velocity "
+                f"rescaling scales the motion it finds and makes none). Start the run with velocities drawn at the "
+                f"temperature, e.g. context.setVelocitiesToTemperature({self.thermostat.temperature:g}*unit.kelvin).",
+                RuntimeWarning, stacklevel=3)
+
+    def _still(self) -> bool:
+        """The last thermostat event found no peculiar kinetic energy (a backend that counts skipped events)."""
+        return True
+
+    def _skipped_thermostat_events(self) -> int:
+        """Thermostat events that did nothing for want of peculiar kinetic energy (a backend that counts them)."""
+        return 0
 
     def _before_step(self):
         """Checks before stepping (a backend's Context checks)."""

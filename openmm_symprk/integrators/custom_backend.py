@@ -21,6 +21,7 @@ from dataclasses import replace
 import openmm as mm
 import openmm.unit as unit
 
+from ..physics.velocity_rescaling import no_peculiar_motion
 from ..systems.checks import warn_once
 from ..systems.properties import masses
 from . import program, thermostat_program
@@ -130,6 +131,7 @@ class PRKIntegrator(IntegratorBase, mm.CustomIntegrator):
         self._checked_probe = False
         self._nonconverged_seen = 0
         self._step_count = None  # the Context's step count after the last call (thermostat, exact_momentum)
+        self._warned_no_peculiar = False
 
     def _before_step(self):
         if not self._checked_context:
@@ -229,6 +231,13 @@ class PRKIntegrator(IntegratorBase, mm.CustomIntegrator):
 
     def _heat_bath_energy(self) -> float:
         return self.getGlobalVariableByName(thermostat_program.HEAT_BATH_VAR)
+
+    def _still(self) -> bool:
+        get = self.getGlobalVariableByName
+        return no_peculiar_motion(get(thermostat_program.KINETIC_VAR), get(thermostat_program.TOTAL_KINETIC_VAR))
+
+    def _skipped_thermostat_events(self) -> int:
+        return int(self.getGlobalVariableByName(thermostat_program.SKIPPED_VAR))
 
     def _thermostat_kinetic_energy(self) -> float:
         return thermostat_program.event_kinetic_energy(self)

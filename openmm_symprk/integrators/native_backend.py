@@ -27,7 +27,6 @@ import openmm as mm
 
 from .. import plugin
 from ..methods.resolved import Substep, SubstepKind
-from ..systems.checks import warn_once
 from .backend import resolve_for_system
 from .base import IntegratorBase
 from .options import NATIVE_OPTIONS, IntegratorOptions
@@ -156,14 +155,9 @@ class NativeSymplecticIntegrator(SymplecticIntegrator, _PluginIntegrator, backen
     def _thermostat_kinetic_energy(self) -> float:
         return float(self.getThermostatKineticEnergy())
 
-    def _after_step(self):
-        if self.hasThermostat() and self.getSkippedThermostatEvents() > 0:
-            warn_once("thermostat-no-peculiar-motion",
-                      f"{type(self).__name__}({self.method_name}): the thermostat found no peculiar kinetic energy to "
-                      f"scale ({int(self.getSkippedThermostatEvents())} event(s) so far): the System is at rest or "
-                      f"moves only as a rigid whole, which velocity rescaling cannot heat towards "
-                      f"{self.thermostat.temperature:g} K (those events changed nothing). Start the run with velocities "
-                      f"drawn at the temperature: context.setVelocitiesToTemperature(T)")
+    def _skipped_thermostat_events(self) -> int:
+        """Events that found no peculiar kinetic energy (IntegratorBase warns once, for both backends)."""
+        return int(self.getSkippedThermostatEvents())
 
     # -- conveniences ----------------------------------------------------------------------------------------
     @property

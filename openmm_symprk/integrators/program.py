@@ -63,10 +63,10 @@ class ProgramInfo:
     """The facts of a compiled program beyond the method it runs (the form of the step, its force evaluations, its
     levels are the method's: :attr:`method`)."""
 
-    method: ResolvedMethod  # the method compiled
-    rattle: bool  # RATTLE steps emitted: the method keeps constraints, or virtual sites need them (compile_program)
-    signature: int  # the value of global 0 (see the module docstring); the plugin's program signature (native)
-    notes: tuple = ()  # lines describe() prints
+    method: ResolvedMethod  #: the method compiled
+    rattle: bool  #: RATTLE steps emitted: the method keeps constraints, or virtual sites need them (compile_program)
+    signature: int  #: the value of global 0 (see the module docstring); the plugin's program signature (native)
+    notes: tuple = ()  #: lines describe() prints
 
     @property
     def force_evals(self) -> int:

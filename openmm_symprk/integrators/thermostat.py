@@ -189,5 +189,5 @@ def thermostat_settings(system, temperature=None, collision_time=None, thermosta
             f"no degrees of freedom to thermostat: the System has {system.getNumParticles()} particle(s) and "
             f"{system.getNumConstraints()} constraint(s), which leaves {dof} degrees of freedom once the "
             f"centre-of-mass velocity{' and the rigid rotation (isolated System)' if isolated else ''} are kept "
-            f"(3 per particle with mass - constraints - 3{' - 3' if isolated else ''})")
+            f"(3 per particle with mass - constraints - 3{' - 3 (2 for two particles)' if isolated else ''})")
     return ThermostatSettings(kelvin, tau, interval, seed, dof, isolated, position)

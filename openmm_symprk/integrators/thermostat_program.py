@@ -3,10 +3,12 @@
 One half event (:func:`emit_half_event`) computes, with ``addComputeSum`` over the degrees of freedom,
 
     M = sum m,  P = sum m v,  K = sum m v.v / 2
-    and, when the rotation is kept (isolated System): sum m x, the second moments sum m x_a x_b, L about the origin,
+    and, when the rotation is kept (isolated System): sum m x, then, about the centre of mass R = sum m x / M, the
+    second moments sum m d_a d_b and L = sum m d x v of d = x - R (about a point near the system: far from the
+    origin moments about the origin cancel catastrophically),
 
-then in global expressions the kept field u = V + w x (x - R) (V = P/M; R the centre of mass, I the inertia
-tensor about it, w = I^-1 (L - R x P)), the peculiar kinetic energy K_pec = K - |P|^2/(2M) (- (L - R x P).w/2),
+then in global expressions the kept field u = V + w x (x - R) (V = P/M; I the inertia tensor about R, w = I^-1 L;
+for a linear system, whose I is singular, w = 2 L / tr I: its two rotations), the peculiar kinetic energy K_pec = K - |P|^2/(2M) (- (L - R x P).w/2),
 a standard normal r1 (``gaussian``), chi2 = sum gaussian^2 * mask over a per-DOF mask holding exactly
 N_f - 1 ones, and (alpha, K') as :func:`openmm_symprk.physics.velocity_rescaling.rescaling_factor` writes them,
 sign included.  Then ``v = u + alpha (v - u)`` for every particle with mass, and the heat-bath energy goes
@@ -23,12 +25,13 @@ from __future__ import annotations
 import openmm as mm
 
 from ..physics.temperature import R_KJ
-from .projection import emit_inertia, emit_rigid_solve, emit_second_moments
+from ..physics.velocity_rescaling import ROUNDOFF
+from .projection import emit_inertia, emit_rigid_solve
 from .thermostat import ThermostatSettings
 
 __all__ = ["PREFIX", "LOST_MASK_VAR", "TEMPERATURE_VAR", "COLLISION_TIME_VAR", "HEAT_BATH_VAR", "MASK_VAR", "ALPHA_VAR",
            "KINETIC_VAR", "NEW_KINETIC_VAR", "add_variables", "emit_half_event", "emit_event", "mask_values",
-           "TOTAL_KINETIC_VAR", "event_kinetic_energy"]
+           "TOTAL_KINETIC_VAR", "SKIPPED_VAR", "event_kinetic_energy"]
 
 PREFIX = "symprk_ts_"
 TEMPERATURE_VAR = PREFIX + "temperature"  # K
@@ -41,6 +44,8 @@ NEW_KINETIC_VAR = PREFIX + "knew"  # and after
 #: set to 1 by an event that found the mask without its dof - 1 ones (a Context reinitialized without its state
 #: loses per-DOF values set while bound): the event then does nothing, and the integrator fills the mask again
 LOST_MASK_VAR = PREFIX + "lost_mask"
+#: the events that found no peculiar kinetic energy to scale (at most ROUNDOFF of the total) and did nothing
+SKIPPED_VAR = PREFIX + "skipped"
 
 #: the total kinetic energy before the last event (kJ/mol); with KINETIC_VAR and NEW_KINETIC_VAR it gives the
 #: kinetic energy at the thermostat point (:func:`event_kinetic_energy`)
@@ -65,7 +70,7 @@ def _globals(keep_rotation: bool) -> tuple:
 
 
 def _per_dof(keep_rotation: bool) -> tuple:
-    return tuple(_v(n) for n in ("ex", "ey", "ez", *(("xp", "xpp", "u") if keep_rotation else ())))
+    return tuple(_v(n) for n in ("ex", "ey", "ez", *(("d", "xp", "xpp", "u") if keep_rotation else ())))
 
 
 def add_variables(integrator: mm.CustomIntegrator, settings: ThermostatSettings) -> None:
@@ -75,7 +80,7 @@ def add_variables(integrator: mm.CustomIntegrator, settings: ThermostatSettings)
     ig = integrator
     for name, value in ((TEMPERATURE_VAR, settings.temperature), (COLLISION_TIME_VAR, settings.collision_time),
                         (HEAT_BATH_VAR, 0.0), (ALPHA_VAR, 1.0), (KINETIC_VAR, 0.0), (NEW_KINETIC_VAR, 0.0),
-                        (LOST_MASK_VAR, 0.0)):
+                        (LOST_MASK_VAR, 0.0), (SKIPPED_VAR, 0.0)):
         ig.addGlobalVariable(name, float(value))
     for name in _globals(settings.keep_rotation):
         ig.addGlobalVariable(name, 0.0)
@@ -122,27 +127,43 @@ def _emit_sums(ig, keep_rotation: bool):
     ig.addComputeSum(v("K"), "0.5*m*v*v")
     if not keep_rotation:
         return
-    xp, xpp = v("xp"), v("xpp")
-    ig.addComputePerDof(xp, "vector(_y(x), _z(x), _x(x))")
-    ig.addComputePerDof(xpp, "vector(_z(x), _x(x), _y(x))")
-    emit_second_moments(ig, v, "m")
-    # L about the origin: (x X v)_x = [xpp v]_z - [xp v]_y and cyclically
-    for a, b, d in (("x", "z", "y"), ("y", "x", "z"), ("z", "y", "x")):
-        ig.addComputeSum(v(f"L{a}"), f"m*v*({xpp}*{e[b]} - {xp}*{e[d]})")
-
-
-def _emit_rotation(ig):
-    """R, I about R, its adjugate and determinant, L about R and w = I^-1 L (0 for a singular I), and
-    k = V - w x R, so that the kept field is k + w x x."""
-    v = _v
+    # the moments about the centre of mass R (a first pass), not about the origin: far from the origin
+    # sum m x x^T - M R R^T and L - R x P cancel catastrophically (a cluster 1e4 nm away lost L to 1e-6)
     M = v("M")
     inv = f"select({M}, 1/{M}, 0)"
     for a in _AXES:
+        ig.addComputeSum(v(f"mx{a}"), f"m*x*{e[a]}")
+    for a in _AXES:
         ig.addComputeGlobal(v(f"R{a}"), f"{v(f'mx{a}')}*{inv}")
-    R = {a: v(f"R{a}") for a in _AXES}
-    emit_inertia(ig, v, M, R)
-    # w = I^-1 (L - R x P) and k = V - w x R
-    emit_rigid_solve(ig, v, R, linear="P", moment="L", about="Lc", angular="w", base="V")
+    d, xp, xpp = v("d"), v("xp"), v("xpp")
+    ig.addComputePerDof(d, f"x - {_comb('Rx', 'Ry', 'Rz')}")
+    ig.addComputePerDof(xp, f"vector(_y({d}), _z({d}), _x({d}))")
+    ig.addComputePerDof(xpp, f"vector(_z({d}), _x({d}), _y({d}))")
+    for a in _AXES:
+        ig.addComputeSum(v(f"q{a}{a}"), f"m*{d}*{d}*{e[a]}")
+    for a, p in zip(_AXES, ("xy", "yz", "zx")):  # d * dp = (d_x d_y, d_y d_z, d_z d_x)
+        ig.addComputeSum(v(f"q{p}"), f"m*{d}*{xp}*{e[a]}")
+    # L about R: (d X v)_x = [dpp v]_z - [dp v]_y and cyclically
+    for a, b, c in (("x", "z", "y"), ("y", "x", "z"), ("z", "y", "x")):
+        ig.addComputeSum(v(f"L{a}"), f"m*v*({xpp}*{e[b]} - {xp}*{e[c]})")
+
+
+#: det I below this fraction of (tr I)^3: the system is linear (I about its axis is 0; a bent triatomic of 1 degree
+#: is 1e-5), and its rotation is w = L / (tr I / 2), its two equal moments being tr I / 2 and L perpendicular to it
+LINEAR = 1e-10
+
+
+def _emit_rotation(ig):
+    """The inertia tensor about R, its adjugate and determinant, and w = I^-1 L with L about R (for a linear system,
+    whose I is singular, w = 2 L / tr I, its two rotations); k = V, so that the kept field is k + w x (x - R)."""
+    v = _v
+    zero = {a: "0" for a in _AXES}
+    emit_inertia(ig, v, v("M"), zero)
+    emit_rigid_solve(ig, v, zero, linear="P", moment="L", about="Lc", angular="w", base="V")
+    tr = "(" + " + ".join(v(f"I{a}{a}") for a in _AXES) + ")"
+    linear = f"step({_num(LINEAR)}*{tr}^3 - abs({v('det')}))"
+    for a in _AXES:
+        ig.addComputeGlobal(v(f"w{a}"), f"select({linear}, select({tr}, 2*{v(f'Lc{a}')}/{tr}, 0), {v(f'w{a}')})")
 
 
 def emit_half_event(integrator: mm.CustomIntegrator, settings: ThermostatSettings) -> None:
@@ -177,7 +198,10 @@ def emit_event(integrator: mm.CustomIntegrator, settings: ThermostatSettings, fr
     # the mask holds its dof - 1 ones (else the Context lost it: do nothing and say so), and K_pec > 0
     ig.addComputeSum(v("nmask"), MASK_VAR)
     ig.addComputeGlobal(LOST_MASK_VAR, f"max({LOST_MASK_VAR}, 1 - delta({v('nmask')} - {dof - 1}))")
-    ig.addComputeGlobal(v("ok"), f"(1 - step(-{K}))*delta({v('nmask')} - {dof - 1})")
+    # no peculiar motion (K_pec round-off of K: at rest, or a rigid motion): no event, counted
+    still = f"step({_num(ROUNDOFF)}*{v('K')} - {K})"
+    ig.addComputeGlobal(SKIPPED_VAR, f"{SKIPPED_VAR} + {still}")
+    ig.addComputeGlobal(v("ok"), f"(1 - {still})*delta({v('nmask')} - {dof - 1})")
     new = (f"{c}*{K} + (1 - {c})*{s}*({r1}*{r1} + {chi2}) + 2*{r1}*sqrt({c}*(1 - {c})*{K}*{s})")
     ig.addComputeGlobal(NEW_KINETIC_VAR, f"select({v('ok')}, {new}, {K})")
     # the velocity came out reversed along itself: r1 + sqrt(c K / ((1 - c) s)) < 0

@@ -112,3 +112,28 @@ def best_position(steps, stability: float | None = None, forced=None) -> str:
     grid = tuple(x for x in H_OMEGA_GRID if stability is None or x < 0.9 * stability) or (H_OMEGA_GRID[0],)
     err = placement_errors(steps, grid, forced=forced)
     return "middle" if err["middle"] < 0.5 * err["ends"] else "ends"
+
+
+def placement_table(names=("verlet", "omelyan-2", "pefrl", "yoshida-4", "blanes-moan-srkn6b-4"),
+                    h_omegas=(0.25, 0.5, 1.0), decay: float = 0.5) -> str:
+    """A text table of w^2<q^2>/kT (1 is exact) for the catalogue methods ``names`` with the thermostat at the ends
+    and in the middle, over ``h_omegas``, and the placement "auto" gives each (docs/thermostat.md quotes it)."""
+    from .catalogue import get_method
+
+    head = "method".ljust(22) + "".join(f"ends {x:<6g}" for x in h_omegas) + \
+        "".join(f"middle {x:<6g}" for x in h_omegas) + "auto"
+    lines = [head]
+    for name in names:
+        method = get_method(name)
+        steps = method.splitting.steps
+        row = name.ljust(22)
+        for position in ("ends", "middle"):
+            for x in h_omegas:
+                try:
+                    value = f"{harmonic_sampling(with_thermostat(steps, position), x, decay)[0]:.4f}"
+                except ValueError:
+                    value = "-"
+                row += value.ljust(len(position) + 7)
+        lines.append(row + best_position(steps, method.stability))
+    return "\n".join(lines)
+

@@ -32,14 +32,28 @@ import numpy as np
 from .momenta import angular_momentum, centre_of_mass, inertia_tensor, linear_momentum
 
 __all__ = ["thermostat_dof", "relaxation_factor", "rescaling_factor", "draw_noise", "Resampled", "resample",
-           "kept_velocities"]
+           "kept_velocities", "ROUNDOFF", "no_peculiar_motion"]
+
+#: A peculiar kinetic energy at most this fraction of the total is round-off (a system at rest, or moving only as a
+#: rigid whole): an event leaves it alone, since sqrt(K'/K_pec) ~ 1e8 would amplify round-off into the kept motion.
+ROUNDOFF = 1e-10
+
+
+def no_peculiar_motion(kinetic: float, total_kinetic: float) -> bool:
+    """True where there is nothing to rescale: the peculiar kinetic energy ``kinetic`` is at most
+    :data:`ROUNDOFF` of the total ``total_kinetic`` (both kJ/mol; 0 and 0 for a system at rest)."""
+    return not kinetic > ROUNDOFF * total_kinetic
 
 
 def thermostat_dof(n_massive: int, n_constraints: int, isolated: bool) -> int:
     """Degrees of freedom the thermostat samples: 3 per particle with mass (virtual sites and massless
     particles never move by themselves), minus one per constraint, minus 3 for the centre-of-mass velocity
-    (always kept), minus 3 more for the rigid rotation when the system is isolated (kept too)."""
-    return 3 * int(n_massive) - int(n_constraints) - 3 - (3 if isolated else 0)
+    (always kept), minus the rigid rotations when the system is isolated (kept too): 3, but 2 for two particles
+    with mass (a linear system has no rotation about its axis; the kept rotation is solved with a regularised
+    inertia tensor, which leaves that axis alone) and 0 for one."""
+    n = int(n_massive)
+    rotations = (3 if n > 2 else (2 if n == 2 else 0)) if isolated else 0
+    return 3 * n - int(n_constraints) - 3 - rotations
 
 
 def relaxation_factor(interval: float, collision_time: float) -> float:
@@ -49,11 +63,14 @@ def relaxation_factor(interval: float, collision_time: float) -> float:
     return math.exp(-interval / collision_time)
 
 
-def rescaling_factor(kinetic: float, target: float, dof: int, c: float, r1: float, chi2: float) -> tuple:
+def rescaling_factor(kinetic: float, target: float, dof: int, c: float, r1: float, chi2: float,
+                     total_kinetic: float | None = None) -> tuple:
     """(alpha, K') for the peculiar kinetic energy ``kinetic`` (kJ/mol), the target N_f kT/2, the relaxation
     factor c = exp(-t/tau), a standard normal ``r1`` and a chi-squared variable ``chi2`` of dof - 1 degrees
-    of freedom.  Deterministic: the native kernels compute the same expression from the same two numbers."""
-    if not kinetic > 0:
+    of freedom.  Deterministic: the native kernels compute the same expression from the same two numbers.
+    ``total_kinetic``: the total kinetic energy, kept motion included; where the peculiar part is round-off of it
+    (:func:`no_peculiar_motion`) the factor is 1, as where ``kinetic`` is not positive."""
+    if not kinetic > 0 or (total_kinetic is not None and no_peculiar_motion(kinetic, total_kinetic)):
         # No peculiar motion to scale (all particles at the kept velocity): nothing can be rescaled.
         return 1.0, float(kinetic)
     s = target / dof
@@ -79,9 +96,10 @@ class Resampled(NamedTuple):
     new_kinetic: float  # and after
 
 
-def resample(kinetic: float, target: float, dof: int, c: float, rng: np.random.Generator) -> Resampled:
+def resample(kinetic: float, target: float, dof: int, c: float, rng: np.random.Generator,
+             total_kinetic: float | None = None) -> Resampled:
     """One thermostat event: draw the noise and return the factor and the kinetic energies before and after."""
-    alpha, new = rescaling_factor(kinetic, target, dof, c, *draw_noise(rng, dof))
+    alpha, new = rescaling_factor(kinetic, target, dof, c, *draw_noise(rng, dof), total_kinetic=total_kinetic)
     return Resampled(alpha, float(kinetic), new)
 
 

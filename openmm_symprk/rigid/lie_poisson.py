@@ -12,8 +12,7 @@ This module implements the integrators of section 5 of Reich (1994) (docs/theory
     about body axis i by the angle -h x_i/M_i.  Order 1.
 ``splitting-2``
     X1(h/2) X2(h/2) X3(h) X2(h/2) X1(h/2), the NO_SQUISH rotation sequence.  Order 2, symmetric.
-``splitting-4``, ``splitting-6`` and every composition of the catalogue (``yoshida-4``, ``suzuki-4``,
-``yoshida-6``, ``kahan-li-6``, ``kahan-li-8``, ...)
+``splitting-4``, ``splitting-6`` and every composition of the catalogue (``yoshida-4``, ``kahan-li-8``, ...)
     ``splitting-2`` composed with the catalogue's composition weights through
     :func:`openmm_symprk.methods.splitting.compose`, the code path that builds the MD kick/drift compositions.
 ``rattle-1``

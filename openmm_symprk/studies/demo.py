@@ -145,8 +145,8 @@ def run_demo(methods=None, n_waters: int = 64, steps: int = 2000, step_fs: float
             for tr in trackers]
     for line in _table(rows, max(28, *(len(r.name) for r in rows))):
         out(line)
-    out("\n|dE| in kJ/mol per degree of freedom; |dP| in Da nm/ps; time per step relative to OpenMM's VerletIntegrator,\n"
-        "each the fastest of its blocks of steps, the integrators taking turns block by block.")
+    out("\n|dE| in kJ/mol per degree of freedom; |dP| in Da nm/ps; time per step relative to OpenMM's "
+        "VerletIntegrator,\neach the fastest of its blocks of steps, the integrators taking turns block by block.")
     if any(r.nvt for r in rows):
         out(f"Rows at 300 K are NVT, where the energy is not conserved: for ours |dE| is that of the energy\n"
             "plus the heat-bath energy (computeHeatBathEnergy), which is; OpenMM's LangevinMiddleIntegrator (friction\n"

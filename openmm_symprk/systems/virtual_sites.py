@@ -11,7 +11,8 @@ or a restart) needs the site's true velocity, the time derivative of its positio
   its velocity is the derivative of its position function along the parents' velocities, taken by a central
   difference (step 1e-6 nm, error far below float32 trajectory precision).
 
-A virtual-site type not listed here (a future OpenMM class) keeps OpenMM's zero, and :attr:`unsupported` names it.
+A virtual-site type not listed here (a future OpenMM class) keeps OpenMM's zero, and
+:attr:`VirtualSiteVelocities.unsupported` names it.
 """
 from __future__ import annotations
 
@@ -30,7 +31,7 @@ class VirtualSiteVelocities:
         self.linear = []  # (site, parents, weights)
         self.out_of_plane = []  # (site, p1, p2, p3, w12, w13, wc)
         self.local = []  # (site, parents, origin w, x w, y w, local position)
-        self.unsupported = []  # (site, class name)
+        self.unsupported = []  #: virtual sites of a type not listed here: (site, class name)
         for i in range(system.getNumParticles()):
             if not system.isVirtualSite(i):
                 continue

@@ -81,7 +81,7 @@ def test_plugin_checks_the_flags_it_is_sent():
             ([K, D], [0.5, 1.0], [-1, -1], [P, 0], "is a kick flagged ProjectVelocitiesBefore"),
             ([K, D], [0.5, 1.0], [-1, -1], [0, C], "is a drift flagged ForcesCached"),
             ([K, D], [0.5, 1.0], [-1, -1], [0, 8], "has flags 8"),
-            ([K, 2], [0.5, 1.0], [-1, -1], [0, 0], "has kind 2; expected 0 .kick. or 1 .drift."),
+            ([K, 3], [0.5, 1.0], [-1, -1], [0, 0], "has kind 3; expected 0 .kick., 1 .drift. or 2 .thermostat event."),
             ([K, D], [0.0, 1.0], [-1, -1], [0, 0], "finite non-zero"),
             ([K, D], [0.5, 1.0], [-1, 3], [0, 0], "a drift takes -1"),
             ([K, D], [0.5, 1.0], [-1], [0, 0], "same length")]:

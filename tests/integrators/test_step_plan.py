@@ -5,12 +5,15 @@ each kernel executing exactly it: Reference, CPU (the Reference kernel on the CP
 The plugin lists the plan of a bound Context (``getStepPlan``: one line per operation) and, on request, records
 what its kernel ran (``setExecutionTraceEnabled`` / ``getExecutionTrace``: step, operation index, force groups
 evaluated).  Checked here, for velocity Verlet, PEFRL (velocity projections before some drifts), Yoshida-4, an
-r-RESPA sequence of two force groups, and the thermostat every step and every third step:
+r-RESPA sequence of two force groups, and the thermostat every step and every third step, at the ends of the step
+and in its middle (``thermostat_position="middle"``: a THERMOSTAT sub-step; with multiple time stepping the middle
+of the outer step):
 
 * the plan states the sequence the integrator was given: a kick per kick sub-step with its groups (-1 resolved
   to the integration force groups), a projection before each drift flagged for one and one at the end of the
   step where the System has constraints, the thermostat's half events before the first and after the last step
-  of each interval, the blow-up check after the last velocity-changing operation;
+  of each interval (ends), or one event at its THERMOSTAT sub-step in the middle step of each interval (phase
+  (n - 1) // 2) and none at the ends (middle), the blow-up check after the last velocity-changing operation;
 * every step runs the plan's operations in order, the thermostat events only in the steps of their phase;
 * forces are evaluated only by kicks, for their own groups, and a step costs getForceEvaluationsPerStep()
   evaluations in steady state (per group with multiple time stepping);
@@ -40,6 +43,11 @@ CASES = {
     "mts": ("morse", "verlet", {"groups": "split"}),
     "nvt-interval1": ("water8", "verlet", {"temperature": 300, "random_seed": 2}),
     "nvt-interval3": ("water8", "omelyan-2", {"temperature": 300, "thermostat_interval": 3, "random_seed": 2}),
+    "nvt-middle": ("water8", "verlet", {"temperature": 300, "random_seed": 2, "thermostat_position": "middle"}),
+    "nvt-middle-interval3": ("water8", "omelyan-2", {"temperature": 300, "thermostat_interval": 3, "random_seed": 2,
+                                                      "thermostat_position": "middle"}),
+    "nvt-middle-mts": ("morse", "verlet", {"groups": "split", "temperature": 300, "random_seed": 2,
+                                           "thermostat_interval": 2, "thermostat_position": "middle"}),
 }
 
 
@@ -78,11 +86,15 @@ def _expected_plan(ig, constrained):
     """The plan's lines as the sequence and settings say they must be (kind, substep, groups, reuse, phase)."""
     out = []
     interval = ig.getThermostatInterval() if ig.hasThermostat() else 1
-    if ig.hasThermostat():
+    middle = any(ig.getSubstepKind(s) == ig.Thermostat for s in range(ig.getNumSubsteps()))
+    ends = ig.hasThermostat() and not middle
+    if ends:
         out.append(("thermostat", None, None, None, 0))
     for s in range(ig.getNumSubsteps()):
         flags = ig.getSubstepFlags(s)
-        if ig.getSubstepKind(s) == ig.Kick:
+        if ig.getSubstepKind(s) == ig.Thermostat:
+            out.append(("thermostat", s, None, None, (interval - 1) // 2))
+        elif ig.getSubstepKind(s) == ig.Kick:
             mask = ig.getSubstepForceGroups(s)
             out.append(("kick", s, ig.getIntegrationForceGroups() if mask == -1 else mask, bool(flags & ig.ForcesCached), None))
         else:
@@ -91,7 +103,7 @@ def _expected_plan(ig, constrained):
             out.append(("drift", s, None, None, None))
     if constrained:
         out.append(("project", None, None, None, None))
-    if ig.hasThermostat():
+    if ends:
         out.append(("thermostat", None, None, None, interval - 1))
     return out, interval
 
@@ -113,10 +125,10 @@ def test_each_kernel_runs_the_plan(case, platform, props, request):
                     int(facts["phase"].split("/")[0]) if kind == "thermostat" else None))
     assert got == expected, "\n".join(plan)
     for (kind, facts, _), (_, s, *_) in zip(parsed, expected):
-        if kind in ("kick", "drift"):
+        if kind in ("kick", "drift") or (kind == "thermostat" and s is not None):
             assert float(facts["c"]) == pytest.approx(ig.getSubstepCoefficient(s), rel=1e-5)
         if kind == "thermostat":
-            assert float(facts["c"]) == 0.5 and facts["phase"].endswith(f"/{interval}")
+            assert float(facts["c"]) == (1.0 if s is not None else 0.5) and facts["phase"].endswith(f"/{interval}")
     changes = [i for i, (kind, _, _) in enumerate(parsed) if kind == "kick" or (kind == "drift" and constrained)]
     assert [i for i, (_, _, words) in enumerate(parsed) if "check" in words] == changes[-1:]
     mts = len({g for k, _, g, _, _ in expected if k == "kick"}) > 1
@@ -135,13 +147,20 @@ def test_each_kernel_runs_the_plan(case, platform, props, request):
         assert all(evaluated != 0 for op, evaluated in ran[:, 1:] if expected[op][0] == "kick" and not expected[op][3])
         if step > 1:  # steady state: the cached forces of the last step's closing kick serve the opening one
             assert np.count_nonzero(ran[:, 2]) == ig.getForceEvaluationsPerStep(), (step, ran.tolist())
+    middle = [i for i, e in enumerate(expected) if e[0] == "thermostat" and e[1] is not None]
+    if middle:  # one event, at the centre of the (outer) step: as many sub-steps before it as after it
+        n = ig.getNumSubsteps()
+        assert len(middle) == 1 and n % 2 == 1 and expected[middle[0]][1] == n // 2
     if mts:  # per group: the slow group once a step, the fast one twice
         steady = trace[(trace[:, 0] > 1) & (trace[:, 2] != 0)]
         per_group = {int(g): int(np.count_nonzero(steady[:, 2] == g)) // (STEPS - 1) for g in set(steady[:, 2].tolist())}
         assert per_group == {1 << 1: 1, 1 << 0: 2}, per_group
     if ig.hasThermostat():
         events = trace[np.isin(trace[:, 1], [i for i, e in enumerate(expected) if e[0] == "thermostat"])]
-        assert len(events) == 2 * (STEPS // interval) + (STEPS % interval > 0)
+        if middle:  # one event in the middle step of each interval
+            assert events[:, 0].tolist() == [k for k in range(1, STEPS + 1) if (k - 1) % interval == (interval - 1) // 2]
+        else:
+            assert len(events) == 2 * (STEPS // interval) + (STEPS % interval > 0)
 
 
 @needs_opencl

@@ -160,11 +160,10 @@ def test_bad_input_is_a_clear_error(backend, cluster, options, error, message):
 def test_errors_about_the_system(backend):
     with pytest.raises(ValueError, match="temperature= needs system="):
         SymplecticIntegrator(0.001, "verlet", backend=backend, temperature=300)
-    two = mm.System()
-    two.addParticle(1.0)
-    two.addParticle(1.0)  # isolated: 6 - 3 - 3 = 0
+    one = mm.System()
+    one.addParticle(1.0)  # isolated: 3 - 3 = 0 (a diatomic has 6 - 3 - 2 = 1: tests/integrators/test_thermostat_edges)
     with pytest.raises(ValueError, match="no degrees of freedom to thermostat.*leaves 0 degrees of freedom"):
-        SymplecticIntegrator(0.001, "verlet", system=two, backend=backend, temperature=300)
+        SymplecticIntegrator(0.001, "verlet", system=one, backend=backend, temperature=300)
 
 
 @pytest.mark.parametrize("backend", BACKENDS)

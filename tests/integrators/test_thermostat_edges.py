@@ -26,6 +26,11 @@ def _native_reason():
 
 BACKENDS = ["custom", pytest.param("native", marks=pytest.mark.skipif(_native_reason() is not None,
                                                                         reason=str(_native_reason())))]
+#: items whose native side (the C++ kernels) is the plugin's own change: expected to fail on native until it is in
+#: this build (non-strict: an XPASS then says the mark can go)
+NATIVE_PENDING = ["custom", pytest.param("native", marks=[
+    pytest.mark.skipif(_native_reason() is not None, reason=str(_native_reason())),
+    pytest.mark.xfail(reason="the native kernels' side of this item is not in this build yet", strict=False)])]
 
 
 def context(system, ig, x, v, platform=REF):
@@ -95,3 +100,140 @@ def test_copy_of_a_used_integrator_runs_as_a_fresh_one(backend, cluster, how):
         runs.append((velocities(c).tobytes(), integrator.computeHeatBathEnergy(), integrator.steps_taken))
         del c
     assert runs[0] == runs[1]
+
+
+# -- 3: angular momentum far from the origin ----------------------------------------------------------------------
+@pytest.mark.parametrize("backend", BACKENDS)
+@pytest.mark.parametrize("distance", [1e4, 1e5])
+def test_angular_momentum_kept_far_from_the_origin(backend, distance):
+    """An 8-water cluster moved ``distance`` nm from the origin, 1000 steps: with the thermostat, L about the centre
+    of mass (the frame-independent part) changes at most 3 times as much as in the NVE run from the same state, which
+    loses it only through the positions' own precision there (measured: 5e-9 at 1e4 nm, 5e-8 at 1e5 nm, relative;
+    with the thermostat 1.1e-8 and 9e-8).  Before the fix the thermostat's moments about the origin lost 1e-6
+    (1e4 nm) and 1.7e-4 (1e5 nm)."""
+    scene = water_cluster(8)
+    x = np.asarray(scene.positions) + distance * np.array([1.0, 0.6, -0.8])
+    m = np.array([scene.system.getParticleMass(i).value_in_unit(unit.dalton)
+                  for i in range(scene.system.getNumParticles())])
+    change = {}
+    for kind, options in (("nve", {}), ("nvt", dict(temperature=300, collision_time=0.01, random_seed=3))):
+        ig = SymplecticIntegrator(0.002, "verlet", system=scene.system, backend=backend, **options)
+        ctx = context(scene.system, ig, x, scene.velocities)
+
+        def l_about_com():
+            st = ctx.getState(getPositions=True, getVelocities=True)
+            X = np.asarray(st.getPositions(asNumpy=True).value_in_unit(unit.nanometer))
+            V = np.asarray(st.getVelocities(asNumpy=True).value_in_unit(unit.nanometer / unit.picosecond))
+            R = (m[:, None] * X).sum(0) / m.sum()
+            return (m[:, None] * np.cross(X - R, V)).sum(0)
+
+        L0 = l_about_com()
+        ig.step(1000)
+        change[kind] = np.linalg.norm(l_about_com() - L0) / np.linalg.norm(L0)
+        assert (ig.computeHeatBathEnergy() != 0 * unit.kilojoule_per_mole) == (kind == "nvt")
+        del ctx
+    assert change["nvt"] < 3 * change["nve"] + 1e-12, change
+
+
+# -- 6: nothing to scale --------------------------------------------------------------------------------------------
+def _gas(n):
+    system = mm.System()
+    for k in range(n):
+        system.addParticle(12.0 + k)
+    x = np.random.default_rng(1).uniform(0, 2, (n, 3))
+    return system, x
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+@pytest.mark.parametrize("motion", ["at rest", "rigid translation"])
+def test_no_peculiar_kinetic_energy_warns_once_and_scales_nothing(backend, motion):
+    system, x = _gas(10)
+    v = np.zeros_like(x) if motion == "at rest" else np.tile([0.3, -1.2, 0.7], (10, 1))
+    ig = SymplecticIntegrator(0.002, "verlet", system=system, backend=backend, temperature=300, random_seed=2)
+    ctx = context(system, ig, x, v)
+    with pytest.warns(RuntimeWarning, match="found no peculiar kinetic energy.*setVelocitiesToTemperature"):
+        ig.step(5)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        ig.step(5)  # once
+    after = velocities(ctx)
+    assert np.array_equal(after, v)  # round-off not amplified: every velocity exactly as it was
+    assert ig.computeHeatBathEnergy() == 0 * unit.kilojoule_per_mole
+    ctx.setVelocitiesToTemperature(300, 1)
+    ig.step(20)
+    assert ig.computeHeatBathEnergy() != 0 * unit.kilojoule_per_mole
+
+
+# -- linear isolated systems -----------------------------------------------------------------------------------------
+@pytest.mark.parametrize("backend", NATIVE_PENDING)
+def test_isolated_diatomic_has_one_degree_of_freedom_and_keeps_l(backend):
+    """A harmonic diatomic in vacuum: 6 - 3 (centre of mass) - 2 (rotations of a linear system) = 1 degree of
+    freedom, the vibration; its thermostat keeps P and L and samples <K_vib> = kT/2."""
+    system = mm.System()
+    for mass in (12.0, 16.0):
+        system.addParticle(mass)
+    bond = mm.HarmonicBondForce()
+    bond.addBond(0, 1, 0.113, 1.0e5)
+    system.addForce(bond)
+    ig = SymplecticIntegrator(0.0005, "verlet", system=system, backend=backend, temperature=300,
+                              collision_time=0.02, random_seed=5)
+    assert ig.thermostat_dof == 1
+    x = np.array([[0.0, 0.0, 0.0], [0.115, 0.01, 0.0]])
+    v = np.array([[0.1, 0.5, -0.2], [-0.3, -0.2, 0.4]])
+    ctx = context(system, ig, x, v)
+    m = np.array([12.0, 16.0])
+    L0 = (m[:, None] * np.cross(x, v)).sum(0)
+    ig.step(2000)
+    st = ctx.getState(getPositions=True, getVelocities=True)
+    X = np.asarray(st.getPositions(asNumpy=True)._value)
+    V = np.asarray(st.getVelocities(asNumpy=True)._value)
+    assert np.linalg.norm((m[:, None] * (V - v)).sum(0)) < 1e-12 * np.sum(m[:, None] * np.abs(V))
+    assert np.linalg.norm((m[:, None] * np.cross(X, V)).sum(0) - L0) < 1e-9 * np.linalg.norm(L0)
+
+
+# -- checkpoints keep the integrator's temperature --------------------------------------------------------------------
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_loading_a_checkpoint_keeps_the_current_temperature(backend, cluster):
+    """As OpenMM's LangevinMiddleIntegrator: the temperature is the integrator's, not the checkpoint's."""
+    ig = SymplecticIntegrator(0.002, "verlet", system=cluster.system, backend=backend, temperature=300,
+                              random_seed=4)
+    ctx = context(cluster.system, ig, cluster.positions, cluster.velocities)
+    ig.step(5)
+    chk = ctx.createCheckpoint()
+    ig.setTemperature(450)
+    ctx.loadCheckpoint(chk)
+    ig.step(1)
+    assert ig.getTemperature() == 450 * unit.kelvin
+    if backend == "custom":
+        from openmm_symprk.integrators import thermostat_program as tp
+
+        assert ig.getGlobalVariableByName(tp.TEMPERATURE_VAR) == 450
+
+
+@pytest.mark.parametrize("backend", NATIVE_PENDING)
+def test_linear_triatomic_keeps_p_and_l(backend):
+    """A flexible CO2-like triatomic, isolated, started on a line with velocities along it and a rotation about a
+    perpendicular axis: it stays linear, its inertia tensor is singular, and the kept rotation (w = 2 L / tr I) keeps
+    L and P through the thermostat's events.  (Its degrees of freedom count 3 rotations: the System does not say it
+    is linear, docs/thermostat.md.)"""
+    system = mm.System()
+    for mass in (16.0, 12.0, 16.0):
+        system.addParticle(mass)
+    bond = mm.HarmonicBondForce()
+    bond.addBond(0, 1, 0.116, 5.0e5)
+    bond.addBond(1, 2, 0.116, 5.0e5)
+    system.addForce(bond)
+    ig = SymplecticIntegrator(0.0005, "verlet", system=system, backend=backend, temperature=300,
+                              collision_time=0.02, random_seed=5)
+    x = np.array([[-0.118, 0.0, 0.0], [0.0, 0.0, 0.0], [0.117, 0.0, 0.0]])
+    v = np.array([[0.3, 0.2, 0.0], [-0.1, 0.0, 0.0], [-0.2, -0.2, 0.0]])  # spins about z, drifts along x
+    m = np.array([16.0, 12.0, 16.0])
+    ctx = context(system, ig, x, v)
+    L0 = (m[:, None] * np.cross(x, v)).sum(0)
+    ig.step(2000)
+    st = ctx.getState(getPositions=True, getVelocities=True)
+    X = np.asarray(st.getPositions(asNumpy=True)._value)
+    V = np.asarray(st.getVelocities(asNumpy=True)._value)
+    assert ig.computeHeatBathEnergy() != 0 * unit.kilojoule_per_mole
+    assert np.linalg.norm((m[:, None] * (V - v)).sum(0)) < 1e-12 * np.sum(m[:, None] * np.abs(V))
+    assert np.linalg.norm((m[:, None] * np.cross(X, V)).sum(0) - L0) < 1e-9 * np.linalg.norm(L0)

@@ -212,10 +212,12 @@ def test_npt_with_a_monte_carlo_barostat_keeps_momentum():
     pytest.param("OpenCL", {"Precision": "double"}, False, 1e-11, marks=needs_opencl, id="OpenCL-double"),
     pytest.param("OpenCL", {"Precision": "mixed"}, True, 1e-10, marks=needs_opencl, id="OpenCL-mixed-exact"),
     pytest.param("OpenCL", {"Precision": "single"}, True, 1e-5, marks=needs_opencl, id="OpenCL-single-exact")])
-def test_angular_momentum_to_round_off_for_an_isolated_cluster(platform, props, exact, bound, water8):
+@pytest.mark.parametrize("position", ["ends", "middle"])
+def test_angular_momentum_to_round_off_for_an_isolated_cluster(platform, props, exact, bound, position, water8):
+    """Both placements (the middle one inside omelyan-2's central kick) on every platform and precision."""
     m = water8.masses()
     ig = N(2 * unit.femtoseconds, "omelyan-2", system=water8.system, temperature=300, collision_time=0.02,
-           random_seed=9, exact_momentum=exact)
+           random_seed=9, exact_momentum=exact, thermostat_position=position)
     assert ig.thermostat.keep_rotation
     ctx = water8.context(ig, platform, props)
     x0, v0 = _xv(ctx)

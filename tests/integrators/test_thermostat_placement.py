@@ -345,3 +345,37 @@ def test_middle_checkpoint_and_copies_continue_bit_for_bit(backend):
         runs.append((arrays(c)[1].tobytes(), integrator.computeHeatBathEnergy()))
         del c
     assert all(r == runs[0] for r in runs[1:])
+
+
+# -- what a reporter reads --------------------------------------------------------------------------------------------
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_conservation_reporter_shows_the_temperature_at_the_thermostat(backend):
+    """With the ends placement the last event is the end of the step, so the temperature at the thermostat equals
+    that of the State's peculiar velocities to round-off; with the middle placement the reporter has the column too."""
+    import io
+
+    import openmm.app as app
+
+    from openmm_symprk.conservation import ConservationReporter
+    from openmm_symprk.physics.velocity_rescaling import kept_velocities
+
+    scene = water_cluster(8)
+    for position in ("ends", "middle"):
+        ig = SymplecticIntegrator(0.002, "verlet", system=scene.system, backend=backend, temperature=300,
+                                  random_seed=1, thermostat_position=position)
+        sim = app.Simulation(scene.topology, scene.system, ig, mm.Platform.getPlatformByName(REF))
+        sim.context.setPositions(scene.positions)
+        sim.context.setVelocities(scene.velocities)
+        out = io.StringIO()
+        reporter = ConservationReporter(out, 5)
+        sim.reporters.append(reporter)
+        sim.step(20)
+        assert "T at the thermostat (K)" in out.getvalue().splitlines()[0]
+        x, v = arrays(sim.context)
+        m = masses(scene.system)
+        u = kept_velocities(x, v, m, True)
+        on_step = float(np.sum(m[:, None] * (v - u) ** 2)) / (ig.thermostat_dof * R_KJ)
+        if position == "ends":
+            assert reporter.records[-1]["T_thermostat"] == pytest.approx(on_step, rel=1e-9)
+        else:
+            assert 0 < reporter.records[-1]["T_thermostat"] != pytest.approx(on_step, rel=1e-6)

@@ -10,7 +10,8 @@ from openmm_symprk.studies.drift import presets
 from openmm_symprk.studies.drift.cli import main
 from openmm_symprk.studies.drift.report import format_summary
 from openmm_symprk.studies.drift.study import run_study
-from openmm_symprk.studies.drift.verdict import (R_KJ, claim_verdict, cost_verdict, magnitude, ratio, row_estimate,
+from openmm_symprk.physics.temperature import R_KJ
+from openmm_symprk.studies.drift.verdict import (claim_verdict, cost_verdict, magnitude, ratio, row_estimate,
                                                  run_drift)
 
 
@@ -166,3 +167,23 @@ def test_cli_errors_name_the_bad_value(tmp_path, capsys):
     assert "exact-momentum study only" in capsys.readouterr().err
     with pytest.raises(SystemExit):
         main(["energy"])
+
+
+def test_runs_stored_by_earlier_versions_keep_their_keys():
+    """Rows are Row labels now; a run's key still hashes the fields of the earlier rows (integrator, step_fs,
+    exact_momentum), so the runs stored before are found again, and a row that says more (a thermostat) gets a key
+    of its own."""
+    from openmm_symprk.studies.core import run_key as hash_key
+    from openmm_symprk.studies.drift.study import _RUN_KEYS, run_key, scene_state_key
+
+    cfg = presets.exact_momentum(quick=True, platforms=("CPU",))
+    for new, exact in zip(cfg["rows"], (False, True)):
+        old = {"name": new["name"], "scene": "villin-vacuum", "integrator": "verlet", "step_fs": 2.0, "platform": "CPU",
+               "precision": None, "exact_momentum": exact}
+        expected = hash_key({"cfg": {k: cfg[k] for k in _RUN_KEYS}, "row": {k: old[k] for k in (
+            "scene", "integrator", "step_fs", "platform", "precision", "exact_momentum")}, "replica": 1,
+            "states": scene_state_key(cfg, "villin-vacuum"), "version": 1})
+        assert run_key(cfg, new, 1) == run_key(cfg, old, 1) == expected
+    nvt = presets.nvt(quick=True)
+    keys = {run_key(nvt, row, 0) for row in nvt["rows"]}
+    assert len(keys) == len(nvt["rows"])

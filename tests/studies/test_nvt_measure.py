@@ -9,7 +9,8 @@ import pytest
 
 from openmm_symprk import plugin
 from openmm_symprk.cli import main as symprk
-from openmm_symprk.studies.nvt import cost, drift, rows
+from openmm_symprk.studies.drift import presets
+from openmm_symprk.studies.nvt import cost, rows
 
 needs_native = pytest.mark.skipif(not plugin.available(), reason="native plugin not built")
 
@@ -66,49 +67,56 @@ def test_interleaved_keeps_every_block():
 
 @needs_native
 def test_drift_quick_gives_estimates_with_errors_and_a_chart(tmp_path, capsys):
+    """``symprk nvt drift`` is the drift study's nvt preset: every pair measured with an error bar, the NVT - NVE
+    difference paired by replica, the table printed, the chart and the JSON written where asked."""
     chart, data = tmp_path / "img" / "nvt.png", tmp_path / "nvt.json"
-    assert symprk(["nvt", "drift", "--quick", "--chart", str(chart), "--json", str(data)]) == 0
+    assert symprk(["nvt", "drift", "--quick", "--out", str(tmp_path / "out"), "--no-progress", "--chart", str(chart),
+                   "--json", str(data)]) == 0
     result = json.loads(data.read_text())
-    assert result["replicas"] == 1 and result["dof"] == 3 * 648 - 3 * 216 - 3
-    assert [r["nvt_row"] for r in result["rows"]] == [p[0][0] for p in drift.default_pairs(quick=True)]
-    for r in result["rows"]:
-        for key in ("nvt", "nve", "difference"):
-            est = r[key]
-            assert est is not None and math.isfinite(est["mean"]) and est["se"] > 0 and math.isfinite(est["se"]), r
+    assert result["config"]["replicas"] == 1 and result["config"]["study"] == "nvt"
+    names = [p[0] for p in presets.nvt_pairs(presets.NVT_QUICK)]
+    assert [c["row"] for c in result["comparisons"]] == names
+    rows = {r["name"]: r for r in result["rows"]}
+    for c in result["comparisons"]:
+        for name in (c["row"], c["ref"]):
+            est = rows[name]["drift"]
+            assert est is not None and math.isfinite(est["mean"]) and est["se"] > 0 and math.isfinite(est["se"])
+        assert rows[c["row"]]["ensemble"] == "NVT" and rows[c["ref"]]["ensemble"] == "NVE"
         # the paired difference is the difference of the two rows (one replica)
-        assert r["difference"]["mean"] == pytest.approx(r["nvt"]["mean"] - r["nve"]["mean"])
+        assert c["difference"]["mean"] == pytest.approx(rows[c["row"]]["drift"]["mean"] - rows[c["ref"]]["drift"]["mean"])
     printed = capsys.readouterr().out
-    assert "NVT - NVE (paired)" in printed and all(r["nvt_row"] in printed for r in result["rows"])
+    assert "NVT - NVE (paired)" in printed and all(n in printed for n in names)
     assert chart.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
 
-def test_bad_options_are_refused_with_their_value(capsys):
+def test_bad_options_are_refused_with_their_value(capsys, tmp_path):
     with pytest.raises(SystemExit) as exc:
         symprk(["nvt", "cost", "--scenes", "water,protein"])
     assert exc.value.code == 2 and "protein" in capsys.readouterr().err
-    with pytest.raises(SystemExit):
-        symprk(["nvt", "drift", "--replicas", "0"])
-    assert "must be positive, got 0" in capsys.readouterr().err
+    assert symprk(["nvt", "drift", "--replicas", "0", "--out", str(tmp_path)]) == 2
+    assert "replicas must be >= 1, got 0" in capsys.readouterr().err
     for bad, said in (("omelyan-2", "'omelyan-2': write method@step_fs"), ("verlet@-1", "'verlet@-1'"),
                       ("no-such-method@2", "no-such-method")):
-        with pytest.raises(SystemExit):
-            symprk(["nvt", "drift", "--rows", bad])
+        assert symprk(["nvt", "drift", "--rows", bad, "--out", str(tmp_path)]) == 2
         assert said in capsys.readouterr().err
-    assert [p[0][0] for p in drift.pairs_from("omelyan-4@4, nosehoover@2")] == ["pefrl 4 fs", "NoseHoover 2 fs"]
+    assert [p[0] for p in presets.nvt_pairs(["omelyan-4@4", "nosehoover@2"])] == ["pefrl 4 fs", "NoseHoover 2 fs"]
 
 
 @needs_native
 def test_every_drift_row_gives_a_full_finite_series():
-    """The full run's rows (NoseHoover and OpenMM's Verlet included) on a small cluster: one sample per block from
-    the end of the first block to the run's end, every effective energy finite, and the thermostat's heat-bath
-    energy in it (NVT and NVE series of the same method differ)."""
+    """The full study's rows (NoseHoover and OpenMM's Verlet included) on a small cluster: one sample per block from
+    the start to the run's end, every effective energy finite, and the thermostat's heat-bath energy in it (NVT and
+    NVE series of the same method differ)."""
+    from openmm_symprk.studies.drift.runs import run_nve
     from openmm_symprk.systems.scenes import water_cluster
 
     sc = water_cluster(8, temperature=300.0)
+    cfg = dict(presets.nvt(), length_ps=0.048, sample_ps=0.012, threads=1)
     series = {}
-    for nvt, nve in drift.default_pairs():
-        for name, row in (nvt, nve):
-            t, e = drift.energy_series(row, sc.system, sc.positions, sc.velocities, 0.048, 12.0, seed=1, threads=1)
-            assert len(t) >= 3 and t[-1] == pytest.approx(0.048, abs=row.step_fs * 1e-3) and all(map(math.isfinite, e))
-            series[name] = e
+    for row in cfg["rows"]:
+        arrays, info = run_nve(sc.system, sc.positions, sc.velocities, row, cfg, seed=1)
+        assert info["status"] == "ok", info
+        t, e = arrays["t"], arrays["e"]
+        assert len(t) == 5 and t[-1] == pytest.approx(0.048) and all(map(math.isfinite, e))
+        series[row["name"]] = e
     assert not (series["verlet 2 fs"] == series["verlet 2 fs NVE"]).all()

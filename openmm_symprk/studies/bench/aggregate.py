@@ -17,10 +17,8 @@ import math
 import platform as _platform
 from statistics import median
 
-import numpy as np
-
-from ...physics.temperature import R_KJ
 from ...stats import Estimate, drift, no_larger
+from ..core.units import kt_per_ns_per_dof
 from .measure import rms_deviation
 from .records import SCHEMA_VERSION
 from .runs import label
@@ -186,8 +184,7 @@ def drift_kT(r: dict, temperature: float = 300.0) -> tuple:
     if len(t) < 3:
         return r["drift_kT_per_ns_per_dof"], r.get("drift_kT_stderr")
     d = drift(t, de)  # kJ/mol per ps per DOF
-    kT = R_KJ * temperature
-    return d.slope * 1e3 / kT, d.se * 1e3 / kT
+    return kt_per_ns_per_dof(d.slope, temperature), kt_per_ns_per_dof(d.se, temperature)
 
 
 def production_summary(scene_config: dict, runs: list, temperature: float = 300.0) -> dict:
@@ -262,8 +259,3 @@ def format_summary(results) -> str:
         out += ["", format_best(results), "", format_best(results, "best_energy", "a max |E - E0| per DOF", "kJ/mol")]
     return "\n".join(out)
 
-
-def traces(results, scene, step_fs):
-    """{label: (t, dE per dof)} of the runs of ``scene`` at ``step_fs``."""
-    return {label(r["method"]): (np.array(r["trace_t"]), np.array(r["trace_de_per_dof"]))
-            for r in results["runs"] if r["scene"] == scene and r["step_fs"] == step_fs and r.get("trace_t")}

@@ -17,7 +17,8 @@ import json
 import os
 import sys
 
-from ..core.cli import positive
+from ..core import platforms
+from ..core.cli import KEPT, positive, run_command
 
 
 def _list(values):
@@ -33,8 +34,8 @@ def _list(values):
 def _check_platform(name):
     import openmm as mm
 
-    names = [mm.Platform.getPlatform(i).getName() for i in range(mm.Platform.getNumPlatforms())]
-    if name not in names:
+    if not platforms.available(name) or ":" in name:
+        names = [mm.Platform.getPlatform(i).getName() for i in range(mm.Platform.getNumPlatforms())]
         raise ValueError(f"unknown OpenMM platform {name!r}; this installation has {', '.join(names)}")
 
 
@@ -144,28 +145,24 @@ def main(argv=None) -> int:
         with open(path) as fh:
             print(format_summary(json.load(fh)))
         return 0
-    from .sweep import SweepExistsError, SweepLockedError, retime_sweep, run_sweep
+    return run_command("symprk bench", lambda: _sweep(args, out), interrupted=KEPT)
 
-    try:
-        _check_out(out)
-        cfg = make_config(args)
-        if args.retime:
-            results = retime_sweep(cfg, out, workers=args.workers, charts=not args.no_charts,
-                                   progress=not args.no_progress)
-        else:
-            results = run_sweep(cfg, out, workers=args.workers, scheduler=args.scheduler, resume=args.resume,
-                                charts=not args.no_charts, progress=not args.no_progress)
-    except (SweepExistsError, SweepLockedError, ValueError, ImportError, OSError) as exc:
-        print(f"symprk bench: error: {exc}", file=sys.stderr)
-        return 2
-    except KeyboardInterrupt:
-        return 130
+
+def _sweep(args, out: str):
     from .aggregate import format_summary
+    from .sweep import retime_sweep, run_sweep
 
+    _check_out(out)
+    cfg = make_config(args)
+    if args.retime:
+        results = retime_sweep(cfg, out, workers=args.workers, charts=not args.no_charts,
+                               progress=not args.no_progress)
+    else:
+        results = run_sweep(cfg, out, workers=args.workers, scheduler=args.scheduler, resume=args.resume,
+                            charts=not args.no_charts, progress=not args.no_progress)
     print(format_summary(results))
     for path in results.get("charts", []):
         print(f"chart: {path}")
-    return 0
 
 
 if __name__ == "__main__":

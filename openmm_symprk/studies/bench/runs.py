@@ -37,21 +37,22 @@ import openmm as mm
 import openmm.unit as unit
 
 from ...physics import angular_momentum, linear_momentum
-from ...systems.prepare import R_KJ
 from ..timing import interleaved
 from ...systems.properties import constraint_violation
 from ...stats import drift
 from . import measure
 from .records import RunRecord
 from ...systems.scenes import Scene
+from ..core import platforms
 from ..core.rows import Row
+from ..core.units import kT, kt_per_ns_per_dof
 
 #: Constraint tolerance for every run (SETTLE ignores it; CCMA iterates to it) ...
 CONSTRAINT_TOLERANCE = 1e-10
 #: ... but production scenes run with OpenMM's default, as users do.
 PRODUCTION_CONSTRAINT_TOLERANCE = 1e-5
 #: Failure thresholds (see stability.py for their rationale).
-KT300 = 0.0083144626 * 300.0
+KT300 = kT(300.0)
 ENERGY_THRESHOLD_KT = 0.1  # kT(300 K) per degree of freedom
 CONSTRAINT_THRESHOLD = 1e-3  # relative bond-length error
 SPEED_LIMIT = 1e5  # nm/ps: a velocity above this is a blow-up
@@ -86,12 +87,12 @@ def label(method: str) -> str:
     return {"openmm-verlet": "OpenMM Verlet", "openmm-langevin": "OpenMM Langevin"}.get(method, method)
 
 
+#: The precision the bench runs a GPU platform in.
+PRECISION = {"OpenCL": "double", "CUDA": "mixed", "HIP": "mixed"}
+
+
 def platform_properties(name: str, threads: int) -> dict:
-    if name == "CPU":
-        return {"Threads": str(threads)}
-    if name in ("OpenCL", "CUDA", "HIP"):
-        return {"Precision": "double" if name == "OpenCL" else "mixed"}
-    return {}
+    return platforms.properties(name, threads, PRECISION.get(name))
 
 
 class Unsupported(Exception):
@@ -268,9 +269,9 @@ def _measure(spec, scene, ctx, ig, rec, arrays):
                constraint_error=worst_c, trace_t=ts, trace_de_per_dof=des)
     if scene.purpose == "production" and len(ts) > 3:
         # production figures: energy fluctuation and drift per DOF, the drift in kT/ns with its standard error
-        kT = R_KJ * scene.temperature
-        rec.update(energy_std_per_dof=float(np.std(des)), drift_kT_per_ns_per_dof=fit.slope * 1e3 / kT,
-                   drift_kT_stderr=fit.se * 1e3 / kT)
+        rec.update(energy_std_per_dof=float(np.std(des)),
+                   drift_kT_per_ns_per_dof=kt_per_ns_per_dof(fit.slope, scene.temperature),
+                   drift_kT_stderr=kt_per_ns_per_dof(fit.se, scene.temperature))
     if rec.blew_up:
         # the measured maxima only cover the samples before the blow-up: do not report them as errors
         rec.update(energy_error=None, energy_error_per_dof=None, drift_per_ns_per_dof=None, dP=None, dL_rel=None,

@@ -1,5 +1,6 @@
-"""What the command lines of the studies share: their common options and the run-and-report frame (options
-checked before anything runs, finished runs kept on Ctrl-C, one-line errors with exit status 2)."""
+"""What the command lines share: the one command frame (:func:`run_command`: one-line errors with exit status 2,
+finished runs kept on Ctrl-C), the studies' common options and their run-and-report frame (options checked before
+anything runs)."""
 from __future__ import annotations
 
 import argparse
@@ -7,7 +8,7 @@ import os
 import sys
 from importlib import import_module
 
-__all__ = ["positive", "add_study_arguments", "run_study_command"]
+__all__ = ["positive", "add_study_arguments", "run_study_command", "run_command", "user_errors"]
 
 
 def positive(kind=float):
@@ -42,13 +43,45 @@ def add_study_arguments(ap, *, quick: str, out: str, workers: str, length: str) 
                          "with fewer replicas); the planned runs not finished are left out and counted")
 
 
+def user_errors() -> tuple:
+    """The exception types that mean "the input was wrong" (one line, exit status 2) rather than "the package has a
+    bug" (a traceback)."""
+    import openmm as mm
+
+    from ...integrators import SimulationBlowUpError
+    from ...methods import TableauError, UnknownMethodError
+
+    return (UnknownMethodError, TableauError, SimulationBlowUpError, mm.OpenMMException, ValueError, TypeError,
+            KeyError, OSError, RuntimeError, ImportError)
+
+
+#: What an interrupted study says.
+KEPT = "interrupted (finished runs are kept; run again to continue)"
+
+
+def run_command(prog: str, action, extra_errors: tuple = (), interrupted: str = "interrupted") -> int:
+    """The one frame of every ``symprk`` command: ``action()`` (its exit status, None for 0); an error of the input
+    (:func:`user_errors` and ``extra_errors``) is one line ``<prog>: error: ...`` with exit status 2, Ctrl-C exit
+    status 130 (``interrupted`` says what was kept), anything else a traceback."""
+    try:
+        return action() or 0
+    except KeyboardInterrupt:
+        print(f"{prog}: {interrupted}", file=sys.stderr)
+        return 130
+    except Exception as exc:
+        if isinstance(exc, user_errors() + tuple(extra_errors)):
+            print(f"{prog}: error: {exc}", file=sys.stderr)
+            return 2
+        raise
+
+
 def run_study_command(prog: str, args, cfg: dict, configure, study: str, report: str) -> int:
     """Apply ``configure(cfg)`` (the study's own options; raises ValueError on a bad one) and the common options,
     run ``run_study`` of the module ``study`` and print ``format_summary`` of the module ``report`` (both imported
     only then, so that ``--help`` and bad options answer at once).  ``args`` needs ``out``, ``workers``,
     ``scheduler``, ``no_progress`` and ``report_only``; ``replicas``, ``length_ps`` and ``no_timing`` apply where
     the command has them (a study without a timing option is not passed ``timing``)."""
-    try:
+    def run():
         configure(cfg)
         for key in ("replicas", "length_ps"):
             if getattr(args, key, None) is not None:
@@ -62,13 +95,8 @@ def run_study_command(prog: str, args, cfg: dict, configure, study: str, report:
         if hasattr(args, "no_timing"):
             options["timing"] = not args.no_timing
         summary = import_module(study).run_study(cfg, args.out, **options)
-    except KeyboardInterrupt:
-        print(f"{prog}: interrupted (finished runs are kept; run again to continue)", file=sys.stderr)
-        return 130
-    except (ValueError, KeyError, OSError, RuntimeError, ImportError) as exc:
-        print(f"{prog}: error: {exc}", file=sys.stderr)
-        return 2
-    print(import_module(report).format_summary(summary))
-    written = sorted(f for f in os.listdir(args.out) if f.endswith((".txt", ".json", ".png")))
-    print(f"\nwrote in {args.out}: {', '.join(written)}")
-    return 0
+        print(import_module(report).format_summary(summary))
+        written = sorted(f for f in os.listdir(args.out) if f.endswith((".txt", ".json", ".png")))
+        print(f"\nwrote in {args.out}: {', '.join(written)}")
+
+    return run_command(prog, run, interrupted=KEPT)

@@ -25,7 +25,8 @@ One grammar of labels, :meth:`Row.parse` reading what :attr:`Row.label` writes::
   nonbonded cutoff); T is the target temperature (default 300 K).
 
 The earlier grammars read as the same rows: the bench's ``<method>[/<inner>]@mts<n>``, ``openmm-mts<n>``,
-``openmm-langevin`` (with its step given apart), ``symprk nvt drift --rows`` ``method@step_fs``, and the
+``openmm-langevin`` (with its step given apart), ``symprk nvt drift --rows`` ``method@step_fs``, ``symprk
+equipartition --rows`` ``method:step_fs``, and the
 OpenMM names ``openmm-nosehoover``, ``openmm-dpd``, ``openmm-mtslangevin``, ``nosehoover``.
 """
 from __future__ import annotations
@@ -54,7 +55,7 @@ RIGID_PREFIX = "rigid:"
 _NUMBER = r"[0-9]*\.?[0-9]+(?:[eE][-+]?[0-9]+)?"
 _OLD_MTS = re.compile(rf"^(?P<who>[^/@\s]+)(?:/(?P<inner>[^@\s]+))?@mts(?P<n>[0-9]+)$")
 _OLD_OPENMM_MTS = re.compile(r"^openmm-mts(?P<n>[0-9]+)$")
-_OLD_AT_STEP = re.compile(rf"^(?P<who>[^@\s]+)@(?P<h>{_NUMBER})$")
+_OLD_AT_STEP = re.compile(rf"^(?P<who>[^@\s]+)[@:](?P<h>{_NUMBER})$")
 
 
 def split_groups(inner_steps: int) -> list:
@@ -205,6 +206,17 @@ class Row:
             return resolve(self.method, constraints, groups=split_groups(self.mts), inner_method=self.inner or None)
         return resolve(self.method, constraints)
 
+    def require_kick_drift(self, where: str):
+        """ValueError unless this package's method of the row is a kick/drift splitting or composition, which is what
+        ``where`` runs (constraints keep RATTLE; the rigid-body engine takes no other); OpenMM's rows pass."""
+        from ...methods.catalogue import get_method
+
+        m = get_method(self.method) if self.is_ours else None
+        if m is not None and not m.is_splitting:
+            raise ValueError(f"row {self.label!r}: {m.name} is a {m.family} method; {where} runs kick/drift splittings "
+                             f"and compositions only, e.g. verlet, omelyan-2, pefrl, yoshida-4 (symprk methods lists "
+                             f"their families)")
+
     def evals_per_step(self, constraints: bool | None = None) -> int:
         """Force (group) evaluations per step: from the resolved method; OpenMM's MTS: 1 + N, otherwise 1."""
         if self.is_ours:
@@ -268,7 +280,7 @@ class Row:
             who = m.groupdict().get("who") or "openmm-mts"
             if m.groupdict().get("inner"):
                 fields["inner"] = m["inner"]
-        elif _OLD_AT_STEP.match(who):  # symprk nvt drift --rows: method@step_fs
+        elif _OLD_AT_STEP.match(who):  # symprk nvt drift --rows method@step_fs, equipartition --rows method:step_fs
             m = _OLD_AT_STEP.match(who)
             who, fields["step_fs"] = m["who"], float(m["h"])
         elif "/" in who:

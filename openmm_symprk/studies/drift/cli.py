@@ -1,10 +1,12 @@
-"""``symprk drift``: NVE energy drift over independent replicas, paired rows, a verdict at 3 SE.
+"""``symprk drift``: energy drift over independent replicas, paired rows, a verdict at 3 SE.
 
     symprk drift hmr --quick                      # seconds: villin in vacuum stands in for the solvated box
     symprk drift hmr                              # 3 x 100 ps per row on solvated villin (hours; resumable)
     symprk drift exact-momentum --quick           # seconds
     symprk drift exact-momentum                   # 3 x 100 ps, CPU and OpenCL single/mixed/double, on and off
     symprk drift hmr --replicas 5                 # more replicas: the finished ones are reused
+    symprk drift nvt --quick                      # NVT (total + heat-bath energy) next to NVE (= symprk nvt drift)
+    symprk drift nvt --rows omelyan-2@4,nosehoover@2 --chart nvt.png
 
 Finished runs are kept in --out and reused when the same command runs again (an interrupted study continues).
 """
@@ -15,15 +17,17 @@ import os
 import sys
 
 from ..core.cli import run_study_command
+from ..core.platforms import split
 from . import presets
 
 
-def build_parser():
-    ap = argparse.ArgumentParser(prog="symprk drift", description=__doc__,
+def build_parser(prog: str = "symprk drift"):
+    ap = argparse.ArgumentParser(prog=prog, description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("study", choices=("hmr", "exact-momentum"),
+    ap.add_argument("study", choices=presets.STUDIES,
                     help="hmr: our verlet vs OpenMM's VerletIntegrator at 4 fs with HMR (docs/production.md); "
-                         "exact-momentum: drift with and without exact_momentum per precision (docs/conservation.md)")
+                         "exact-momentum: drift with and without exact_momentum per precision (docs/conservation.md); "
+                         "nvt: the thermostat's effective-energy drift next to NVE (docs/thermostat.md)")
     ap.add_argument("--quick", action="store_true", help="seconds: tiny runs, the pipeline end to end")
     ap.add_argument("--out", help="output folder (default drift-results/<study>[-quick]); finished runs are reused")
     ap.add_argument("--replicas", type=int, help="independent replicas per row (default 3)")
@@ -34,6 +38,10 @@ def build_parser():
     ap.add_argument("--platforms", help="exact-momentum: comma-separated, e.g. CPU,OpenCL:mixed "
                                         f"(default {','.join(presets.PRECISION_PLATFORMS)})")
     ap.add_argument("--no-control", action="store_true", help="hmr: skip the 2 fs non-HMR control pair")
+    ap.add_argument("--rows", metavar="METHOD@FS,...",
+                    help="nvt: only these pairs, e.g. omelyan-2@4,nosehoover@2 (default: the full set)")
+    ap.add_argument("--chart", help="nvt: also write the work-precision chart (PNG) here (always: <out>/nvt-drift.png)")
+    ap.add_argument("--json", help="also write the summary as JSON to this file (always: <out>/results.json)")
     ap.add_argument("--workers", type=int, default=1,
                     help="worker processes (default 1: runs use --threads each; 2 cores take one run at a time)")
     ap.add_argument("--scheduler", metavar="ADDRESS", help="Dask scheduler address instead of local workers")
@@ -43,15 +51,27 @@ def build_parser():
     return ap
 
 
+def _bad_platform(spec: str) -> bool:
+    try:
+        return split(spec)[0] not in ("CPU", "Reference", "OpenCL", "CUDA", "HIP")
+    except ValueError:
+        return True
+
+
 def make_config(args) -> dict:
-    if args.study == "hmr":
-        if args.platforms:
-            raise ValueError("--platforms applies to the exact-momentum study only")
+    if args.rows and args.study != "nvt":
+        raise ValueError("--rows applies to the nvt study only")
+    if args.chart and args.study != "nvt":
+        raise ValueError("--chart applies to the nvt study only")
+    if args.study in ("hmr", "nvt") and args.platforms:
+        raise ValueError("--platforms applies to the exact-momentum study only")
+    if args.study == "nvt":
+        cfg = presets.nvt(args.quick, [s.strip() for s in args.rows.split(",") if s.strip()] if args.rows else None)
+    elif args.study == "hmr":
         cfg = presets.hmr(args.quick, control=not args.no_control)
     else:
         platforms = [p for p in (args.platforms or "").split(",") if p] or presets.PRECISION_PLATFORMS
-        bad = [p for p in platforms if p.partition(":")[0] not in ("CPU", "Reference", "OpenCL", "CUDA", "HIP")
-               or p.partition(":")[2] not in ("", "single", "mixed", "double")]
+        bad = [p for p in platforms if _bad_platform(p)]
         if bad:
             raise ValueError(f"--platforms: {', '.join(bad)} not understood; give NAME or NAME:PRECISION, e.g. "
                              f"CPU,OpenCL:single,OpenCL:mixed,OpenCL:double")
@@ -64,12 +84,30 @@ def make_config(args) -> dict:
     return cfg
 
 
-def main(argv=None) -> int:
-    args = build_parser().parse_args(argv)
+def main(argv=None, prog: str = "symprk drift") -> int:
+    args = build_parser(prog).parse_args(argv)
     if not args.out:
         args.out = os.path.join("drift-results", args.study + ("-quick" if args.quick else ""))
-    return run_study_command("symprk drift", args, {}, lambda cfg: cfg.update(make_config(args)),
-                             "openmm_symprk.studies.drift.study", "openmm_symprk.studies.drift.report")
+    rc = run_study_command(prog, args, {}, lambda cfg: cfg.update(make_config(args)),
+                           "openmm_symprk.studies.drift.study", "openmm_symprk.studies.drift.report")
+    if rc == 0 and (args.chart or args.json):
+        import json
+        import shutil
+
+        from ...support.files import write_json
+
+        with open(os.path.join(args.out, "results.json")) as fh:
+            summary = json.load(fh)
+        if args.json:
+            write_json(args.json, summary)
+            print(f"wrote {args.json}")
+        if args.chart and not os.path.exists(os.path.join(args.out, "nvt-drift.png")):
+            print(f"{prog}: no chart was drawn (see above), so none is copied to {args.chart}", file=sys.stderr)
+        elif args.chart:
+            os.makedirs(os.path.dirname(os.path.abspath(args.chart)), exist_ok=True)
+            shutil.copyfile(os.path.join(args.out, "nvt-drift.png"), args.chart)
+            print(f"wrote {args.chart}")
+    return rc
 
 
 if __name__ == "__main__":

@@ -2,16 +2,20 @@
 
     {"study": name, "replicas": R, "length_ps": T, "sample_ps": dt, "decorrelate_ps": t, "temperature": K,
      "seed": s, "threads": n, "constraint_tolerance": tol,
-     "rows": [{"name", "scene", "integrator", "step_fs", "platform", "precision", "exact_momentum"}, ...],
+     "rows": [{"name", "scene", "row", "step_fs", "platform", "precision"}, ...],
      "comparisons": [{"row": name, "ref": name, "kind": "claim" | "cost", "factor": f | None}, ...]}
 
-A "claim" comparison asks whether ``row`` drifts less than ``ref`` (about ``factor`` times less);  a "cost"
-comparison whether ``row`` (an option switched on) drifts more than ``ref`` (switched off).  Both are paired by
-replica (:mod:`.verdict`).
+``row`` is a :class:`~..core.rows.Row` label (one line a row: who, step, thermostat, options); ``scene`` a named
+scene (:mod:`openmm_symprk.systems.scenes.named`).  A "claim" comparison asks whether ``row`` drifts less than
+``ref`` (about ``factor`` times less);  a "cost" comparison whether ``row`` (an option switched on: exact momentum,
+the thermostat) drifts more than ``ref`` (switched off).  Both are paired by replica (:mod:`.verdict`).
 """
 from __future__ import annotations
 
-__all__ = ["hmr", "exact_momentum", "PRECISION_PLATFORMS", "OPENMM_PUBLISHED"]
+from ..core.platforms import split
+from ..core.rows import Row
+
+__all__ = ["hmr", "exact_momentum", "nvt", "nvt_pairs", "PRECISION_PLATFORMS", "OPENMM_PUBLISHED", "STUDIES"]
 
 #: The platforms of the exact-momentum study: CPU (single-precision forces, double integration) and OpenCL in
 #: each precision (PoCL runs it on the CPU here).
@@ -30,10 +34,11 @@ def _common(quick: bool) -> dict:
             "seed": 101, "threads": 2, "constraint_tolerance": 1e-5}
 
 
-def _row(name, scene, integrator, step_fs, platform="CPU", exact_momentum=False):
-    plat, _, precision = platform.partition(":")
-    return {"name": name, "scene": scene, "integrator": integrator, "step_fs": float(step_fs), "platform": plat,
-            "precision": precision or None, "exact_momentum": bool(exact_momentum)}
+def _row(name, scene, label, platform="CPU"):
+    plat, precision = split(platform)
+    row = Row.parse(label)
+    return {"name": name, "scene": scene, "row": row.label, "step_fs": row.step_fs, "platform": plat,
+            "precision": precision}
 
 
 def hmr(quick: bool = False, control: bool = True) -> dict:
@@ -42,11 +47,11 @@ def hmr(quick: bool = False, control: bool = True) -> dict:
     as a control.  OpenMM's default constraint tolerance (1e-5), as the production study ran.  ``quick``: villin in
     vacuum (with and without HMR) instead of the solvated box, 0.2 ps per run: seconds, the pipeline only."""
     hmr_scene, plain = ("villin-vacuum-hmr", "villin-vacuum") if quick else ("villin-pme-hmr", "villin-pme")
-    rows = [_row("verlet 4 fs HMR", hmr_scene, "verlet", 4.0), _row("OpenMM Verlet 4 fs HMR", hmr_scene,
-                                                                     "openmm-verlet", 4.0)]
+    rows = [_row("verlet 4 fs HMR", hmr_scene, "verlet 4 fs"),
+            _row("OpenMM Verlet 4 fs HMR", hmr_scene, "openmm-verlet 4 fs")]
     comparisons = [{"row": "verlet 4 fs HMR", "ref": "OpenMM Verlet 4 fs HMR", "kind": "claim", "factor": 10.0}]
     if control:
-        rows += [_row("verlet 2 fs", plain, "verlet", 2.0), _row("OpenMM Verlet 2 fs", plain, "openmm-verlet", 2.0)]
+        rows += [_row("verlet 2 fs", plain, "verlet 2 fs"), _row("OpenMM Verlet 2 fs", plain, "openmm-verlet 2 fs")]
         comparisons.append({"row": "verlet 2 fs", "ref": "OpenMM Verlet 2 fs", "kind": "claim", "factor": None})
     return dict(_common(quick), study="hmr", mode="quick" if quick else "full", rows=rows, comparisons=comparisons)
 
@@ -57,8 +62,54 @@ def exact_momentum(quick: bool = False, platforms=PRECISION_PLATFORMS) -> dict:
     rows, comparisons = [], []
     for plat in platforms:
         off, on = f"{plat} off", f"{plat} on"
-        rows += [_row(off, "villin-vacuum", "verlet", 2.0, plat, False),
-                 _row(on, "villin-vacuum", "verlet", 2.0, plat, True)]
+        rows += [_row(off, "villin-vacuum", "verlet 2 fs", plat),
+                 _row(on, "villin-vacuum", "verlet 2 fs exact-momentum", plat)]
         comparisons.append({"row": on, "ref": off, "kind": "cost", "factor": None})
     return dict(_common(quick), study="exact-momentum", mode="quick" if quick else "full", rows=rows,
                 comparisons=comparisons)
+
+
+#: The NVT study's pairs: (NVT row, the NVE row of the same method and step).  Ours thermostatted by velocity
+#: rescaling (the package's default collision time 0.1 ps, every step) next to the same method without it;
+#: OpenMM's NoseHooverIntegrator (its own heat-bath energy) next to OpenMM's VerletIntegrator.
+NVT_PAIRS = ["verlet@1", "verlet@2", "verlet@3", "omelyan-2@4", "pefrl@4", "nosehoover@2"]
+NVT_QUICK = ["verlet@2", "omelyan-2@4"]
+
+
+def nvt_pairs(items) -> list:
+    """[(NVT name, NVT label, NVE name, NVE label)] from "method@step_fs" items (``nosehoover@2``: OpenMM's
+    NoseHooverIntegrator next to its VerletIntegrator); ValueError naming a bad item."""
+    out = []
+    for item in items:
+        if "@" not in item:
+            raise ValueError(f"row {item!r}: write method@step_fs, e.g. omelyan-2@4 or nosehoover@2")
+        row = Row.parse(item)
+        h = f"{row.step_fs:g} fs"
+        if row.who == "nose-hoover":
+            out.append((f"NoseHoover {h}", row.label, f"OpenMM Verlet {h}", f"openmm-verlet {h}"))
+        elif row.is_ours and not row.is_rigid:
+            out.append((f"{row.method} {h}", f"{row.method} {h} SVR 0.1 ps", f"{row.method} {h} NVE", f"{row.method} {h}"))
+        else:
+            raise ValueError(f"row {item!r}: the NVT study pairs catalogue methods and nosehoover")
+    if not out:
+        raise ValueError("no rows: write method@step_fs,..., e.g. verlet@2,omelyan-2@4")
+    return out
+
+
+def nvt(quick: bool = False, items=None) -> dict:
+    """The NVT study (docs/thermostat.md, "Measurements"): with the thermostat on, total + heat-bath energy is
+    conserved but for the integrator's error, so its drift should be the NVE drift of the same method and step;
+    each NVT row is compared with its NVE row replica by replica.  216 rigid TIP3P waters, PME 0.9 nm (the named
+    scene ``water-box-216``), CPU platform.  ``items``: "method@step_fs" pairs instead of the full set.  ``quick``:
+    two pairs, one replica of 0.2 ps (seconds, the pipeline only)."""
+    rows, comparisons = [], []
+    for nvt_name, nvt_label, nve_name, nve_label in nvt_pairs(items or (NVT_QUICK if quick else NVT_PAIRS)):
+        rows += [_row(nvt_name, "water-box-216", nvt_label), _row(nve_name, "water-box-216", nve_label)]
+        comparisons.append({"row": nvt_name, "ref": nve_name, "kind": "cost", "factor": None})
+    common = dict(_common(quick), replicas=1 if quick else 3, length_ps=0.2 if quick else 20.0,
+                  sample_ps=0.008 if quick else 0.02, decorrelate_ps=0.1 if quick else 2.0, threads=2)
+    return dict(common, study="nvt", mode="quick" if quick else "full", rows=rows, comparisons=comparisons)
+
+
+#: The studies by name (``symprk drift NAME``).
+STUDIES = ("hmr", "exact-momentum", "nvt")

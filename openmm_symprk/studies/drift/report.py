@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from .presets import OPENMM_PUBLISHED
+from .runs import row_of
 from .verdict import K_SE, claim_verdict, cost_verdict, row_estimate, run_drift
 
 __all__ = ["summarise", "format_summary"]
@@ -28,7 +29,10 @@ def summarise(cfg: dict, found: dict, skipped=()) -> dict:
             walls.append(info["wall_per_ps"])
         per_row[row["name"]] = drifts
         est = row_estimate(drifts)
-        rows.append(dict(row, replicas_done=len(drifts), failed=failed, drift=_est(est),
+        spec = row_of(row)
+        rows.append(dict(row, replicas_done=len(drifts), failed=failed, drift=_est(est), ensemble=spec.ensemble,
+                         exact_momentum=spec.exact_momentum,
+                         evals_per_ps=spec.evals_per_ps(),
                          per_replica={str(r): list(v) for r, v in sorted(drifts.items())},
                          wall_s_per_ps=float(np.mean(walls)) if walls else None,
                          skipped=row["name"] in skipped))
@@ -84,6 +88,8 @@ def format_summary(s: dict) -> str:
             if c["kind"] == "claim" else " (does it cost?)"
         out.append(f"| {c['row']} | {c['ref']} | {_pm(c.get('difference'))} | {ratio} | {speed} | "
                    f"**{c['verdict']}**{claim} |")
+    if cfg.get("study") == "nvt":
+        out += ["", format_nvt(s)]
     if s.get("openmm_published"):
         pub = ", ".join(f"{k} {v:.1e}" for k, v in s["openmm_published"].items())
         out += ["", f"OpenMM's published drift (kT/ns/DOF; user guide, Testing and Validation, Energy Conservation: "
@@ -92,3 +98,16 @@ def format_summary(s: dict) -> str:
                 f"drift is not resolved from zero at {s['k_se']:g} SE); speed ratio: reference's wall time per ps / "
                 f"the row's (> 1: the row is faster; same process, in sequence)."]
     return "\n".join(out)
+
+
+def format_nvt(s: dict) -> str:
+    """The NVT study's table: per pair the NVT drift (total + heat-bath energy), the NVE drift of the same method and
+    step, and their difference paired by replica."""
+    rows = {r["name"]: r for r in s["rows"]}
+    lines = [f"{'NVT row':18s} {'f/ps':>6s} {'NVT drift':>20s} {'NVE drift (same step)':>22s} {'NVT - NVE (paired)':>20s}"]
+    for c in s["comparisons"]:
+        nvt, nve = rows[c["row"]], rows[c["ref"]]
+        lines.append(f"{c['row']:18s} {nvt['evals_per_ps']:6.0f} {_pm(nvt['drift']):>20s} {_pm(nve['drift']):>22s} "
+                     f"{_pm(c.get('difference')):>20s}")
+    lines.append("kT/ns/DOF; NVT: total + heat-bath energy; the NVE row of NoseHoover is OpenMM's VerletIntegrator")
+    return "\n".join(lines)

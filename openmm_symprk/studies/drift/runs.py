@@ -1,10 +1,10 @@
-"""One NVE run of a drift study: a row (integrator, step, platform, precision, exact_momentum) from one replica state.
+"""One run of a drift study: a row (a :class:`~..core.rows.Row` label, platform, precision) from one replica state.
 
-Rows: ``integrator`` is ``"openmm-verlet"`` (OpenMM's VerletIntegrator, leapfrog: it starts from
-v(-h/2) = v0 - (h/2) F(x0)/m, constrained, the bench's convention) or a catalogue method run by
-:class:`~openmm_symprk.SymplecticIntegrator` (native backend where available), with ``exact_momentum``.  The total
-energy is sampled every ``sample_ps``; what is stored is the series itself (t, E), so the drift and its error are
-computed when the study summarises (:func:`.verdict.run_drift`) and a better estimator needs no rerun.
+A leapfrog row (OpenMM's VerletIntegrator) starts from v(-h/2) = v0 - (h/2) F(x0)/m, constrained
+(:meth:`~..core.rows.Row.set_state`).  The effective energy -- the total energy, plus the heat-bath energy of a
+thermostat that reports one (``computeHeatBathEnergy``; zero at the start) -- is sampled every ``sample_ps``; what
+is stored is the series itself (t, E), so the drift and its error are computed when the study summarises
+(:func:`.verdict.run_drift`) and a better estimator needs no rerun.
 """
 from __future__ import annotations
 
@@ -14,33 +14,30 @@ import numpy as np
 import openmm as mm
 import openmm.unit as unit
 
+from ..core.platforms import properties
 from ..core.rows import Row
 
-__all__ = ["row_of", "properties", "run_nve"]
+__all__ = ["row_of", "run_nve"]
 
 
 def row_of(row: dict) -> Row:
-    """The :class:`~..core.rows.Row` of a drift row (``integrator``, ``step_fs``, ``exact_momentum``)."""
+    """The :class:`~..core.rows.Row` of a drift row: its ``row`` label, or (rows stored by earlier versions)
+    ``integrator``, ``step_fs`` and ``exact_momentum``."""
+    if "row" in row:
+        return Row.parse(row["row"])
     return Row(row["integrator"], float(row["step_fs"]), exact_momentum=bool(row.get("exact_momentum", False)))
 
 
-def properties(row: dict, threads: int) -> dict:
-    if row["platform"] == "CPU":
-        return {"Threads": str(int(threads))}
-    if row.get("precision"):
-        return {"Precision": row["precision"]}
-    return {}
-
-
-def run_nve(system, x0, v0, row: dict, cfg: dict):
-    """(arrays {"t": ps, "e": kJ/mol}, info) of one NVE run; a blow-up is a record (status "blew-up"), not an
-    exception."""
+def run_nve(system, x0, v0, row: dict, cfg: dict, seed: int = 1):
+    """(arrays {"t": ps, "e": kJ/mol}, info) of one run (``seed``: a stochastic row's random seed); a blow-up is a
+    record (status "blew-up"), not an exception."""
     from ...systems.properties import degrees_of_freedom
 
     spec = row_of(row)
-    ig = spec.build(system, constraint_tolerance=cfg["constraint_tolerance"])
+    ig = spec.build(system, seed=seed, constraint_tolerance=cfg["constraint_tolerance"])
+    heat = ig.computeHeatBathEnergy if spec.thermostat and spec.has_heat_bath else None
     plat = mm.Platform.getPlatformByName(row["platform"])
-    ctx = mm.Context(system, ig, plat, properties(row, cfg.get("threads", 1)))
+    ctx = mm.Context(system, ig, plat, properties(row["platform"], cfg.get("threads", 1), row.get("precision")))
     info = {"status": "ok", "n_dof": int(degrees_of_freedom(system)), "platform_used": plat.getName()}
     try:
         spec.set_state(ctx, x0, v0)
@@ -52,7 +49,10 @@ def run_nve(system, x0, v0, row: dict, cfg: dict):
         def sample(step):
             e = ctx.getState(getEnergy=True)
             ts.append(step * h_ps)
-            es.append((e.getKineticEnergy() + e.getPotentialEnergy()).value_in_unit(unit.kilojoule_per_mole))
+            total = e.getKineticEnergy() + e.getPotentialEnergy()
+            if heat is not None and step:  # zero at the start (OpenMM 8.6's NoseHooverIntegrator crashes if asked)
+                total += heat()
+            es.append(total.value_in_unit(unit.kilojoule_per_mole))
 
         sample(0)
         done, t0, timed_from = 0, time.perf_counter(), 0

@@ -1,6 +1,6 @@
-"""The drift study on the studies' skeleton: replica states per scene, one stored NVE run per (row, replica).
+"""The drift study on the studies' skeleton: replica states per scene, one stored run per (row, replica).
 
-``<out>/states/`` holds the scenes and their replica states (:mod:`.scenes`), ``<out>/runs/<key>.json`` + ``.npz``
+``<out>/states/`` holds the scenes and their replica states (:mod:`openmm_symprk.systems.scenes`), ``<out>/runs/<key>.json`` + ``.npz``
 one finished run each.  A run's key hashes everything it depends on (the row, the replica, the run length, the
 sampling, the constraint tolerance, the threads and the key of its replica states), so calling the study again
 reuses every finished run, and a changed setting never reuses a stale one.  ``summary.txt`` and ``results.json``
@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import os
 
-from ..core import Run, Study, run_key as hash_key, write_json, write_text
+from ..core import Run, Study, platforms, run_key as hash_key, write_json, write_text
 from ...systems.scenes.replicas import replica_states, state_key
 
 __all__ = ["DriftStudy", "run_study", "run_key", "check"]
@@ -18,7 +18,19 @@ __all__ = ["DriftStudy", "run_study", "run_key", "check"]
 #: Version of what a run stores (a change never reuses stale runs).
 RUN_VERSION = 1
 _RUN_KEYS = ("length_ps", "sample_ps", "constraint_tolerance", "threads", "temperature")
-_ROW_KEYS = ("scene", "integrator", "step_fs", "platform", "precision", "exact_momentum")
+
+
+def _row_key(row: dict) -> dict:
+    """What a run's key hashes of its row: the fields of the rows of earlier versions (so their stored runs are
+    found again), and the row's label where it says more than those (a thermostat, multiple time stepping, ...)."""
+    from .runs import row_of
+
+    r = row_of(row)
+    out = {"scene": row["scene"], "integrator": r.who, "step_fs": r.step_fs, "platform": row["platform"],
+           "precision": row.get("precision"), "exact_momentum": r.exact_momentum}
+    if r != type(r)(r.who, r.step_fs, exact_momentum=r.exact_momentum):
+        out["row"] = r.label
+    return out
 
 
 def scene_state_key(cfg: dict, scene: str) -> str:
@@ -32,7 +44,7 @@ def states_of(cfg: dict, scene: str, out: str, log=print) -> dict:
 
 
 def run_key(cfg: dict, row: dict, replica: int) -> str:
-    return hash_key({"cfg": {k: cfg[k] for k in _RUN_KEYS}, "row": {k: row.get(k) for k in _ROW_KEYS},
+    return hash_key({"cfg": {k: cfg[k] for k in _RUN_KEYS}, "row": _row_key(row),
                      "replica": int(replica), "states": scene_state_key(cfg, row["scene"]), "version": RUN_VERSION})
 
 
@@ -53,28 +65,16 @@ def check(cfg: dict):
     for row in cfg["rows"]:
         if row["scene"] not in SCENES:
             raise ValueError(f"row {row['name']}: unknown scene {row['scene']!r}; known: {', '.join(SCENES)}")
-        if not float(row["step_fs"]) > 0:
-            raise ValueError(f"row {row['name']}: step_fs must be positive, got {row['step_fs']!r}")
         from .runs import row_of
 
-        row_of(row)  # ValueError naming the catalogue and OpenMM's integrators
-        n = float(cfg["length_ps"]) * 1e3 / float(row["step_fs"])
+        step = row_of(row).step_fs  # ValueError naming the catalogue and OpenMM's integrators
+        n = float(cfg["length_ps"]) * 1e3 / step
         if round(n) < 3:
-            raise ValueError(f"row {row['name']}: {cfg['length_ps']} ps is under 3 steps of {row['step_fs']} fs")
+            raise ValueError(f"row {row['name']}: {cfg['length_ps']} ps is under 3 steps of {step:g} fs")
     for c in cfg["comparisons"]:
         for k in ("row", "ref"):
             if c[k] not in names:
                 raise ValueError(f"comparison {c}: no row named {c[k]!r} (rows: {', '.join(names)})")
-
-
-def available(platform: str) -> bool:
-    import openmm as mm
-
-    try:
-        mm.Platform.getPlatformByName(platform)
-        return True
-    except Exception:
-        return False
 
 
 _systems: dict = {}
@@ -89,7 +89,8 @@ def work(shared: dict, row: dict, replica: int, cfg: dict):
     key = (row["scene"], len(shared["xml"]), hash(shared["xml"]))
     if key not in _systems:
         _systems[key] = mm.XmlSerializer.deserialize(shared["xml"])
-    return run_nve(_systems[key], shared["x"][replica], shared["v"][replica], row, cfg)
+    return run_nve(_systems[key], shared["x"][replica], shared["v"][replica], row, cfg,
+                   seed=int(cfg["seed"]) * 1000 + int(replica) + 1)
 
 
 class DriftStudy(Study):
@@ -110,7 +111,7 @@ class DriftStudy(Study):
         """The rows whose platform this installation has."""
         rows, self.skipped = [], []
         for row in self.cfg["rows"]:
-            (rows if available(row["platform"]) else self.skipped).append(row)
+            (rows if platforms.available(row["platform"]) else self.skipped).append(row)
         for row in self.skipped:
             self.log(f"skipping row {row['name']}: no OpenMM platform {row['platform']} here")
         return rows
@@ -120,8 +121,10 @@ class DriftStudy(Study):
         rows = self.rows()
         self.states = {s: states_of(cfg, s, self.out, self.log) for s in dict.fromkeys(r["scene"] for r in rows)}
         runs = []
+        from .runs import row_of
+
         for row in rows:
-            cost = float(cfg["length_ps"]) / float(row["step_fs"]) * (10.0 if "pme" in row["scene"] else 1.0)
+            cost = float(cfg["length_ps"]) * row_of(row).evals_per_ps() * (10.0 if "pme" in row["scene"] else 1.0)
             for r in range(int(cfg["replicas"])):
                 runs.append(Run(run_key(cfg, row, r), row["scene"], (row, r, cfg),
                                 {"row": row["name"], "replica": r, "scene": row["scene"]}, cost))
@@ -141,6 +144,13 @@ class DriftStudy(Study):
         summary = summarise(self.cfg, {k[0]: v for k, v in found.items()}, skipped=[r["name"] for r in self.skipped])
         write_json(os.path.join(self.out, "results.json"), summary)
         write_text(os.path.join(self.out, "summary.txt"), format_summary(summary) + "\n")
+        if self.cfg.get("study") == "nvt":
+            from .chart import work_precision
+
+            try:
+                work_precision(summary, os.path.join(self.out, "nvt-drift.png"))
+            except ImportError as exc:  # MissingDependencyError says which extra installs matplotlib
+                self.log(f"no chart: {exc}")
         return summary
 
 

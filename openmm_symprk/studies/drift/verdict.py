@@ -14,12 +14,10 @@ from __future__ import annotations
 import numpy as np
 
 from ...stats import Estimate, combine, drift, paired
+from ..core.units import kt_per_ns_per_dof
 
-__all__ = ["R_KJ", "run_drift", "row_estimate", "magnitude", "ratio", "claim_verdict", "cost_verdict", "K_SE",
-           "NOT_HALVED"]
+__all__ = ["run_drift", "row_estimate", "magnitude", "ratio", "claim_verdict", "cost_verdict", "K_SE", "NOT_HALVED"]
 
-#: Gas constant, kJ/mol/K.
-R_KJ = 0.0083144626
 #: Standard errors for a verdict.
 K_SE = 3.0
 #: A claim "a drifts about f times less than b" (f >= 2) is refuted when a/b is resolved above this.
@@ -30,9 +28,8 @@ def run_drift(t_ps, e_kj, n_dof: int, temperature: float) -> tuple[float, float]
     """(drift, standard error) in kT per ns per degree of freedom of the energy series e(t) (kJ/mol, ps)."""
     if n_dof < 1:
         raise ValueError(f"n_dof must be >= 1, got {n_dof}")
-    kt = R_KJ * float(temperature)
     fit = drift(np.asarray(t_ps, dtype=np.float64), np.asarray(e_kj, dtype=np.float64) / n_dof)
-    return fit.slope * 1e3 / kt, fit.se * 1e3 / kt
+    return kt_per_ns_per_dof(fit.slope, temperature), kt_per_ns_per_dof(fit.se, temperature)
 
 
 def row_estimate(reps: dict) -> Estimate | None:

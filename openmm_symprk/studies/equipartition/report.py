@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ...physics.temperature import R_KJ
+from ..core.units import kt_per_ns_per_dof
 from ...support import require
 from ..core.rows import Row
 from .runs import force_evals_per_step
@@ -25,7 +25,8 @@ __all__ = ["summarise", "format_summary", "chart", "label"]
 
 
 def label(method: str, step_fs: float) -> str:
-    return f"{method} {step_fs:g} fs"
+    """The row's label (:attr:`~..core.rows.Row.label`), e.g. 'rigid:verlet 2 fs'."""
+    return Row(method, step_fs).label
 
 
 def _estimate_dict(e: Estimate) -> dict:
@@ -41,7 +42,6 @@ def _row_stats(reps, n_waters, temperature):
     taus = []
     replicas = [int(info["replica"]) for _, info in reps]
     dof = 6 * n_waters - 3
-    kT = R_KJ * temperature
     for arrays, _ in reps:
         t = arrays["t"]
         ok = np.isfinite(arrays["etot"])
@@ -53,7 +53,7 @@ def _row_stats(reps, n_waters, temperature):
         per["T_rot"].append(series_stats(arrays["T_rot"][ok], dt))
         per["pe"].append(series_stats(arrays["pe"][ok] / n_waters, dt))
         slope, se = drift(t[ok], arrays["etot"][ok])  # kJ/mol/ps
-        per["drift"].append((slope * 1000.0 / (kT * dof), se * 1000.0 / (kT * dof)))
+        per["drift"].append((kt_per_ns_per_dof(slope, temperature, dof), kt_per_ns_per_dof(se, temperature, dof)))
     out = {}
     for k, vals in per.items():
         if k == "drift":

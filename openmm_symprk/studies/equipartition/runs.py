@@ -10,14 +10,12 @@ from __future__ import annotations
 import time
 
 import numpy as np
-import openmm as mm
-import openmm.unit as unit
 
 from ...physics.momenta import kinetic_energy
 from ...physics.temperature import kinetic_temperatures
-from ...rigid.bodies import RigidBodies
 from ...systems.prepare import equilibrate, minimise, without_net_momentum
 from ...systems.scenes import WATER_DENSITY_G_CM3, Scene, water_box
+from ..core.engine import RowEngine
 from ..core.rows import Row
 
 __all__ = ["build_box", "replica_states", "run_nve", "steps_per_sample", "force_evals_per_step", "make_engine"]
@@ -72,38 +70,9 @@ def steps_per_sample(step_fs: float, sample_fs: float) -> int:
     return max(1, int(round(sample_fs / step_fs)))
 
 
-class _Constrained:
-    def __init__(self, box, x, v, row, props):
-        self.integrator = row.build(box.system)
-        self.context = mm.Context(box.system, self.integrator, mm.Platform.getPlatformByName("CPU"), props)
-        self.context.setPositions(x)
-        self.context.setVelocities(v)
-
-    def step(self, n):
-        self.integrator.step(n)
-
-    def sample(self):
-        st = self.context.getState(getPositions=True, getVelocities=True, getEnergy=True)
-        x = st.getPositions(asNumpy=True).value_in_unit(unit.nanometer)
-        v = st.getVelocities(asNumpy=True).value_in_unit(unit.nanometer / unit.picosecond)
-        return np.asarray(x), np.asarray(v), st.getPotentialEnergy().value_in_unit(unit.kilojoule_per_mole)
-
-
-class _Rigid:
-    def __init__(self, box, x, v, row, props):
-        self.engine = RigidBodies(box.system, x, v, box.molecules, row.h_ps, row.method, "CPU", props)
-
-    def step(self, n):
-        self.engine.step(n)
-
-    def sample(self):
-        return self.engine.positions(), self.engine.velocities(), self.engine.potential_energy()
-
-
 def make_engine(box, x, v, method, step_fs, threads):
     """The running row ``method`` at ``step_fs`` (``rigid:<method>``: the rigid-body engine) from (x, v)."""
-    row = Row(method, float(step_fs))
-    return (_Rigid if row.is_rigid else _Constrained)(box, x, v, row, {"Threads": str(threads)})
+    return RowEngine(box, x, v, Row(method, float(step_fs)), threads=threads)
 
 
 def run_nve(box: Scene, x, v, method: str, step_fs: float, cfg: dict):

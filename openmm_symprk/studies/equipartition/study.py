@@ -113,16 +113,11 @@ def _check(cfg):
     for k in ("length_ps", "sample_fs", "equilibrate_ps", "cutoff_nm", "temperature"):
         if not float(cfg[k]) > 0:
             raise ValueError(f"{k} must be positive, got {cfg[k]!r}")
-    from ...methods.catalogue import get_method
     from ..core.rows import Row
 
     for model, rows in cfg["models"].items():
         for method, h in rows:
-            m = get_method(Row(method, 1.0).method)
-            if not m.is_splitting:
-                raise ValueError(f"{model}: row {method} is a {m.family} method; rigid water (constraints, or the "
-                                 f"rigid-body engine) runs kick/drift splittings and compositions only, e.g. "
-                                 f"verlet, omelyan-2, pefrl, yoshida-4 (symprk methods lists their families)")
+            Row(method, 1.0).require_kick_drift(f"{model}: rigid water (constraints, or the rigid-body engine)")
             if not float(h) > 0:
                 raise ValueError(f"{model}: step size of {method} must be positive, got {h!r}")
         if list(cfg["reference"]) not in [[m, float(h)] for m, h in rows]:

@@ -119,6 +119,39 @@ int main() {
         expect(verletPlan == vector<string>({"kick substep=0 c=0.5 groups=0x2 reuse", "drift substep=1 c=1",
                                              "kick substep=2 c=0.5 groups=0x2 check", "project"}),
                "velocity Verlet's plan with the integration force groups {1}");
+
+        // the middle placement: the Thermostat sub-step between the drift's halves is the only event, in the middle
+        // step of each interval of 3 (phase 1), with c = exp(-1*3*dt/tau); no ends events
+        const int T = SymPRKIntegrator::Thermostat;
+        SymPRKIntegrator middle(0.001, {K, D, T, D, K}, {0.5, 0.5, 1.0, 0.5, 0.5}, {-1, -1, -1, -1, -1}, {cached, 0, 0, 0, 0});
+        middle.setThermostat(300.0, 0.1, 3, 3*3-1-3, false);
+        Context context3(system, middle, Platform::getPlatformByName("Reference"));
+        context3.setPositions({Vec3(0, 0, 0), Vec3(0.1, 0, 0), Vec3(0.2, 0.05, 0)});
+        context3.setVelocities({Vec3(0.1, 0.2, -0.1), Vec3(-0.3, 0.1, 0.2), Vec3(0.05, -0.2, 0.1)});
+        const vector<string> middlePlan = {"kick substep=0 c=0.5 groups=0xffffffff reuse", "drift substep=1 c=0.5",
+                                           "thermostat substep=2 c=1 phase=1/3", "drift substep=3 c=0.5",
+                                           "kick substep=4 c=0.5 groups=0xffffffff check", "project"};
+        expect(middle.getStepPlan() == middlePlan, "the plan of the middle placement");
+        middle.setExecutionTraceEnabled(true);
+        middle.step(7);
+        vector<int> eventSteps;
+        const vector<int> middleTrace = middle.getExecutionTrace();
+        for (size_t i = 0; i < middleTrace.size(); i += 3)
+            if (middleTrace[i+1] == 2)
+                eventSteps.push_back(middleTrace[i]);
+        expect(eventSteps == vector<int>({2, 5}), "the middle events run in steps 2 and 5 of 7");
+        expect(middle.getHeatBathEnergy() != 0.0, "the middle events exchange heat");
+
+        // a Thermostat sub-step needs a thermostat
+        SymPRKIntegrator bare(0.001, {K, D, T, D, K}, {0.5, 0.5, 1.0, 0.5, 0.5}, {-1, -1, -1, -1, -1}, {cached, 0, 0, 0, 0});
+        bool refused = false;
+        try {
+            Context context4(system, bare, Platform::getPlatformByName("Reference"));
+        }
+        catch (const OpenMMException& e) {
+            refused = (string(e.what()).find("sub-step 2 is a thermostat event, but the integrator has no thermostat") != string::npos);
+        }
+        expect(refused, "a Thermostat sub-step without a thermostat is refused when the Context is created");
     }
     catch (const exception& e) {
         cerr << "exception: " << e.what() << endl;

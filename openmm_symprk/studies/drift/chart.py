@@ -1,4 +1,4 @@
-"""The NVT work-precision chart: the effective-energy drift (kT/ns/DOF, signed, one standard error) against force
+"""The NVT study's work-precision chart: the effective-energy drift (kT/ns/DOF, signed, one standard error) against force
 evaluations per ps, NVT rows filled, the NVE drift of the same method and step hollow beside it (matplotlib, Agg
 backend, PNG).  The y axis is symmetric-logarithmic: linear within +-0.01 kT/ns/DOF, so a drift consistent with
 zero shows as such and the sign is kept."""
@@ -9,13 +9,17 @@ import os
 from ...support import require
 
 
-def work_precision(result: dict, path: str) -> str:
-    require("matplotlib", "studies", "openmm_symprk.studies.nvt.chart").use("Agg")
-    plt = require("matplotlib.pyplot", "studies", "openmm_symprk.studies.nvt.chart")
+def work_precision(summary: dict, path: str) -> str:
+    """Draw the chart of a summary of the NVT study (:func:`.report.summarise`) into ``path``; returns ``path``."""
+    require("matplotlib", "studies", "openmm_symprk.studies.drift.chart").use("Agg")
+    plt = require("matplotlib.pyplot", "studies", "openmm_symprk.studies.drift.chart")
     fig, ax = plt.subplots(figsize=(7.0, 4.6))
     colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
-    xs = [r["evals_per_ps"] for r in result["rows"]]
-    for i, r in enumerate(result["rows"]):
+    by = {r["name"]: r for r in summary["rows"]}
+    pairs = [{"nvt_row": c["row"], "evals_per_ps": by[c["row"]]["evals_per_ps"], "nvt": by[c["row"]]["drift"],
+              "nve": by[c["ref"]]["drift"]} for c in summary["comparisons"]]
+    xs = [r["evals_per_ps"] for r in pairs]
+    for i, r in enumerate(pairs):
         c = colours[i % len(colours)]
         x = xs[i]
         same = [j for j, y in enumerate(xs) if y == x]  # rows of one cost side by side
@@ -28,15 +32,16 @@ def work_precision(result: dict, path: str) -> str:
     ax.axhline(0.0, color="grey", lw=0.8)
     ax.set_xscale("log")
     ax.set_yscale("symlog", linthresh=0.01)
-    ticker = require("matplotlib.ticker", "studies", "openmm_symprk.studies.nvt.chart")
+    ticker = require("matplotlib.ticker", "studies", "openmm_symprk.studies.drift.chart")
     ax.xaxis.set_major_formatter(ticker.ScalarFormatter())
     ax.xaxis.set_minor_formatter(ticker.NullFormatter())
     ax.set_xticks(sorted(set(xs)))
     ax.set_xlim(min(xs) / 1.4, max(xs) * 1.4)
     ax.set_xlabel("force evaluations per ps (cost)")
     ax.set_ylabel("drift of the (effective) energy, kT/ns/DOF")
-    ax.set_title(f"NVT (filled: total + heat-bath energy) and NVE (hollow), {result['replicas']} x "
-                 f"{result['length_ps']:g} ps\n{result['scene']}, {result['platform']}", fontsize=9)
+    cfg = summary["config"]
+    ax.set_title(f"NVT (filled: total + heat-bath energy) and NVE (hollow), {cfg['replicas']} x "
+                 f"{cfg['length_ps']:g} ps\n{cfg['rows'][0]['scene']}, {cfg['rows'][0]['platform']}", fontsize=9)
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)
     fig.tight_layout()
