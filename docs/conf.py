@@ -39,7 +39,7 @@ extensions = [
 
 source_suffix = {".rst": "restructuredtext", ".md": "markdown"}
 root_doc = "index"
-exclude_patterns = ["_build"]
+exclude_patterns = ["_build", "data"]  # data: studies' committed results (docs/data/fidelity), not pages
 
 # -- the pages (MyST) --------------------------------------------------------------------------------------
 #: Markdown headings up to this level get GitHub-style anchors, so that links such as thermostat.md#api work.
