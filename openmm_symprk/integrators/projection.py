@@ -31,7 +31,11 @@ Precision
 Exactness needs the net force and the torque summed precisely, from the same forces and masses the
 kick uses.  Errors in r_cm and I only scale the removed correction by a relative amount of their own
 size: they leave a residual of (round-off) x (round-off).  The moments are summed about the origin and
-shifted to the centre of mass in global (double) expressions.
+shifted to the centre of mass in global (double) expressions; far from the origin that shift cancels, but only
+the removed correction's size suffers, so it stays harmless here (measured, an 8-water cluster, 500 Verlet steps
+on Reference: |dL|/|L| about the centre of mass 2e-15 at the origin, 2e-11 at 1e4 nm and 3e-10 at 1e5 nm, the
+positions' own precision there; summing about the centre of mass instead gave 1e-11 and 5e-10).  The thermostat's
+kept rotation, which is not such a correction, is computed about the centre of mass (:mod:`.thermostat_program`).
 
 Masses.  On OpenCL/CUDA in single and mixed precision the per-DOF ``m`` of a CustomIntegrator is a
 single-precision reciprocal of the stored inverse mass (measured: relative error 3e-8 on PoCL), so

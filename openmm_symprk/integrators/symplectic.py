@@ -35,10 +35,14 @@ class SymplecticIntegrator(IntegratorBase):
       takes ``allow_nonsymplectic``, ``constraints``, ``tolerance`` and ``max_iterations``
       (see :class:`~openmm_symprk.integrators.custom_backend.PRKIntegrator`);
     * NVT: ``temperature`` (K, needs ``system=``), ``collision_time`` (ps, default 0.1), ``thermostat_interval``
-      (default 1) and ``random_seed`` (default 0: fresh per Context) add stochastic velocity rescaling around
-      the step, keeping total momentum (and angular momentum of an isolated System) exactly
-      (:mod:`openmm_symprk.integrators.thermostat`, docs/thermostat.md); accessors ``getTemperature``,
-      ``setTemperature``, ``computeHeatBathEnergy``, ``thermostat_dof``... (:class:`~.base.IntegratorBase`).
+      (default 1, at most 2**31 - 1), ``random_seed`` (default 0: fresh per Context) and ``thermostat_position``
+      ("ends", the default: half events around the step; "middle": one event at the step's centre, exact
+      configurations for Verlet; "auto": the better of the two for the method, docs/thermostat.md) add stochastic
+      velocity rescaling, keeping total momentum (and angular momentum of an isolated System) exactly
+      (:mod:`openmm_symprk.integrators.thermostat`); accessors ``getTemperature``, ``setTemperature``,
+      ``computeHeatBathEnergy``, ``thermostat_kinetic_energy``, ``thermostat_dof``... (:class:`~.base.IntegratorBase`).
+      The thermostat needs a peculiar kinetic energy to scale: a System at rest or moving as a rigid whole stays
+      so (a warning says so); start with velocities drawn at the temperature.
 
     The options are checked once, into one frozen :class:`~.options.IntegratorOptions` (``integrator.options``),
     which the backend reads; ``integrator.resolved`` is the method as it runs, ``integrator.program_info`` the facts

@@ -56,9 +56,11 @@ def test_quick_prints_every_observable_for_every_row(quick):
             assert r["values"][key] is not None and r["values"][key]["se"] > 0, (lab, key)
         assert 1.0 < r["values"]["D"]["mean"] < 15.0 and 0.26 < r["values"]["g_r"]["mean"] < 0.30
         assert 5.0 < r["values"]["w_zero"]["mean"] < 40.0  # the librations: omega's first zero within tens of fs
-        has_bath = r["row"]["kind"] in ("symprk", "nose-hoover")
+        d = describe(r["row"])
+        has_bath = d["family"] == "symprk" or lab.startswith(("nose-hoover", "openmm-verlet"))
         assert (r["values"]["drift"] is not None) == has_bath, lab
-        assert r["evals_per_ps"] == pytest.approx(describe(r["row"])["evals_per_step"] * 1000 / r["row"]["step_fs"])
+        assert r["evals_per_ps"] == pytest.approx(d["evals_per_step"] * 1000 / d["step_fs"])
+        assert r["reference"] == res["references"][d["ensemble"]]
         assert r["s_per_ps"] > 0
 
 
@@ -72,7 +74,7 @@ def test_the_equipartition_view_is_made_from_the_same_runs(quick):
     fid = {r["label"]: r for r in res["rows"]}
     assert view["reference"] == "verlet 0.5 fs"
     assert [r["label"] for r in view["rows"]] == ["verlet 0.5 fs", "verlet 1 fs", "verlet 2 fs", "verlet 3 fs",
-                                                  "omelyan-2 4 fs", "pefrl 4 fs"]
+                                                  "omelyan-2 4 fs", "omelyan-2 5 fs", "omelyan-2 6 fs", "pefrl 4 fs"]
     for r in view["rows"]:
         assert r["replicas"] == 2 and r["dT"]["mean"] == pytest.approx(fid[r["label"]]["values"]["dT"]["mean"])
         assert r["pe"]["mean"] == pytest.approx(fid[r["label"]]["values"]["pe"]["mean"])
@@ -102,7 +104,7 @@ def test_a_second_call_reuses_every_run(quick):
     _, out, _ = quick
     logs = []
     again = run_study(presets.quick(), out, workers=1, timing=False, progress=False, log=logs.append)
-    n = sum(1 for r in presets.quick()["rows"] if "collision_time_ps" not in r) * presets.quick()["replicas"]
+    n = sum(1 for r in presets.quick()["rows"] if "SVR" not in r) * presets.quick()["replicas"]
     available = sum(r["replicas"] for r in again["rows"])
     assert available >= n and any(f"reusing {available} finished runs" in line for line in logs), logs
     with open(os.path.join(out, "results.json")) as fh:
@@ -143,8 +145,7 @@ def test_an_unavailable_thermostat_row_is_reported_not_run(tmp_path, monkeypatch
     monkeypatch.setattr(integrators, "SymplecticIntegrator", without_thermostat)
     cfg = presets.quick()
     cfg.update(replicas=1, length_ps=0.24, omega_ps=0.06, omega_max_lag_ps=0.03, msd_window_ps=[0.04, 0.1])
-    cfg["rows"] = [{"kind": "symprk", "method": "verlet", "step_fs": 2.0},
-                   {"kind": "symprk", "method": "verlet", "step_fs": 2.0, "collision_time_ps": 0.1}]
+    cfg["rows"], cfg["references"] = ["verlet 2 fs", "verlet 2 fs SVR 0.1 ps"], {"NVE": "verlet 2 fs"}
     logs = []
     summary = run_study(cfg, str(tmp_path), workers=1, timing=False, progress=False, log=logs.append)
     ref, svr = summary["rows"]
@@ -165,7 +166,7 @@ def test_an_unrelated_integrator_error_is_not_hidden(monkeypatch):
         raise ValueError("stepSize must be positive")
 
     monkeypatch.setattr(integrators, "SymplecticIntegrator", broken)
-    row = check_row({"kind": "symprk", "method": "verlet", "step_fs": 2.0, "collision_time_ps": 1.0})
+    row = check_row("verlet 2 fs SVR 1 ps")
     with pytest.raises(ValueError, match="stepSize"):
         availability(row, types.SimpleNamespace(system=None), 300.0)
 
@@ -185,7 +186,11 @@ def _synthetic(cfg, rows, value, se=0.01, replicas=8, seed=3):
 
 
 def _rows(*specs):
-    return [check_row(dict(kind="symprk", method=m, step_fs=h)) for m, h in specs]
+    return [check_row(f"{m} {h:g} fs") for m, h in specs]
+
+
+def _h(row):
+    return describe(row)["step_fs"]
 
 
 def test_rows_are_paired_with_the_reference_replica_by_replica():
@@ -195,7 +200,7 @@ def test_rows_are_paired_with_the_reference_replica_by_replica():
     rows = _rows(("verlet", 0.5), ("verlet", 3.0), ("omelyan-2", 4.0))
     offsets = np.random.default_rng(1).normal(scale=0.3, size=8)
     shift = {3.0: 0.05, 0.5: 0.0, 4.0: 0.0}
-    grouped = _synthetic(cfg, rows, lambda row, r, k: 2.0 + offsets[r] + shift[row["step_fs"]], se=0.005)
+    grouped = _synthetic(cfg, rows, lambda row, r, k: 2.0 + offsets[r] + shift[_h(row)], se=0.005)
     res = {e["label"]: e for e in summarise(cfg, rows, grouped)["rows"]}
     far, near = res["verlet 3 fs"], res["omelyan-2 4 fs"]
     assert far["vs_ref"]["D"]["mean"] == pytest.approx(0.05, abs=0.01) and far["vs_ref"]["D"]["se"] < 0.005
@@ -217,7 +222,7 @@ def test_the_extrapolated_reference_recovers_each_replicas_h_to_zero_limit():
     b = 0.02
 
     def value(row, r, k):
-        return a[r] if row["method"] == "pefrl" else a[r] + b * row["step_fs"] ** 2
+        return a[r] if row.startswith("pefrl") else a[r] + b * _h(row) ** 2
 
     summary = summarise(cfg, rows, _synthetic(cfg, rows, value, se=1e-4))
     res = {e["label"]: e for e in summary["rows"]}
@@ -246,23 +251,31 @@ def test_a_published_effect_is_claimed_only_beyond_three_standard_errors():
 # -- settings -------------------------------------------------------------------------------------------------------
 def test_run_keys_follow_every_setting_and_are_pinned():
     cfg = presets.full()
-    row = cfg["rows"][4]
+    row = "omelyan-2 4 fs"
     key = run_key(cfg, row, 3)
     other = copy.deepcopy(cfg)
     other["msd_window_ps"] = [1.0, 8.0]
-    assert run_key(other, row, 3) != key and run_key(cfg, row, 2) != key and run_key(cfg, cfg["rows"][3], 3) != key
+    assert run_key(other, row, 3) != key and run_key(cfg, row, 2) != key and run_key(cfg, "verlet 3 fs", 3) != key
     other = copy.deepcopy(cfg)
     other["density_g_cm3"] = 0.9
     assert run_key(other, row, 3) != key
-    assert key == run_key(presets.full(), presets.full()["rows"][4], 3) == "c73d85be549144a1"
+    other = copy.deepcopy(cfg)
+    other["model"] = "tip3p"
+    assert run_key(other, row, 3) != key
+    # a label written another way is the same row; the references do not change a run
+    other = copy.deepcopy(cfg)
+    other["references"] = {"NVE": "verlet 0.5 fs"}
+    assert run_key(other, "omelyan-2  4 fs", 3) == key
+    assert key == run_key(presets.full(), "omelyan-2 4 fs", 3) == "79e3f5d46b06d938"
 
 
 @pytest.mark.parametrize("row, message", [
-    ({"kind": "brownian", "step_fs": 2.0}, "kind must be one of"),
-    ({"kind": "langevin", "step_fs": 2.0}, "missing: friction_per_ps"),
-    ({"kind": "langevin", "step_fs": 2.0, "friction_per_ps": 1.0, "method": "verlet"}, "unknown: method"),
-    ({"kind": "symprk", "method": "verlet", "step_fs": -1.0}, "step_fs must be a positive number"),
-    ({"kind": "symprk", "method": "rk4", "step_fs": 1.0}, "rk4 is a reference method"),
+    ("brownian 2 fs", "unknown method 'brownian'"),
+    ("langevin 2 fs SVR 1 ps", "SVR does not apply"),
+    ({"kind": "symprk", "method": "verlet", "step_fs": 2.0}, "a row is a label"),
+    ("verlet -1 fs", "positive"),
+    ("rk4 1 fs", "rk4 is a reference method"),
+    ("rigid:verlet 2 fs", "not rigid-body engines"),
 ])
 def test_bad_rows_are_refused_with_the_reason(row, message):
     with pytest.raises(ValueError, match=message):
@@ -278,6 +291,179 @@ def test_the_cli_refuses_unknown_rows_before_building_anything(tmp_path, capsys)
 
 def test_labels_name_every_option():
     labels = [label(r) for r in presets.full()["rows"]]
-    assert len(set(labels)) == len(labels)
+    assert labels == presets.full()["rows"] and len(set(labels)) == len(labels)  # written canonically, once each
     assert "omelyan-2 4 fs SVR 1 ps" in labels and "langevin 4 fs friction 1/ps HMR 3 Da" in labels
     assert "mts-langevin 3/2 fs friction 1/ps" in labels and "dpd 2 fs friction 1/ps" in labels
+    assert set(presets.REFERENCES.values()) <= set(labels) and set(presets.DECIDING) <= set(labels)
+    for lab in ("verlet 2 fs SVR 0.1 ps middle", "verlet 3 fs SVR 0.1 ps middle", "verlet 4 fs SVR 0.1 ps middle",
+                "omelyan-2 5 fs SVR 0.1 ps", "omelyan-2 6 fs SVR 0.1 ps", "omelyan-2 5 fs", "omelyan-2 6 fs",
+                "langevin 1 fs friction 0.1/ps", "langevin 3 fs friction 0.1/ps", "langevin 4 fs friction 0.1/ps",
+                "openmm-verlet 1 fs", "openmm-verlet 2 fs", "verlet 4/2 fs", "omelyan-2 6/2 fs"):
+        assert lab in labels, lab
+
+
+def test_omelyan_rows_with_the_thermostat_sit_at_its_best_placement():
+    """The omelyan-2 NVT rows run the thermostat at the ends: the placement methods.placement picks for it."""
+    from openmm_symprk.methods.resolved import resolve
+    from openmm_symprk.methods.placement import best_position
+
+    m = resolve("omelyan-2")
+    assert best_position(m.splitting.steps, m.stability) == "ends"
+    assert all("middle" not in lab for lab in presets.full()["rows"] if lab.startswith("omelyan-2") and "SVR" in lab)
+
+
+# -- issue 26: the NVT reference, the answer, the resolution, instabilities, committed results -------------------
+def test_nvt_rows_are_paired_with_the_nvt_reference_and_nve_rows_with_the_nve_one():
+    """NVE replicas share one set of offsets (each state's own energy), NVT replicas another (the thermostat pins
+    the temperature): paired with its own reference, a 0.05 shift of an NVT row is resolved and an NVE row equal
+    to its reference is not flagged; against the NVE reference the NVT shift would drown in the offsets."""
+    cfg = presets.quick()
+    rows = [check_row(r) for r in ("verlet 0.5 fs", "verlet 0.5 fs SVR 0.1 ps middle", "omelyan-2 4 fs",
+                                   "omelyan-2 4 fs SVR 0.1 ps", "langevin 2 fs friction 0.1/ps")]
+    refs = {"NVE": rows[0], "NVT": rows[1]}
+    rng = np.random.default_rng(5)
+    nve_off, nvt_off = rng.normal(scale=0.3, size=8), rng.normal(scale=0.3, size=8)
+
+    def value(row, r, k):
+        nvt = describe(row)["ensemble"] == "NVT"
+        return 2.0 + (nvt_off[r] if nvt else nve_off[r]) + (0.05 if row.startswith("langevin") else 0.0)
+
+    grouped = _synthetic(cfg, rows, value, se=0.005)
+    summary = summarise(cfg, rows, grouped, references=refs)
+    res = {e["label"]: e for e in summary["rows"]}
+    assert summary["references"] == {"NVE": "verlet 0.5 fs", "NVT": "verlet 0.5 fs SVR 0.1 ps middle"}
+    assert res["omelyan-2 4 fs"]["reference"] == "verlet 0.5 fs" and res["omelyan-2 4 fs"]["matches_ref"]
+    lang, om = res["langevin 2 fs friction 0.1/ps"], res["omelyan-2 4 fs SVR 0.1 ps"]
+    assert lang["reference"] == om["reference"] == "verlet 0.5 fs SVR 0.1 ps middle"
+    assert lang["vs_ref"]["D"]["mean"] == pytest.approx(0.05, abs=0.01) and lang["vs_ref"]["D"]["se"] < 0.005
+    assert not lang["matches_ref"] and om["matches_ref"]
+    d = [a[1]["obs"]["D"][0] - b[1]["obs"]["D"][0]
+         for a, b in zip(grouped[lang["label"]], grouped["verlet 0.5 fs SVR 0.1 ps middle"])]
+    assert lang["vs_ref"]["D"]["mean"] == pytest.approx(np.mean(d), rel=1e-12)
+    # the same rows against the NVE reference alone: the offsets do not cancel, nothing is resolved
+    alone = {e["label"]: e for e in summarise(cfg, rows, grouped)["rows"]}
+    assert alone["langevin 2 fs friction 0.1/ps"]["vs_ref"]["D"]["se"] > 10 * lang["vs_ref"]["D"]["se"]
+    assert res["verlet 0.5 fs SVR 0.1 ps middle"]["is_reference"] and not res["verlet 0.5 fs SVR 0.1 ps middle"]["vs_ref"]["D"]
+
+
+def test_the_nvt_rows_are_extrapolated_on_verlet_with_the_thermostat_in_the_middle():
+    cfg = presets.quick()
+    rows = [check_row(r) for r in ("verlet 0.5 fs", "verlet 2 fs", "verlet 0.5 fs SVR 0.1 ps middle",
+                                   "verlet 2 fs SVR 0.1 ps middle", "verlet 3 fs SVR 0.1 ps middle",
+                                   "verlet 2 fs SVR 0.1 ps", "omelyan-2 4 fs SVR 0.1 ps")]
+    a, c = np.random.default_rng(2).normal(5.0, 0.5, size=(2, 8))
+    b = 0.02
+
+    def value(row, r, k):
+        if row == "omelyan-2 4 fs SVR 0.1 ps":
+            return c[r]
+        if row == "verlet 2 fs SVR 0.1 ps":  # the ends placement: not a point of the NVT fit
+            return 100.0
+        return (c[r] if "SVR" in row else a[r]) + b * _h(row) ** 2
+
+    summary = summarise(cfg, rows, _synthetic(cfg, rows, value, se=1e-4),
+                        references={"NVE": rows[0], "NVT": rows[2]})
+    res = {e["label"]: e for e in summary["rows"]}
+    assert summary["extrapolated_nvt"]["D"]["steps_fs"] == [0.5, 2.0, 3.0]
+    assert summary["extrapolated_nvt"]["D"]["b"] == pytest.approx(b, rel=0.05)
+    assert abs(res["omelyan-2 4 fs SVR 0.1 ps"]["vs_extrapolated"]["D"]["mean"]) < 2e-4
+    assert res["verlet 2 fs"]["vs_extrapolated"]["D"]["mean"] == pytest.approx(4 * b, abs=2e-4)
+
+
+def test_the_answer_is_the_cheapest_match_and_its_speed_against_openmms_cheapest():
+    table = [
+        {"label": "ref", "ensemble": "NVT", "matches_ref": False, "is_reference": True, "family": "symprk",
+         "s_per_ps": 8.0, "evals_per_ps": 2000, "evals_vs_ref": 1, "wall_vs_ref": 1, "max_z": None},
+        {"label": "ours fast", "ensemble": "NVT", "matches_ref": True, "family": "symprk", "s_per_ps": 1.0,
+         "evals_per_ps": 500, "evals_vs_ref": .25, "wall_vs_ref": .125, "max_z": 1.0},
+        {"label": "ours faster but wrong", "ensemble": "NVT", "matches_ref": False, "family": "symprk",
+         "s_per_ps": 0.5, "evals_per_ps": 250, "evals_vs_ref": .125, "wall_vs_ref": .06, "max_z": 5.0},
+        {"label": "openmm", "ensemble": "NVT", "matches_ref": True, "family": "openmm", "s_per_ps": 3.0,
+         "evals_per_ps": 1000, "evals_vs_ref": .5, "wall_vs_ref": .4, "max_z": 2.0},
+        {"label": "openmm slow", "ensemble": "NVT", "matches_ref": True, "family": "openmm", "s_per_ps": 6.0,
+         "evals_per_ps": 2000, "evals_vs_ref": 1, "wall_vs_ref": .8, "max_z": 0.5}]
+    from openmm_symprk.studies.fidelity.report import answer
+
+    a = answer(table, "NVT")
+    assert a["label"] == a["ours"] == "ours fast" and a["openmm"] == "openmm" and a["by"] == "wall time"
+    assert a["speedup_vs_openmm"] == pytest.approx(3.0)
+    assert answer(table, "NVE") is None
+    table[3]["s_per_ps"] = None  # not timed: picked by force evaluations, no ratio claimed
+    a = answer(table, "NVT")
+    assert a["by"] == "force evaluations" and a["speedup_vs_openmm"] is None
+
+
+def test_the_replicas_needed_scale_as_the_square_of_the_error():
+    from openmm_symprk.studies.fidelity.report import resolution_needed
+
+    assert resolution_needed(4, 0.1, 0.05) == 16 and resolution_needed(4, 0.01, 0.05) == 4
+    assert resolution_needed(3, 0.0501, 0.05) == 4 and resolution_needed(4, None, 0.05) is None
+    cfg = presets.quick()
+    rows = _rows(("verlet", 0.5), ("verlet", 2.0))
+    offsets = np.random.default_rng(1).normal(scale=0.3, size=8)
+    grouped = _synthetic(cfg, rows, lambda row, r, k: 2.0 + offsets[r], se=0.05)
+    e = {x["label"]: x for x in summarise(cfg, rows, grouped)["rows"]}["verlet 2 fs"]
+    se_d = e["vs_ref"]["D"]["se"]
+    assert e["resolution"]["D_rel_se"] == pytest.approx(se_d / e_ref_d(summarise(cfg, rows, grouped)), rel=1e-12)
+    assert e["resolution"]["replicas_needed"] == max(
+        resolution_needed(8, e["resolution"]["D_rel_se"], 0.05), resolution_needed(8, e["vs_ref"]["pe"]["se"], 0.05))
+
+
+def e_ref_d(summary):
+    return next(x for x in summary["rows"] if x["label"] == summary["reference"])["values"]["D"]["mean"]
+
+
+def test_a_row_that_blows_up_is_recorded_unstable_with_its_step(tmp_path):
+    """Verlet at 14 fs on the quick box, the package's and OpenMM's: the run stops and says at which step (OpenMM's
+    integrator: within which steps); the study goes on and reports "unstable at step N" for the row."""
+    from openmm_symprk.studies.fidelity.report import format_summary
+
+    cfg = presets.quick()
+    cfg.update(replicas=1, length_ps=0.24, omega_ps=0.06, omega_max_lag_ps=0.03, msd_window_ps=[0.04, 0.1],
+               rows=["verlet 2 fs", "verlet 14 fs", "openmm-verlet 14 fs"], references={"NVE": "verlet 2 fs"})
+    summary = run_study(cfg, str(tmp_path), workers=1, timing=False, progress=False, log=lambda *a: None)
+    ref, *bad = summary["rows"]
+    assert ref["replicas"] == 1
+    for row in bad:
+        (status,) = row["failed"]
+        assert row["replicas"] == 0 and status.startswith("unstable at step ")
+        assert 0 < int(status.split()[-1].split("-")[0]) <= 4  # within the first 50 fs (4 steps)
+        assert f"{row['label']:36s} {status}" in format_summary(summary)
+
+
+def test_unstable_names_the_step_of_either_kind_of_blow_up():
+    import openmm as mm
+
+    from openmm_symprk.integrators import SimulationBlowUpError
+    from openmm_symprk.studies.fidelity.simulation.runs import unstable
+
+    err = SimulationBlowUpError("the simulation blew up at integrator step 1234 with method 'verlet' at ...")
+    assert unstable(err, 1000, 500) == "unstable at step 1234"
+    assert unstable(mm.OpenMMException("Particle coordinate is NaN"), 1000, 50) == "unstable at step 1001-1050"
+    assert unstable(ValueError("something else"), 0, 1) is None
+
+
+def test_report_only_remakes_the_summary_from_the_committed_json_alone(quick, tmp_path):
+    """The committed form of a study: states, each run's JSON and timings.json, no arrays, no results.  Report-only
+    on it prints the same tables and verdicts as the study that ran; a run on it reuses every stored run."""
+    import shutil
+
+    from openmm_symprk.studies.fidelity.report import format_summary
+
+    _, out, _ = quick
+    kept = tmp_path / "committed"
+    shutil.copytree(out, kept, ignore=shutil.ignore_patterns(".lock", "*.npz", "results.json", "*.png", "*.txt",
+                                                             "table.md"))
+    shutil.copytree(os.path.join(out, "states"), kept / "states", dirs_exist_ok=True)
+    assert not glob.glob(str(kept / "runs" / "*.npz")) and glob.glob(str(kept / "states" / "*.npz"))
+    with open(os.path.join(out, "summary.txt")) as fh:
+        first = fh.read()
+    again = run_study(presets.quick(), str(kept), workers=1, progress=False, log=lambda *a: None, report_only=True)
+    assert format_summary(again) + "\n" == first
+    with open(os.path.join(out, "table.md")) as fh, open(kept / "table.md") as fh2:
+        assert fh.read() == fh2.read()
+    assert again["temperature_view"] is None  # it needs the runs' time series, which are not committed
+    logs = []
+    resumed = run_study(presets.quick(), str(kept), workers=1, timing=False, progress=False, log=logs.append)
+    n = sum(r["replicas"] for r in resumed["rows"])
+    assert n and any(f"reusing {n} finished runs" in line for line in logs) and format_summary(resumed) + "\n" == first

@@ -25,7 +25,8 @@ One grammar of labels, :meth:`Row.parse` reading what :attr:`Row.label` writes::
   nonbonded cutoff); T is the target temperature (default 300 K).
 
 The earlier grammars read as the same rows: the bench's ``<method>[/<inner>]@mts<n>``, ``openmm-mts<n>``,
-``openmm-langevin`` (with its step given apart), ``symprk nvt drift --rows`` ``method@step_fs``, and the
+``openmm-langevin`` (with its step given apart), ``symprk nvt drift --rows`` ``method@step_fs``, ``symprk
+equipartition --rows`` ``method:step_fs``, and the
 OpenMM names ``openmm-nosehoover``, ``openmm-dpd``, ``openmm-mtslangevin``, ``nosehoover``.
 """
 from __future__ import annotations
@@ -54,7 +55,7 @@ RIGID_PREFIX = "rigid:"
 _NUMBER = r"[0-9]*\.?[0-9]+(?:[eE][-+]?[0-9]+)?"
 _OLD_MTS = re.compile(rf"^(?P<who>[^/@\s]+)(?:/(?P<inner>[^@\s]+))?@mts(?P<n>[0-9]+)$")
 _OLD_OPENMM_MTS = re.compile(r"^openmm-mts(?P<n>[0-9]+)$")
-_OLD_AT_STEP = re.compile(rf"^(?P<who>[^@\s]+)@(?P<h>{_NUMBER})$")
+_OLD_AT_STEP = re.compile(rf"^(?P<who>[^@\s]+)[@:](?P<h>{_NUMBER})$")
 
 
 def split_groups(inner_steps: int) -> list:
@@ -279,7 +280,7 @@ class Row:
             who = m.groupdict().get("who") or "openmm-mts"
             if m.groupdict().get("inner"):
                 fields["inner"] = m["inner"]
-        elif _OLD_AT_STEP.match(who):  # symprk nvt drift --rows: method@step_fs
+        elif _OLD_AT_STEP.match(who):  # symprk nvt drift --rows method@step_fs, equipartition --rows method:step_fs
             m = _OLD_AT_STEP.match(who)
             who, fields["step_fs"] = m["who"], float(m["h"])
         elif "/" in who:

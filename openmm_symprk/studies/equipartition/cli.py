@@ -5,23 +5,20 @@ import argparse
 import sys
 
 from ..core.cli import add_study_arguments, run_study_command
+from ..core.rows import Row
 from . import presets
 
 
 def _rows(text: str) -> list:
-    """'verlet:0.5,omelyan-2:4' -> [['verlet', 0.5], ['omelyan-2', 4.0]]."""
-    rows = []
-    for item in text.split(","):
-        item = item.strip()
-        if not item:
-            continue
-        method, sep, h = item.rpartition(":")
+    """'verlet:0.5,omelyan-2 4 fs' -> the row labels (:meth:`~..core.rows.Row.parse`); a row without a step is
+    refused here, an unknown method when the study is configured."""
+    rows = [item.strip() for item in text.split(",") if item.strip()]
+    for item in rows:
         try:
-            rows.append([method, float(h)])
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"{item!r} is not METHOD:STEP_FS (e.g. verlet:0.5)") from None
-        if not sep or not method:
-            raise argparse.ArgumentTypeError(f"{item!r} is not METHOD:STEP_FS (e.g. verlet:0.5)")
+            Row.parse(item)
+        except ValueError as exc:
+            if "no step" in str(exc):
+                raise argparse.ArgumentTypeError(f"{item!r} is not METHOD:STEP_FS (e.g. verlet:0.5)") from None
     return rows
 
 
@@ -32,7 +29,7 @@ def build_parser():
                         length="NVE length measured per replica")
     ap.add_argument("--models", default=None, help="comma-separated water models (spce, tip3p); default: all (--quick: spce)")
     ap.add_argument("--rows", type=_rows, default=None,
-                    help="METHOD:STEP_FS,... for every model (rigid:METHOD for the rigid-body engine); "
+                    help="METHOD:STEP_FS,... (or row labels: 'verlet 2 fs') for every model (rigid:METHOD for the rigid-body engine); "
                          "the reference verlet:0.5 is added")
     return ap
 
@@ -52,7 +49,8 @@ def main(argv=None) -> int:
             cfg["models"] = {m: cfg["models"].get(m, base[m]) for m in wanted}
         if args.rows:
             ref = [cfg["reference"][0], float(cfg["reference"][1])]
-            rows = ([ref] if ref not in args.rows else []) + args.rows
+            given = [[r.who, r.step_fs] for r in map(Row.parse, args.rows)]
+            rows = ([ref] if ref not in given else []) + given
             cfg["models"] = {m: rows for m in cfg["models"]}
 
     return run_study_command("symprk equipartition", args, cfg, configure, "openmm_symprk.studies.equipartition.study",

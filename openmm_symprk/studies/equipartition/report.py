@@ -25,7 +25,8 @@ __all__ = ["summarise", "format_summary", "chart", "label"]
 
 
 def label(method: str, step_fs: float) -> str:
-    return f"{method} {step_fs:g} fs"
+    """The row's label (:attr:`~..core.rows.Row.label`), e.g. 'rigid:verlet 2 fs'."""
+    return Row(method, step_fs).label
 
 
 def _estimate_dict(e: Estimate) -> dict:

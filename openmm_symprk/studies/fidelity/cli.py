@@ -17,20 +17,36 @@ def build_parser():
                         length="measured length per run (frames every sample_fs)")
     ap.add_argument("--rows", default=None,
                     help="comma-separated labels of the preset rows to run (the reference is always run), "
-                         "e.g. 'verlet 2 fs,omelyan-2 4 fs'; default: all")
+                         "e.g. 'verlet 2 fs,omelyan-2 4 fs'; 'deciding': the rows that decide issue 26's answer; "
+                         "default: all")
+    ap.add_argument("--model", choices=("spce", "tip3p"), default=None,
+                    help="water model (default spce); its replica states and runs are kept apart")
     return ap
 
 
 def select_rows(cfg: dict, text: str) -> list:
-    """The reference row and the preset rows whose labels are named in ``text`` (comma-separated)."""
+    """The references and the preset rows named in ``text`` (comma-separated labels, written in any order of the
+    row grammar, or ``deciding``: :data:`.presets.DECIDING`), in the presets' order."""
     from .rowspec import label
 
-    wanted = [w.strip() for w in text.split(",") if w.strip()]
+    wanted = []
+    for w in (w.strip() for w in text.split(",")):
+        if w == "deciding":
+            wanted += presets.DECIDING
+        elif w:
+            wanted.append(w)
     labels = [label(r) for r in cfg["rows"]]
-    unknown = [w for w in wanted if w not in labels]
+    named = []
+    for w in wanted:
+        try:
+            named.append(label(w))
+        except ValueError:
+            named.append(w)
+    unknown = [w for w, lab in zip(wanted, named) if lab not in labels]
     if unknown:
         raise ValueError(f"unknown row(s) {', '.join(repr(u) for u in unknown)}; the rows are: {'; '.join(labels)}")
-    return [cfg["rows"][0]] + [r for r, lab in zip(cfg["rows"][1:], labels[1:]) if lab in wanted]
+    keep = set(named) | {label(r) for r in (cfg.get("references") or {}).values()} | {labels[0]}
+    return [r for r, lab in zip(cfg["rows"], labels) if lab in keep]
 
 
 def main(argv=None) -> int:
@@ -38,6 +54,8 @@ def main(argv=None) -> int:
     cfg = presets.quick() if args.quick else presets.full()
 
     def configure(cfg):
+        if args.model:
+            cfg["model"] = args.model
         if args.rows:
             cfg["rows"] = select_rows(cfg, args.rows)
 

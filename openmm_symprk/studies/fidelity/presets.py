@@ -1,47 +1,52 @@
 """Settings and rows of the fidelity study (data only; :mod:`.simulation.engines` builds them).
 
-A row is a dict: ``kind`` (who integrates), ``step_fs`` and the kind's options:
+A row is one label of the studies' row type (:class:`openmm_symprk.studies.core.rows.Row`; the grammar is in
+that module's docstring), e.g. ``"verlet 2 fs"``, ``"omelyan-2 4 fs SVR 0.1 ps"`` (the package's stochastic velocity
+rescaling, collision time 0.1 ps, at the ends of the step), ``"verlet 2 fs SVR 0.1 ps middle"`` (in the middle of
+the step), ``"langevin 2 fs friction 0.1/ps"`` (OpenMM's LangevinMiddleIntegrator), ``"openmm-verlet 2 fs"``,
+``"mts-langevin 3/2 fs friction 1/ps"`` (BAOAB-RESPA: reciprocal-space PME once per 3-fs step, the rest twice),
+``"verlet 4/2 fs"`` (the package's MTS, the same split), ``"... HMR 3 Da"`` (hydrogen masses repartitioned).
 
-* ``"symprk"`` -- :class:`~openmm_symprk.SymplecticIntegrator` with catalogue ``method``; NVE, or thermostatted
-  by stochastic velocity rescaling with ``collision_time_ps`` (the package's thermostat; a row whose integrator
-  does not accept ``temperature=`` yet is reported "unavailable: needs the thermostat");
-* ``"langevin"`` -- OpenMM's LangevinMiddleIntegrator, ``friction_per_ps``;
-* ``"mts-langevin"`` -- OpenMM's MTSLangevinIntegrator (BAOAB-RESPA), ``friction_per_ps``, reciprocal-space PME
-  once per outer step, the rest ``inner_steps`` times;
-* ``"nose-hoover"`` -- OpenMM's NoseHooverIntegrator (one chain), ``collision_frequency_per_ps``;
-* ``"dpd"`` -- OpenMM's DPDIntegrator (pairwise friction, keeps the momentum), ``friction_per_ps`` and
-  ``cutoff_nm`` (default: the box's nonbonded cutoff);
-
-and for any kind ``hmr_da``: the hydrogen masses repartitioned to that many daltons (rigid water's too).
-The reference row is the first: Verlet at 0.5 fs, NVE.
+The references (:data:`REFERENCES`) are rows too, always run: Verlet at 0.5 fs NVE for the NVE rows, and Verlet at
+0.5 fs with the thermostat in the middle of the step at :data:`NVT_TAU_PS` for the NVT rows.
 """
 from __future__ import annotations
 
 import copy
 
-__all__ = ["ROWS", "full", "quick"]
+__all__ = ["ROWS", "REFERENCES", "NVT_TAU_PS", "full", "quick", "first"]
 
-#: The rows of issue 21, reference first.
+#: Collision time of the package's thermostat in the NVT reference and the new NVT rows (issue 26).
+NVT_TAU_PS = 0.1
+#: The reference of each ensemble (rows of :data:`ROWS`).
+REFERENCES = {"NVE": "verlet 0.5 fs", "NVT": "verlet 0.5 fs SVR 0.1 ps middle"}
+
+#: The rows of issue 21 and issue 26, references first.
 ROWS = [
-    {"kind": "symprk", "method": "verlet", "step_fs": 0.5},
-    {"kind": "symprk", "method": "verlet", "step_fs": 1.0},
-    {"kind": "symprk", "method": "verlet", "step_fs": 2.0},
-    {"kind": "symprk", "method": "verlet", "step_fs": 3.0},
-    {"kind": "symprk", "method": "omelyan-2", "step_fs": 4.0},
-    {"kind": "symprk", "method": "pefrl", "step_fs": 4.0},
-    {"kind": "symprk", "method": "verlet", "step_fs": 4.0, "hmr_da": 3.0},
-    {"kind": "symprk", "method": "omelyan-2", "step_fs": 4.0, "hmr_da": 3.0},
-    {"kind": "symprk", "method": "verlet", "step_fs": 2.0, "collision_time_ps": 0.1},
-    {"kind": "symprk", "method": "verlet", "step_fs": 2.0, "collision_time_ps": 1.0},
-    {"kind": "symprk", "method": "omelyan-2", "step_fs": 4.0, "collision_time_ps": 0.1},
-    {"kind": "symprk", "method": "omelyan-2", "step_fs": 4.0, "collision_time_ps": 1.0},
-    {"kind": "langevin", "step_fs": 2.0, "friction_per_ps": 1.0},
-    {"kind": "langevin", "step_fs": 2.0, "friction_per_ps": 0.1},
-    {"kind": "langevin", "step_fs": 4.0, "friction_per_ps": 1.0, "hmr_da": 3.0},
-    {"kind": "mts-langevin", "step_fs": 3.0, "friction_per_ps": 1.0, "inner_steps": 2},
-    {"kind": "nose-hoover", "step_fs": 2.0, "collision_frequency_per_ps": 1.0},
-    {"kind": "dpd", "step_fs": 2.0, "friction_per_ps": 1.0},
+    "verlet 0.5 fs",
+    "verlet 0.5 fs SVR 0.1 ps middle",
+    # NVE: the package
+    "verlet 1 fs", "verlet 2 fs", "verlet 3 fs",
+    "omelyan-2 4 fs", "omelyan-2 5 fs", "omelyan-2 6 fs", "pefrl 4 fs",
+    "verlet 4 fs HMR 3 Da", "omelyan-2 4 fs HMR 3 Da",
+    "verlet 4/2 fs", "omelyan-2 6/2 fs",  # the package's MTS: reciprocal-space PME once per outer step
+    # NVE: OpenMM
+    "openmm-verlet 1 fs", "openmm-verlet 2 fs",
+    # NVT: the package's thermostat, at the ends (issue 21) and in the middle of the step (issue 26)
+    "verlet 2 fs SVR 0.1 ps", "verlet 2 fs SVR 1 ps", "omelyan-2 4 fs SVR 0.1 ps", "omelyan-2 4 fs SVR 1 ps",
+    "verlet 2 fs SVR 0.1 ps middle", "verlet 3 fs SVR 0.1 ps middle", "verlet 4 fs SVR 0.1 ps middle",
+    # omelyan-2 at its best placement (methods.placement.best_position: "ends")
+    "omelyan-2 5 fs SVR 0.1 ps", "omelyan-2 6 fs SVR 0.1 ps",
+    "verlet 4/2 fs SVR 0.1 ps middle", "omelyan-2 6/2 fs SVR 0.1 ps",
+    # NVT: OpenMM
+    "langevin 1 fs friction 0.1/ps", "langevin 2 fs friction 0.1/ps", "langevin 3 fs friction 0.1/ps",
+    "langevin 4 fs friction 0.1/ps", "langevin 2 fs friction 1/ps", "langevin 4 fs friction 1/ps HMR 3 Da",
+    "mts-langevin 3/2 fs friction 1/ps", "nose-hoover 2 fs 1/ps", "dpd 2 fs friction 1/ps",
 ]
+
+#: The rows that decide issue 26's answer (NVT), run first and on the second water model.
+DECIDING = ["verlet 2 fs SVR 0.1 ps middle", "omelyan-2 4 fs SVR 0.1 ps", "langevin 2 fs friction 0.1/ps",
+            "omelyan-2 4 fs", "openmm-verlet 2 fs"]
 
 
 def full() -> dict:
@@ -56,7 +61,7 @@ def full() -> dict:
         "settle_ps": 2.0, "omega_ps": 2.0, "omega_fs": 4.0, "omega_max_lag_ps": 0.5,
         "length_ps": 20.0, "sample_fs": 24.0, "rdf_every": 5,
         "msd_window_ps": [2.0, 8.0], "tau_fit": [0.1, 0.5], "rdf_r_min_nm": 0.2, "timing_fs": 200.0,
-        "rows": copy.deepcopy(ROWS),
+        "rows": list(ROWS), "references": dict(REFERENCES),
     }
 
 

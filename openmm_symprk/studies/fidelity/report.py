@@ -19,9 +19,14 @@ from ...support import require
 from ...analysis.diffusion import VISCOSITY_MPAS, yeh_hummer
 from .extrapolation import extrapolate_h2
 from ...analysis.observe import OBSERVABLES
-from .rowspec import describe
+from .rowspec import describe, is_verlet_limit, to_row
 
-__all__ = ["K_SE", "MATCHED", "summarise", "format_summary", "chart", "claim"]
+__all__ = ["K_SE", "MATCHED", "TARGETS", "summarise", "format_summary", "markdown_table", "chart", "claim",
+           "answer", "resolution_needed"]
+
+#: The resolution issue 26 asks of every row's paired difference: D's standard error at most 5% of the reference's
+#: D, PE's at most 0.05 kJ/mol per molecule.
+TARGETS = {"D_rel": 0.05, "pe": 0.05}
 
 #: Standard errors beyond which a difference counts.
 K_SE = 3.0
@@ -57,14 +62,11 @@ def _paired(a: dict, b: dict):
     return None if e is None or not (e.se > 0 or e.mean != 0) else e
 
 
-def _is_verlet_nve(row) -> bool:
-    return row["kind"] == "symprk" and row.get("method") == "verlet" and describe(row)["ensemble"] == "NVE" \
-        and "hmr_da" not in row
-
-
-def _extrapolated(rows, per) -> tuple:
-    """({key: {replica: (a, a_se)}} per replica, {key: fit of the rows' combined values}) of the Verlet NVE rows."""
-    verlet = [(r["step_fs"], describe(r)["label"]) for r in rows if _is_verlet_nve(r) and describe(r)["label"] in per]
+def _extrapolated(rows, per, ensemble: str = "NVE", tau_ps: float | None = None) -> tuple:
+    """({key: {replica: (a, a_se)}} per replica, {key: fit of the rows' combined values}) of the Verlet rows of
+    ``ensemble`` (:func:`.rowspec.is_verlet_limit`: NVE, or NVT with the thermostat in the middle at ``tau_ps``)."""
+    verlet = [(to_row(r).step_fs, describe(r)["label"]) for r in rows
+              if is_verlet_limit(r, ensemble, tau_ps) and describe(r)["label"] in per]
     by_rep, fits = {}, {}
     for key, _, _ in OBSERVABLES:
         reps = {}
@@ -110,26 +112,39 @@ def claim(per: dict, a: str, b: str, published: float, what: str) -> dict:
                      f", {'within' if consistent else 'beyond'} {K_SE:g} SE of it): {verdict}")}
 
 
+def resolution_needed(n: int, se: float | None, target: float) -> int | None:
+    """Replicas that bring a paired standard error ``se`` measured over ``n`` replicas to ``target`` (SE ~ 1/sqrt(n),
+    the measured per-replica scatter kept), at least ``n``; None where it cannot be said (no error yet)."""
+    if se is None or not np.isfinite(se) or not target > 0 or n < 1:
+        return None
+    return max(int(n), int(np.ceil(n * (se / target) ** 2)))
+
+
 def summarise(cfg: dict, rows: list, grouped: dict, timings: dict | None = None, unavailable: dict | None = None,
-              box_nm: float | None = None) -> dict:
+              box_nm: float | None = None, references: dict | None = None) -> dict:
     """The study's results from its finished runs (``grouped``: {row label: [(arrays, info) per replica]}),
-    timings ({label: wall seconds per simulated ps}) and unavailable rows ({label: why})."""
+    timings ({label: wall seconds per simulated ps}), unavailable rows ({label: why}) and the references
+    ({ensemble: label}; default: the first row for NVE, and the NVT rows against it too).  NVT rows are paired
+    with the NVT reference where there is one, NVE rows with the NVE reference; each ensemble's rows also with
+    its Verlet rows extrapolated to h -> 0."""
     timings, unavailable = timings or {}, unavailable or {}
-    ref_label = describe(rows[0])["label"]
+    refs = {ens: describe(lab)["label"] for ens, lab in (references or {"NVE": rows[0]}).items()}
+    ref_label = refs["NVE"]
     yh = yeh_hummer(box_nm, cfg["temperature"], VISCOSITY_MPAS[cfg["model"]]) if box_nm else None
     table, per = [], {}
     for row in rows:
         d = describe(row)
         lab = d["label"]
-        entry = {"label": lab, "row": row, "ensemble": d["ensemble"], "family": d["family"], "hmr": d["hmr"],
-                 "evals_per_ps": d["evals_per_step"] * 1000.0 / row["step_fs"], "s_per_ps": timings.get(lab),
+        entry = {"label": lab, "row": lab, "ensemble": d["ensemble"], "family": d["family"], "hmr": d["hmr"],
+                 "reference": refs.get(d["ensemble"], ref_label), "is_reference": lab in refs.values(),
+                 "evals_per_ps": d["evals_per_step"] * 1000.0 / d["step_fs"], "s_per_ps": timings.get(lab),
                  "status": unavailable.get(lab, "ok"), "replicas": 0, "failed": []}
         table.append(entry)
         if lab in unavailable:
             continue
         reps = grouped.get(lab, [])
         good = [(a, i) for a, i in reps if i.get("status") == "ok"]
-        entry["failed"] = [i["status"] for _, i in reps if i.get("status") != "ok"]
+        entry["failed"] = [str(i["status"]).replace("blew up", "unstable") for _, i in reps if i.get("status") != "ok"]
         entry["replicas"] = len(good)
         if not good:
             continue
@@ -142,37 +157,38 @@ def summarise(cfg: dict, rows: list, grouped: dict, timings: dict | None = None,
         entry["notes"] = notes
         if entry["values"]["D"] and yh is not None:
             entry["D_yeh_hummer"] = entry["values"]["D"]["mean"] + yh
-    extrap, fits = _extrapolated(rows, per)
-    ref = per.get(ref_label)
+    nvt_tau = to_row(refs["NVT"]).tau_ps if "NVT" in refs else None
+    extrap = {"NVE": _extrapolated(rows, per, "NVE")}
+    if "NVT" in refs:
+        extrap["NVT"] = _extrapolated(rows, per, "NVT", nvt_tau)
+    fits = extrap["NVE"][1]
     for entry in table:
         mine = per.get(entry["label"])
         if mine is None:
             continue
+        ref = per.get(entry["reference"])
+        by_rep = extrap.get(entry["ensemble"], extrap["NVE"])[0]
         entry["vs_ref"], entry["vs_extrapolated"] = {}, {}
         for k, _, _ in OBSERVABLES:
-            e = _paired(mine[k], ref[k]) if ref and entry["label"] != ref_label else None
+            e = _paired(mine[k], ref[k]) if ref and entry["label"] != entry["reference"] else None
             entry["vs_ref"][k] = e.as_dict() if e else None
-            e = _paired(mine[k], extrap.get(k, {}))
+            e = _paired(mine[k], by_rep.get(k, {}))
             entry["vs_extrapolated"][k] = e.as_dict() if e else None
         z = {k: abs(v["mean"]) / v["se"] for k in MATCHED for v in [entry["vs_ref"][k]] if v and v["se"] > 0}
         entry["max_z"] = max(z.values()) if z else None
         entry["differs"] = sorted(k for k, zz in z.items() if zz > K_SE)
         entry["matches_ref"] = bool(z) and not entry["differs"] and not entry["failed"]
+        entry["resolution"] = _resolution(entry, ref)
     ref_entry = next(e for e in table if e["label"] == ref_label)
     ref_s = ref_entry["s_per_ps"]
     for entry in table:
         entry["evals_vs_ref"] = entry["evals_per_ps"] / ref_entry["evals_per_ps"]
         entry["wall_vs_ref"] = entry["s_per_ps"] / ref_s if entry["s_per_ps"] and ref_s else None
-    cheapest = {}
-    for ens in ("NVE", "NVT"):
-        cands = [e for e in table if e["ensemble"] == ens and e.get("matches_ref") and e["label"] != ref_label]
-        best = min(cands, key=lambda e: (e["evals_per_ps"], e["s_per_ps"] or float("inf"))) if cands else None
-        cheapest[ens] = None if best is None else {k: best[k] for k in ("label", "evals_vs_ref", "wall_vs_ref",
-                                                                         "max_z")}
-    labels = {describe(r)["label"]: r for r in rows}
-    lang = {r.get("friction_per_ps"): lab for lab, r in labels.items()
-            if r["kind"] == "langevin" and r["step_fs"] == 2.0 and "hmr_da" not in r}
-    mts = next((lab for lab, r in labels.items() if r["kind"] == "mts-langevin"), None)
+    cheapest = {ens: answer(table, ens) for ens in ("NVE", "NVT")}
+    labels = {describe(r)["label"]: to_row(r) for r in rows}
+    lang = {r.friction_per_ps: lab for lab, r in labels.items()
+            if r.who == "langevin" and r.step_fs == 2.0 and r.hmr_da is None}
+    mts = next((lab for lab, r in labels.items() if r.who == "mts-langevin"), None)
     claims = {
         "langevin_friction": claim(per, lang.get(1.0, "langevin 2 fs friction 1/ps"),
                                    lang.get(0.1, "langevin 2 fs friction 0.1/ps"), (4.7 - 5.4) / 5.4,
@@ -187,8 +203,80 @@ def summarise(cfg: dict, rows: list, grouped: dict, timings: dict | None = None,
     for k, _, _ in OBSERVABLES:
         ses = [e["vs_ref"][k]["se"] for e in table if e.get("vs_ref", {}).get(k)]
         resolution[k] = K_SE * float(np.median(ses)) if ses else None
-    return {"config": cfg, "reference": ref_label, "rows": table, "extrapolated": fits, "yeh_hummer": yh,
-            "box_nm": box_nm, "cheapest": cheapest, "claims": claims, "resolution": resolution, "k_se": K_SE}
+    return {"config": cfg, "reference": ref_label, "references": refs, "rows": table, "extrapolated": fits,
+            "extrapolated_nvt": extrap["NVT"][1] if "NVT" in extrap else {}, "yeh_hummer": yh,
+            "box_nm": box_nm, "cheapest": cheapest, "claims": claims, "resolution": resolution, "k_se": K_SE,
+            "targets": dict(TARGETS), "to_resolve": _to_resolve(cfg, table, grouped)}
+
+
+def _resolution(entry: dict, ref: dict | None) -> dict:
+    """The row's paired errors of D (relative to the reference's D) and PE against :data:`TARGETS`, and the
+    replicas that would reach both (:func:`resolution_needed`)."""
+    d, pe = entry["vs_ref"].get("D"), entry["vs_ref"].get("pe")
+    base = _combined(ref["D"]) if ref else None
+    out = {"D_rel_se": None, "pe_se": None, "reached": None, "replicas_needed": None}
+    if d and base is not None and base.mean > 0:
+        out["D_rel_se"] = d["se"] / base.mean
+    if pe:
+        out["pe_se"] = pe["se"]
+    if out["D_rel_se"] is None or out["pe_se"] is None:
+        return out
+    n = entry["replicas"]
+    out["reached"] = bool(out["D_rel_se"] <= TARGETS["D_rel"] and out["pe_se"] <= TARGETS["pe"])
+    out["replicas_needed"] = max(resolution_needed(n, out["D_rel_se"], TARGETS["D_rel"]),
+                                 resolution_needed(n, out["pe_se"], TARGETS["pe"]))
+    return out
+
+
+def _to_resolve(cfg: dict, table: list, grouped: dict) -> dict:
+    """What reaching :data:`TARGETS` for every compared row would take: the replicas (the largest any row needs;
+    every row runs every replica, so that the rows stay paired), the simulated ns and the core-hours, from each
+    row's measured wall time per run."""
+    need = [e["resolution"]["replicas_needed"] for e in table if (e.get("resolution") or {}).get("replicas_needed")]
+    if not need:
+        return {}
+    n = max(need)
+    per_run_ps = float(cfg["settle_ps"]) + float(cfg["omega_ps"]) + float(cfg["length_ps"])
+    core_s, missing = 0.0, 0
+    for e in table:
+        walls = [i.get("wall_s") for _, i in grouped.get(e["label"], []) if i.get("wall_s")]
+        have = e["replicas"] + len(e["failed"])
+        if e["status"] != "ok":
+            continue
+        if walls:
+            core_s += max(0, n - have) * float(np.mean(walls))
+        else:
+            missing += 1
+    return {"replicas": n, "ns_per_row": n * per_run_ps / 1000.0, "core_hours_more": core_s / 3600.0,
+            "rows_without_runs": missing}
+
+
+def answer(table: list, ensemble: str) -> dict | None:
+    """The cheapest configuration of ``ensemble`` matching its reference in every observable, the cheapest
+    OpenMM built-in that does, and the ratio of simulated time per wall second of the first to the second
+    (timed in turns).  Cheapest: least wall time per simulated ps where every candidate was timed, else fewest
+    force evaluations per ps (ties broken by wall time).  None when no row of the ensemble matches."""
+    cands = [e for e in table if e["ensemble"] == ensemble and e.get("matches_ref") and not e.get("is_reference")]
+    if not cands:
+        return None
+    timed = all(e["s_per_ps"] for e in cands)
+
+    def cost(e):
+        return (e["s_per_ps"],) if timed else (e["evals_per_ps"], e["s_per_ps"] or float("inf"))
+
+    best = min(cands, key=cost)
+    out = {k: best[k] for k in ("label", "evals_vs_ref", "wall_vs_ref", "max_z", "family")}
+    out["by"] = "wall time" if timed else "force evaluations"
+    ours = [e for e in cands if e["family"] == "symprk"]
+    builtin = [e for e in cands if e["family"] == "openmm"]
+    out["ours"] = min(ours, key=cost)["label"] if ours else None
+    out["openmm"] = min(builtin, key=cost)["label"] if builtin else None
+    out["speedup_vs_openmm"] = None
+    if ours and builtin:
+        a, b = min(ours, key=cost), min(builtin, key=cost)
+        if a["s_per_ps"] and b["s_per_ps"]:
+            out["speedup_vs_openmm"] = b["s_per_ps"] / a["s_per_ps"]
+    return out
 
 
 def _pm(d, spec) -> str:
@@ -218,11 +306,12 @@ def _table(summary, field, title, extra=True) -> list:
                                                                   for k, _, _ in OBSERVABLES)
         if extra:
             wr = f"{e['wall_vs_ref']:.2f}" if e["wall_vs_ref"] else "-"
-            mark = "ref" if e["label"] == summary["reference"] else ("yes" if e["matches_ref"] else "no")
+            mark = "ref" if e.get("is_reference") or e["label"] == summary["reference"] else \
+                ("yes" if e["matches_ref"] else "no")
             z = f"{e['max_z']:.1f}" if e.get("max_z") is not None else "-"
             line += f" {e['evals_per_ps']:8.0f} {wr:>8s} {z:>5s} {mark}"
             if e["failed"]:
-                line += f" ({len(e['failed'])} failed: {e['failed'][0]})"
+                line += f" ({len(e['failed'])} run(s) {e['failed'][0]})"
         lines.append(line)
     return lines
 
@@ -240,30 +329,27 @@ def format_summary(summary: dict) -> str:
                "drift kT/ns/dof of the (effective) energy; '-': not measured or not applicable.", ""]
     lines += _table(summary, "values", "Values", extra=False)
     lines.append("")
-    lines += _table(summary, "vs_ref", f"Bias against the reference ({summary['reference']}), paired by replica; "
-                                       f"match: no observable beyond {summary['k_se']:g} SE")
+    refs = summary.get("references") or {"NVE": summary["reference"]}
+    lines += _table(summary, "vs_ref", "Bias against the reference, paired by replica ("
+                    + "; ".join(f"{ens} rows against {lab}" for ens, lab in refs.items())
+                    + f"); match: no observable beyond {summary['k_se']:g} SE")
     lines.append("")
-    lines += _table(summary, "vs_extrapolated", "Bias against Verlet extrapolated to h -> 0 (a + b h^2 per replica), "
-                                                "paired by replica", extra=False)
-    fits = summary["extrapolated"]
-    if fits:
-        lines.append("Verlet extrapolated to h -> 0 (fit of the rows' means): " + "; ".join(
-            f"{_SHORT[k]} {format(f['a'], FORMAT[k])}±{format(f['a_se'], FORMAT[k])}"
-            + (f" (chi2/dof {f['chi2_red']:.1f})" if f["dof"] > 0 else "") for k, f in fits.items()))
+    lines += _table(summary, "vs_extrapolated", "Bias against Verlet extrapolated to h -> 0 (a + b h^2 per replica; "
+                                                "NVT rows: Verlet with the thermostat in the middle), paired by replica",
+                    extra=False)
+    for what, fits in (("Verlet NVE", summary["extrapolated"]), ("Verlet NVT (middle)", summary.get("extrapolated_nvt"))):
+        if fits:
+            lines.append(f"{what} extrapolated to h -> 0 (fit of the rows' means): " + "; ".join(
+                f"{_SHORT[k]} {format(f['a'], FORMAT[k])}±{format(f['a_se'], FORMAT[k])}"
+                + (f" (chi2/dof {f['chi2_red']:.1f})" if f["dof"] > 0 else "") for k, f in fits.items()))
     lines.append("")
     yh = summary["yeh_hummer"]
     for e in summary["rows"]:
         if e.get("D_yeh_hummer") is not None and e["label"] == summary["reference"]:
             lines.append(f"D of the reference with the Yeh-Hummer correction (literature comparison): "
                          f"{e['D_yeh_hummer']:.2f} ± {e['values']['D']['se']:.2f} x 1e-5 cm^2/s (+{yh:.3f})")
-    for ens, c in summary["cheapest"].items():
-        if c:
-            wall = f", {c['wall_vs_ref']:.2f}x its wall time" if c["wall_vs_ref"] else ""
-            lines.append(f"cheapest {ens} configuration matching {summary['reference']} in every observable: "
-                         f"{c['label']} ({c['evals_vs_ref']:.2f}x the force evaluations{wall}; largest difference "
-                         f"{c['max_z']:.1f} SE)")
-        else:
-            lines.append(f"no {ens} configuration matches {summary['reference']} in every observable")
+    lines += answer_lines(summary)
+    lines += resolution_lines(summary)
     res = summary["resolution"]
     lines.append("resolved at 3 SE (median paired error x 3): " + "; ".join(
         f"{_SHORT[k]} {format(v, FORMAT[k])}" for k, v in res.items() if v is not None))
@@ -276,6 +362,82 @@ def format_summary(summary: dict) -> str:
     for k, (why, where) in notes.items():
         lines.append(f"{_SHORT[k]} not measured in {len(where)} row(s) ({', '.join(where[:3])}"
                      f"{', ...' if len(where) > 3 else ''}), e.g.: {why}")
+    return "\n".join(lines)
+
+
+def answer_lines(summary: dict) -> list:
+    """The report's answer: per ensemble, the cheapest configuration matching its reference, the cheapest OpenMM
+    built-in that does, and the ratio of their simulated time per wall second."""
+    refs = summary.get("references") or {"NVE": summary["reference"]}
+    lines = []
+    for ens, c in summary["cheapest"].items():
+        ref = refs.get(ens, summary["reference"])
+        if not c:
+            lines.append(f"no {ens} configuration matches {ref} in every observable")
+            continue
+        wall = f", {c['wall_vs_ref']:.2f}x its wall time" if c["wall_vs_ref"] else ""
+        lines.append(f"cheapest {ens} configuration matching {ref} in every observable (by {c['by']}): "
+                     f"{c['label']} ({c['evals_vs_ref']:.2f}x the NVE reference's force evaluations{wall}; largest "
+                     f"difference {c['max_z']:.1f} SE)")
+        if c["ours"] and c["openmm"]:
+            ratio = f"{c['speedup_vs_openmm']:.2f}x" if c["speedup_vs_openmm"] else "- (not timed)"
+            lines.append(f"  {ens}: this package's cheapest match {c['ours']} against OpenMM's cheapest match "
+                         f"{c['openmm']}: {ratio} the simulated time per wall second (timed in turns)")
+        else:
+            lines.append(f"  {ens}: matches only from " + ("this package" if c["ours"] else "OpenMM's built-ins")
+                         + ": no ratio")
+    return lines
+
+
+def resolution_lines(summary: dict) -> list:
+    """Each compared row's paired errors of D and PE against :data:`TARGETS` and what reaching them would take."""
+    t = summary.get("targets") or TARGETS
+    lines = [f"resolution against the targets (paired SE of D <= {100 * t['D_rel']:g}% of D, of PE <= {t['pe']:g} "
+             f"kJ/mol): row, replicas, SE(D)/D, SE(PE), replicas needed"]
+    for e in summary["rows"]:
+        r = e.get("resolution") or {}
+        if r.get("D_rel_se") is None or r.get("pe_se") is None:
+            continue
+        mark = "reached" if r["reached"] else f"needs {r['replicas_needed']}"
+        lines.append(f"  {e['label']:36s} {e['replicas']:3d}  {100 * r['D_rel_se']:5.1f}%  {r['pe_se']:.3f}  {mark}")
+    need = summary.get("to_resolve") or {}
+    if need:
+        lines.append(f"reaching the targets in every compared row: {need['replicas']} replicas of every row "
+                     f"({need['ns_per_row']:.2f} ns per row), about {need['core_hours_more']:.1f} more core-hours at "
+                     f"this folder's measured wall time per run"
+                     + (f" ({need['rows_without_runs']} row(s) not run yet not counted)"
+                        if need["rows_without_runs"] else ""))
+    return lines
+
+
+def markdown_table(summary: dict, keys=("D", "tau1_dip", "tau2_hh", "w_zero", "w_min", "pe", "dT", "g_h",
+                                         "drift")) -> str:
+    """The bias table of docs/fidelity.md (markdown): each row's values against its reference, paired by replica;
+    the references' own lines hold their values; bold: beyond K_SE standard errors."""
+    head = ["row", "n", "f/ps", "wall/ref"] + [_SHORT[k] for k in keys] + ["max z"]
+    lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+    for e in summary["rows"]:
+        if e["status"] != "ok" or not e["replicas"]:
+            why = e["status"] if e["status"] != "ok" else (e["failed"][0] if e["failed"] else "no finished runs")
+            lines.append(f"| {e['label']} | 0 | {e['evals_per_ps']:.0f} | | {why} |" + " |" * (len(head) - 5))
+            continue
+        own = e.get("is_reference")
+        vals = e.get("values") if own else e.get("vs_ref")
+        cells = []
+        for k in keys:
+            d = (vals or {}).get(k)
+            if not d:
+                cells.append("–")
+                continue
+            sign = "" if own else "+"
+            text = f"{format(d['mean'], sign + FORMAT[k])} ± {format(d['se'], FORMAT[k])}".replace("-", "−")
+            cells.append(f"**{text}**" if not own and d["se"] > 0 and abs(d["mean"]) > K_SE * d["se"] else text)
+        name = f"**{e['label']}** (reference: values)" if own else e["label"]
+        wr = f"{e['wall_vs_ref']:.2f}" if e["wall_vs_ref"] else "–"
+        z = "–" if own or e.get("max_z") is None else f"{e['max_z']:.1f}"
+        fail = f" ({len(e['failed'])} run(s) {e['failed'][0]})" if e["failed"] else ""
+        lines.append(f"| {name}{fail} | {e['replicas']} | {e['evals_per_ps']:.0f} | {wr} | " + " | ".join(cells)
+                     + f" | {z} |")
     return "\n".join(lines)
 
 

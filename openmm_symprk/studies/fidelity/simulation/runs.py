@@ -26,7 +26,28 @@ from ...equipartition.runs import steps_per_sample
 from ..rowspec import describe
 from .engines import Engine
 
-__all__ = ["run_row", "replica_seed", "charges"]
+__all__ = ["run_row", "replica_seed", "charges", "unstable", "UNSTABLE"]
+
+#: How a run that blew up is recorded (and reported): "unstable at step N" (N counted from the run's start).
+UNSTABLE = "unstable at step {}"
+
+
+def unstable(exc: Exception, steps_before: int, n: int) -> str | None:
+    """The status of a run whose ``n`` steps from step ``steps_before`` raised ``exc``: "unstable at step N" where
+    ``exc`` says the integration blew up (this package's SimulationBlowUpError names the step of its call;
+    OpenMM's integrators raise an OpenMMException about NaN coordinates: the chunk's last step is given, "by
+    step N"), else None (an error that is not an instability)."""
+    import re
+
+    from ....integrators import SimulationBlowUpError
+
+    if isinstance(exc, SimulationBlowUpError):
+        m = re.search(r"at integrator step (\d+)", str(exc))
+        # the integrator counts from its creation, which is the run's start (one integrator per run)
+        return UNSTABLE.format(int(m.group(1)) if m else steps_before + n)
+    if isinstance(exc, mm.OpenMMException) and "nan" in str(exc).lower():
+        return UNSTABLE.format(f"{steps_before + 1}-{steps_before + n}" if n > 1 else steps_before + 1)
+    return None
 
 
 def replica_seed(cfg: dict, replica: int) -> int:
@@ -42,37 +63,58 @@ def charges(system) -> np.ndarray:
 
 def run_row(scene, x, v, row: dict, cfg: dict, replica: int):
     """One run of ``row`` from the replica state (x, v) of ``scene``; returns (arrays, info).  info: status
-    ("ok" or "blew up at step S"), wall_s, steps, force_evals, obs {key: [value, se] or None}, notes."""
+    ("ok" or "unstable at step S", :func:`unstable`), wall_s, steps, force_evals, obs {key: [value, se] or None}, notes."""
     t0 = time.perf_counter()
     eng = Engine(scene, x, v, row, float(cfg["temperature"]), replica_seed(cfg, replica), cfg.get("threads", 1))
-    h, info = row["step_fs"], describe(row)
+    info = describe(row)
+    h = info["step_fs"]
     mols, m, q = scene.molecules, eng.masses, charges(scene.system)
     n_constraints = scene.system.getNumConstraints()
     box = float(scene.system.getDefaultPeriodicBoxVectors()[0][0].value_in_unit(unit.nanometer))  # cubic
     steps, status = 0, "ok"
 
+    class Unstable(Exception):
+        pass
+
     def advance(n):
-        nonlocal steps
-        eng.step(n)
+        nonlocal steps, status
+        try:
+            eng.step(n)
+        except Exception as exc:  # noqa: BLE001 - an instability is recorded, anything else raised
+            why = unstable(exc, steps, n)
+            if why is None:
+                raise
+            status = why
+            raise Unstable() from None
         steps += n
 
-    advance(max(0, int(round(cfg["settle_ps"] * 1000.0 / h))))
     every_w = steps_per_sample(h, cfg["omega_fs"])
-    xs_w, vs_w = [], []
-    for i in range(int(round(cfg["omega_ps"] * 1000.0 / (every_w * h))) + 1):
-        if i:
-            advance(every_w)
-        xw, vw, _ = eng.sample(energy=False)
-        xs_w.append(xw)
-        vs_w.append(vw)
     every = steps_per_sample(h, cfg["sample_fs"])
     n = int(round(cfg["length_ps"] * 1000.0 / (every * h))) + 1
     keys = ("t", "T_trans", "T_rot", "pe", "etot")
     out = {k: np.full(n, np.nan) for k in keys}
+    xs_w, vs_w = [], []
+    try:
+        advance(max(0, int(round(cfg["settle_ps"] * 1000.0 / h))))
+        for i in range(int(round(cfg["omega_ps"] * 1000.0 / (every_w * h))) + 1):
+            if i:
+                advance(every_w)
+            xw, vw, _ = eng.sample(energy=False)
+            xs_w.append(xw)
+            vs_w.append(vw)
+    except Unstable:
+        pass
+    if status != "ok":
+        info = {"status": status, "steps": steps, "force_evals": steps * info["evals_per_step"],
+                "wall_s": time.perf_counter() - t0}
+        return {k: out[k] for k in keys}, info
     com, dip, hh, oxygen = [], [], [], []
     for i in range(n):
         if i:
-            advance(every)
+            try:
+                advance(every)
+            except Unstable:
+                break
         xs, vs, pe = eng.sample()
         kt = kinetic_temperatures(xs, vs, m, mols, info["keeps_momentum"], n_constraints)
         bath = eng.heat_bath()
@@ -80,7 +122,7 @@ def run_row(scene, x, v, row: dict, cfg: dict, replica: int):
         out["t"][i], out["T_trans"][i], out["T_rot"][i], out["pe"][i], out["etot"][i] = \
             i * every * h * 1e-3, kt.translational, kt.rotational, pe, etot
         if not np.isfinite(etot) or abs(kt.translational) > 1e5:
-            status = f"blew up at step {steps}"
+            status = UNSTABLE.format(steps)
             break
         frame = xs[None]
         com.append(centre_of_mass_trajectory(frame, m, mols)[0])

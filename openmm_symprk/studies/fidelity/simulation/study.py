@@ -19,7 +19,7 @@ import warnings
 from ....systems.checks import ConservationWarning
 from ...core import Run, Study, run_key as hash_key, write_json, write_text
 from ...equipartition.study import STATE_KEYS, STATE_VERSION, replica_state_set
-from ..rowspec import check_row, describe
+from ..rowspec import check_row, describe, to_row
 from .engines import availability
 
 __all__ = ["FidelityStudy", "run_study", "run_key", "temperature_view", "RUN_KEYS", "RUN_VERSION"]
@@ -27,13 +27,37 @@ __all__ = ["FidelityStudy", "run_study", "run_key", "temperature_view", "RUN_KEY
 #: What a run depends on besides its row and replica (the observables are computed in the run: their settings too).
 RUN_KEYS = STATE_KEYS + ("model", "settle_ps", "omega_ps", "omega_fs", "omega_max_lag_ps", "length_ps",
                          "sample_fs", "rdf_every", "msd_window_ps", "tau_fit", "rdf_r_min_nm")
-#: Version of what a run stores; a run stored by another version is never reused.
-RUN_VERSION = 1
+#: Version of what a run stores; a run stored by another version is never reused (2: rows stored as their labels;
+#: leapfrog integrators started from v(-h/2); blow-ups recorded as "unstable at step N").
+RUN_VERSION = 2
+#: The file of the rows' wall time per simulated ps, timed in turns (kept so that --report-only remakes the cost
+#: columns on any machine; a run that times again replaces it).
+TIMINGS = "timings.json"
 
 
-def run_key(cfg: dict, row: dict, replica: int) -> str:
+def run_key(cfg: dict, row, replica: int) -> str:
     return hash_key({"cfg": {k: cfg[k] for k in RUN_KEYS}, "row": check_row(row), "replica": int(replica),
                      "states": STATE_VERSION, "version": RUN_VERSION})
+
+
+def references(cfg: dict, rows: list) -> dict:
+    """{ensemble: canonical label} of the study's references: ``cfg["references"]`` (default: the first row for
+    NVE); ValueError where a reference is not among the rows or not of its ensemble."""
+    given = dict(cfg.get("references") or {"NVE": rows[0]})
+    out = {}
+    for ens, lab in given.items():
+        if ens not in ("NVE", "NVT"):
+            raise ValueError(f"references: ensemble {ens!r}; known: NVE, NVT")
+        lab = check_row(lab)
+        if lab not in rows:
+            raise ValueError(f"the {ens} reference {lab!r} is not among the rows")
+        r = to_row(lab)
+        if r.ensemble != ens or not r.is_ours or r.hmr_da is not None or r.mts:
+            raise ValueError(f"the {ens} reference must be an {ens} row of this package without HMR or MTS, got {lab!r}")
+        out[ens] = lab
+    if "NVE" not in out:
+        raise ValueError("references: an NVE reference is needed")
+    return out
 
 
 _boxes: dict = {}
@@ -62,13 +86,13 @@ def check(cfg: dict) -> list:
     if float(cfg["omega_fs"]) > 4.0:
         raise ValueError(f"omega_fs must be <= 4 fs (the angular-velocity correlation falls to zero within "
                          f"~20 fs), got {cfg['omega_fs']}")
+    if cfg.get("model", "spce") not in ("spce", "tip3p"):
+        raise ValueError(f"model {cfg.get('model')!r}; known: spce, tip3p")
     rows = [check_row(r) for r in cfg["rows"]]
     if not rows:
         raise ValueError("no rows")
-    ref = rows[0]
-    if not (ref["kind"] == "symprk" and describe(ref)["ensemble"] == "NVE" and "hmr_da" not in ref):
-        raise ValueError(f"the first row is the reference and must be an NVE row of this package, got {ref}")
-    labels = [describe(r)["label"] for r in rows]
+    references(cfg, rows)
+    labels = rows
     dup = sorted({x for x in labels if labels.count(x) > 1})
     if dup:
         raise ValueError(f"rows given twice: {', '.join(dup)}")
@@ -85,7 +109,7 @@ class FidelityStudy(Study):
                  log=print, scheduler: str | None = None):
         self.rows = check(cfg)
         super().__init__(out, workers, scheduler, progress, log)
-        self.cfg, self.timing = cfg, timing
+        self.cfg, self.timing, self.report_only = cfg, timing, False
         self.states, self.unavailable, self.box = None, {}, None
 
     def plan(self) -> list:
@@ -109,7 +133,7 @@ class FidelityStudy(Study):
                 continue
             for r in range(int(cfg["replicas"])):
                 cost = describe(row)["evals_per_step"] * (cfg["settle_ps"] + cfg["omega_ps"] + cfg["length_ps"]) \
-                    / row["step_fs"]
+                    / to_row(row).step_fs
                 runs.append(Run(run_key(cfg, row, r), "box", (row, r), {"row": lab, "replica": r}, cost))
         return runs
 
@@ -122,15 +146,19 @@ class FidelityStudy(Study):
             self.log(f"{info['row']} replica {info['replica']}: {info['status']}")
 
     def summarise(self, runs) -> dict:
-        from ..report import chart, format_summary, summarise
+        from ..report import chart, format_summary, markdown_table, summarise
 
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", ConservationWarning)
-            timings = self.timings() if self.timing else {}
+            timings = self.stored_timings() if self.report_only or not self.timing else self.timings()
         grouped = {k[0]: v for k, v in self.results(runs, ("row",)).items()}
-        summary = summarise(self.cfg, self.rows, grouped, timings, self.unavailable, self.box_edge())
-        summary["temperature_view"] = temperature_view(self.cfg, self.rows, grouped, timings)
+        summary = summarise(self.cfg, self.rows, grouped, timings, self.unavailable, self.box_edge(),
+                            references(self.cfg, self.rows))
+        # the temperature view needs each run's time series (<key>.npz), which a committed data set leaves out
+        with_series = {lab: [rep for rep in reps if len(rep[0].get("t", ()))] for lab, reps in grouped.items()}
+        summary["temperature_view"] = temperature_view(self.cfg, self.rows, with_series, timings)
         write_text(os.path.join(self.out, "summary.txt"), format_summary(summary) + "\n")
+        write_text(os.path.join(self.out, "table.md"), markdown_table(summary) + "\n")
         if summary["temperature_view"]:
             from ...equipartition.report import format_summary as equipartition_summary
 
@@ -150,6 +178,16 @@ class FidelityStudy(Study):
 
         return float(self.box.system.getDefaultPeriodicBoxVectors()[0][0].value_in_unit(unit.nanometer))
 
+    def stored_timings(self) -> dict:
+        """The rows' wall time per simulated ps last timed in turns in this folder (:data:`TIMINGS`), {} if none."""
+        import json
+
+        try:
+            with open(os.path.join(self.out, TIMINGS)) as fh:
+                return dict(json.load(fh)["s_per_ps"])
+        except (FileNotFoundError, json.JSONDecodeError, KeyError):
+            return {}
+
     def timings(self) -> dict:
         """Seconds per simulated ps of each available row on replica 0, measured in turns
         (:func:`openmm_symprk.studies.timing.interleaved`), so the ratios hold under the machine's load."""
@@ -162,13 +200,24 @@ class FidelityStudy(Study):
         for row in self.rows:
             lab = describe(row)["label"]
             if lab not in self.unavailable:
-                engines[lab] = (row["step_fs"], Engine(self.box, x[0], v[0], row, float(self.cfg["temperature"]),
+                engines[lab] = (to_row(row).step_fs, Engine(self.box, x[0], v[0], row, float(self.cfg["temperature"]),
                                                        replica_seed(self.cfg, 0), self.cfg.get("threads", 1)))
         block = float(self.cfg.get("timing_fs", 50.0))
         steps = {k: max(1, int(round(block / h))) for k, (h, _) in engines.items()}
         res = interleaved({k: e.step for k, (_, e) in engines.items()}, steps, rounds=3)
         self.log(f"timed {len(engines)} rows in turns")
-        return {k: tm.best / (engines[k][0] * 1e-3) for k, tm in res.items()}
+        out = {k: tm.best / (engines[k][0] * 1e-3) for k, tm in res.items()}
+        import platform
+        import time
+
+        import openmm as mm
+
+        write_json(os.path.join(self.out, TIMINGS), {
+            "s_per_ps": out, "when": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()),
+            "machine": f"{platform.machine()} {os.cpu_count()} cores, OpenMM {mm.__version__} CPU platform, "
+                       f"{self.cfg.get('threads', 1)} thread(s) per run",
+            "how": "each row on replica 0, in turns (studies.timing.interleaved), best of 3 rounds"})
+        return out
 
 
 def temperature_view(cfg: dict, rows: list, grouped: dict, timings: dict) -> dict | None:
@@ -178,17 +227,17 @@ def temperature_view(cfg: dict, rows: list, grouped: dict, timings: dict) -> dic
     series (t, T_trans, T_rot, pe, etot), so the view needs no run of its own.  None without such rows."""
     from ...equipartition.report import summarise as equipartition_summarise
 
-    nve = [r for r in rows if r["kind"] == "symprk" and describe(r)["ensemble"] == "NVE" and "hmr_da" not in r]
-    if not nve:
+    nve = [to_row(r) for r in rows]
+    nve = [r for r in nve if r.is_ours and r.ensemble == "NVE" and r.hmr_da is None and not r.mts]
+    if not nve or not any(grouped.get(r.label) for r in nve):
         return None
     model = cfg["model"]
     eq_cfg = {k: cfg[k] for k in ("n_waters", "cutoff_nm", "density_g_cm3", "temperature", "settle_ps",
                                   "length_ps", "sample_fs")}
-    eq_cfg.update(reference=[nve[0]["method"], nve[0]["step_fs"]],
-                  models={model: [[r["method"], r["step_fs"]] for r in nve]})
-    runs = {(model, r["method"], r["step_fs"]): grouped.get(describe(r)["label"], []) for r in nve}
-    eq_timings = {(model, r["method"], r["step_fs"]): timings[describe(r)["label"]] for r in nve
-                  if describe(r)["label"] in timings}
+    eq_cfg.update(reference=[nve[0].method, nve[0].step_fs],
+                  models={model: [[r.method, r.step_fs] for r in nve]})
+    runs = {(model, r.method, r.step_fs): grouped.get(r.label, []) for r in nve}
+    eq_timings = {(model, r.method, r.step_fs): timings[r.label] for r in nve if r.label in timings}
     return equipartition_summarise(eq_cfg, runs, eq_timings)
 
 
@@ -197,4 +246,6 @@ def run_study(cfg: dict, out: str, workers: int = 2, timing: bool = True, progre
     """Run (or finish, or only re-summarise: ``report_only``, see :meth:`~openmm_symprk.studies.core.study.Study.run`) the study in ``out``; returns the summary (:func:`..report.summarise`)
     and writes ``summary.txt``, ``equipartition.txt`` (:func:`temperature_view`), ``results.json``, ``fidelity.png`` (bias against force evaluations per ps) and,
     with timing, ``fidelity-wall.png`` (against wall time per simulated ps) there."""
-    return FidelityStudy(cfg, out, workers, timing, progress, log, scheduler).run(report_only)
+    study = FidelityStudy(cfg, out, workers, timing, progress, log, scheduler)
+    study.report_only = bool(report_only)
+    return study.run(report_only)
