@@ -25,6 +25,7 @@ import openmm as mm
 
 from ..conservation.diagnostics import angular_momentum, linear_momentum
 from ..support.files import write_text
+from .core import platforms
 from .core.rows import Row
 from .timing import interleaved
 
@@ -34,18 +35,12 @@ DEFAULT_SCENES = ("water", "protein")
 
 
 def _platform(spec):
-    name, _, prec = spec.partition(":")
-    props = {"Precision": prec} if prec else {}
-    return name, props
+    name, precision = platforms.split(spec)
+    return name, platforms.properties(name, precision=precision)
 
 
 def available(spec) -> bool:
-    name, _ = _platform(spec)
-    try:
-        mm.Platform.getPlatformByName(name)
-        return True
-    except Exception:
-        return False
+    return platforms.available(spec)
 
 
 def _scene(name, n_waters):

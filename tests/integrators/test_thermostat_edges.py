@@ -208,3 +208,32 @@ def test_loading_a_checkpoint_keeps_the_current_temperature(backend, cluster):
         from openmm_symprk.integrators import thermostat_program as tp
 
         assert ig.getGlobalVariableByName(tp.TEMPERATURE_VAR) == 450
+
+
+@pytest.mark.parametrize("backend", NATIVE_PENDING)
+def test_linear_triatomic_keeps_p_and_l(backend):
+    """A flexible CO2-like triatomic, isolated, started on a line with velocities along it and a rotation about a
+    perpendicular axis: it stays linear, its inertia tensor is singular, and the kept rotation (w = 2 L / tr I) keeps
+    L and P through the thermostat's events.  (Its degrees of freedom count 3 rotations: the System does not say it
+    is linear, docs/thermostat.md.)"""
+    system = mm.System()
+    for mass in (16.0, 12.0, 16.0):
+        system.addParticle(mass)
+    bond = mm.HarmonicBondForce()
+    bond.addBond(0, 1, 0.116, 5.0e5)
+    bond.addBond(1, 2, 0.116, 5.0e5)
+    system.addForce(bond)
+    ig = SymplecticIntegrator(0.0005, "verlet", system=system, backend=backend, temperature=300,
+                              collision_time=0.02, random_seed=5)
+    x = np.array([[-0.118, 0.0, 0.0], [0.0, 0.0, 0.0], [0.117, 0.0, 0.0]])
+    v = np.array([[0.3, 0.2, 0.0], [-0.1, 0.0, 0.0], [-0.2, -0.2, 0.0]])  # spins about z, drifts along x
+    m = np.array([16.0, 12.0, 16.0])
+    ctx = context(system, ig, x, v)
+    L0 = (m[:, None] * np.cross(x, v)).sum(0)
+    ig.step(2000)
+    st = ctx.getState(getPositions=True, getVelocities=True)
+    X = np.asarray(st.getPositions(asNumpy=True)._value)
+    V = np.asarray(st.getVelocities(asNumpy=True)._value)
+    assert ig.computeHeatBathEnergy() != 0 * unit.kilojoule_per_mole
+    assert np.linalg.norm((m[:, None] * (V - v)).sum(0)) < 1e-12 * np.sum(m[:, None] * np.abs(V))
+    assert np.linalg.norm((m[:, None] * np.cross(X, V)).sum(0) - L0) < 1e-9 * np.linalg.norm(L0)

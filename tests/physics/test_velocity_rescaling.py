@@ -100,3 +100,23 @@ def test_rigid_motion_is_all_kept():
     x, m = rng.normal(size=(6, 3)), rng.uniform(1, 16, 6)
     v = np.array([0.3, -0.2, 0.1]) + np.cross([0.5, 1.0, -2.0], x - (m[:, None] * x).sum(0) / m.sum())
     assert np.allclose(kept_velocities(x, v, m, keep_rotation=True), v, atol=1e-12)
+
+
+def test_round_off_peculiar_energy_is_not_scaled():
+    """K_pec at most 1e-10 of the total kinetic energy (a rigid translation's round-off): factor 1, nothing drawn
+    into the kept motion; just above it the event acts."""
+    from openmm_symprk.physics.velocity_rescaling import ROUNDOFF, no_peculiar_motion
+
+    total = 250.0
+    assert no_peculiar_motion(0.0, 0.0) and no_peculiar_motion(ROUNDOFF * total, total)
+    assert rescaling_factor(ROUNDOFF * total, 10.0, 8, 0.5, 0.7, 4.0, total_kinetic=total) == (1.0, ROUNDOFF * total)
+    alpha, _ = rescaling_factor(2 * ROUNDOFF * total, 10.0, 8, 0.5, 0.7, 4.0, total_kinetic=total)
+    assert alpha > 1e3  # the factor that would amplify round-off, where the peculiar energy is not round-off
+
+
+def test_linear_isolated_systems_have_two_rotations():
+    assert thermostat_dof(2, 0, True) == 1  # a diatomic: its vibration
+    assert thermostat_dof(2, 1, True) == 0  # a rigid diatomic: nothing left
+    assert thermostat_dof(1, 0, True) == 0
+    assert thermostat_dof(3, 0, True) == 3  # three particles: three rotations (the System does not say linear)
+    assert thermostat_dof(2, 0, False) == 3

@@ -17,6 +17,7 @@ import json
 import os
 import sys
 
+from ..core import platforms
 from ..core.cli import KEPT, positive, run_command
 
 
@@ -33,8 +34,8 @@ def _list(values):
 def _check_platform(name):
     import openmm as mm
 
-    names = [mm.Platform.getPlatform(i).getName() for i in range(mm.Platform.getNumPlatforms())]
-    if name not in names:
+    if not platforms.available(name) or ":" in name:
+        names = [mm.Platform.getPlatform(i).getName() for i in range(mm.Platform.getNumPlatforms())]
         raise ValueError(f"unknown OpenMM platform {name!r}; this installation has {', '.join(names)}")
 
 

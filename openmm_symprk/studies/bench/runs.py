@@ -43,6 +43,7 @@ from ...stats import drift
 from . import measure
 from .records import RunRecord
 from ...systems.scenes import Scene
+from ..core import platforms
 from ..core.rows import Row
 from ..core.units import kT, kt_per_ns_per_dof
 
@@ -86,12 +87,12 @@ def label(method: str) -> str:
     return {"openmm-verlet": "OpenMM Verlet", "openmm-langevin": "OpenMM Langevin"}.get(method, method)
 
 
+#: The precision the bench runs a GPU platform in.
+PRECISION = {"OpenCL": "double", "CUDA": "mixed", "HIP": "mixed"}
+
+
 def platform_properties(name: str, threads: int) -> dict:
-    if name == "CPU":
-        return {"Threads": str(threads)}
-    if name in ("OpenCL", "CUDA", "HIP"):
-        return {"Precision": "double" if name == "OpenCL" else "mixed"}
-    return {}
+    return platforms.properties(name, threads, PRECISION.get(name))
 
 
 class Unsupported(Exception):

@@ -17,6 +17,7 @@ import os
 import sys
 
 from ..core.cli import run_study_command
+from ..core.platforms import split
 from . import presets
 
 
@@ -50,6 +51,13 @@ def build_parser(prog: str = "symprk drift"):
     return ap
 
 
+def _bad_platform(spec: str) -> bool:
+    try:
+        return split(spec)[0] not in ("CPU", "Reference", "OpenCL", "CUDA", "HIP")
+    except ValueError:
+        return True
+
+
 def make_config(args) -> dict:
     if args.rows and args.study != "nvt":
         raise ValueError("--rows applies to the nvt study only")
@@ -63,8 +71,7 @@ def make_config(args) -> dict:
         cfg = presets.hmr(args.quick, control=not args.no_control)
     else:
         platforms = [p for p in (args.platforms or "").split(",") if p] or presets.PRECISION_PLATFORMS
-        bad = [p for p in platforms if p.partition(":")[0] not in ("CPU", "Reference", "OpenCL", "CUDA", "HIP")
-               or p.partition(":")[2] not in ("", "single", "mixed", "double")]
+        bad = [p for p in platforms if _bad_platform(p)]
         if bad:
             raise ValueError(f"--platforms: {', '.join(bad)} not understood; give NAME or NAME:PRECISION, e.g. "
                              f"CPU,OpenCL:single,OpenCL:mixed,OpenCL:double")

@@ -12,6 +12,7 @@ the thermostat) drifts more than ``ref`` (switched off).  Both are paired by rep
 """
 from __future__ import annotations
 
+from ..core.platforms import split
 from ..core.rows import Row
 
 __all__ = ["hmr", "exact_momentum", "nvt", "nvt_pairs", "PRECISION_PLATFORMS", "OPENMM_PUBLISHED", "STUDIES"]
@@ -34,10 +35,10 @@ def _common(quick: bool) -> dict:
 
 
 def _row(name, scene, label, platform="CPU"):
-    plat, _, precision = platform.partition(":")
+    plat, precision = split(platform)
     row = Row.parse(label)
     return {"name": name, "scene": scene, "row": row.label, "step_fs": row.step_fs, "platform": plat,
-            "precision": precision or None}
+            "precision": precision}
 
 
 def hmr(quick: bool = False, control: bool = True) -> dict:

@@ -14,9 +14,10 @@ import numpy as np
 import openmm as mm
 import openmm.unit as unit
 
+from ..core.platforms import properties
 from ..core.rows import Row
 
-__all__ = ["row_of", "properties", "run_nve"]
+__all__ = ["row_of", "run_nve"]
 
 
 def row_of(row: dict) -> Row:
@@ -25,14 +26,6 @@ def row_of(row: dict) -> Row:
     if "row" in row:
         return Row.parse(row["row"])
     return Row(row["integrator"], float(row["step_fs"]), exact_momentum=bool(row.get("exact_momentum", False)))
-
-
-def properties(row: dict, threads: int) -> dict:
-    if row["platform"] == "CPU":
-        return {"Threads": str(int(threads))}
-    if row.get("precision"):
-        return {"Precision": row["precision"]}
-    return {}
 
 
 def run_nve(system, x0, v0, row: dict, cfg: dict, seed: int = 1):
@@ -44,7 +37,7 @@ def run_nve(system, x0, v0, row: dict, cfg: dict, seed: int = 1):
     ig = spec.build(system, seed=seed, constraint_tolerance=cfg["constraint_tolerance"])
     heat = ig.computeHeatBathEnergy if spec.thermostat and spec.has_heat_bath else None
     plat = mm.Platform.getPlatformByName(row["platform"])
-    ctx = mm.Context(system, ig, plat, properties(row, cfg.get("threads", 1)))
+    ctx = mm.Context(system, ig, plat, properties(row["platform"], cfg.get("threads", 1), row.get("precision")))
     info = {"status": "ok", "n_dof": int(degrees_of_freedom(system)), "platform_used": plat.getName()}
     try:
         spec.set_state(ctx, x0, v0)

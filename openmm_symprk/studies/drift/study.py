@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import os
 
-from ..core import Run, Study, run_key as hash_key, write_json, write_text
+from ..core import Run, Study, platforms, run_key as hash_key, write_json, write_text
 from ...systems.scenes.replicas import replica_states, state_key
 
 __all__ = ["DriftStudy", "run_study", "run_key", "check"]
@@ -77,16 +77,6 @@ def check(cfg: dict):
                 raise ValueError(f"comparison {c}: no row named {c[k]!r} (rows: {', '.join(names)})")
 
 
-def available(platform: str) -> bool:
-    import openmm as mm
-
-    try:
-        mm.Platform.getPlatformByName(platform)
-        return True
-    except Exception:
-        return False
-
-
 _systems: dict = {}
 
 
@@ -121,7 +111,7 @@ class DriftStudy(Study):
         """The rows whose platform this installation has."""
         rows, self.skipped = [], []
         for row in self.cfg["rows"]:
-            (rows if available(row["platform"]) else self.skipped).append(row)
+            (rows if platforms.available(row["platform"]) else self.skipped).append(row)
         for row in self.skipped:
             self.log(f"skipping row {row['name']}: no OpenMM platform {row['platform']} here")
         return rows

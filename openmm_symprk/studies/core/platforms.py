@@ -1,0 +1,36 @@
+"""OpenMM platforms as the studies name them: ``NAME`` or ``NAME:PRECISION`` (e.g. ``CPU``, ``OpenCL:mixed``), whether
+this installation has one, and the Context properties a run sets (the CPU platform's threads, a GPU platform's
+precision)."""
+from __future__ import annotations
+
+__all__ = ["PRECISIONS", "split", "available", "properties"]
+
+#: The precision modes of OpenMM's OpenCL, CUDA and HIP platforms.
+PRECISIONS = ("single", "mixed", "double")
+
+
+def split(spec: str) -> tuple:
+    """``"OpenCL:mixed"`` -> ("OpenCL", "mixed"); ``"CPU"`` -> ("CPU", None); ValueError for an unknown precision."""
+    name, _, precision = str(spec).partition(":")
+    if precision and precision not in PRECISIONS:
+        raise ValueError(f"platform {spec!r}: precision {precision!r} not known; give NAME or NAME:PRECISION with "
+                         f"PRECISION one of {', '.join(PRECISIONS)}, e.g. CPU,OpenCL:single,OpenCL:mixed,OpenCL:double")
+    return name, precision or None
+
+
+def available(name: str) -> bool:
+    """Whether this installation of OpenMM has the platform ``name`` (a spec's precision is ignored)."""
+    import openmm as mm
+
+    try:
+        mm.Platform.getPlatformByName(split(name)[0])
+        return True
+    except Exception:
+        return False
+
+
+def properties(name: str, threads: int | None = None, precision: str | None = None) -> dict:
+    """The Context properties of a run: ``Threads`` on the CPU platform, ``Precision`` elsewhere when given."""
+    if name == "CPU":
+        return {"Threads": str(int(threads))} if threads else {}
+    return {"Precision": precision} if precision else {}
