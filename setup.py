@@ -271,10 +271,11 @@ EXTRAS = {
     "studies": ["matplotlib>=3.7", "tqdm>=4.60", "pymbar>=4", "scipy>=1.10", "MDAnalysis>=2.7"],
     "cluster": ["dask[distributed]>=2023.1"],
     "cuda12": ["openmm-cuda-12>=8.6,<8.7"],
-    # the documentation site (docs/conf.py subclasses Sphinx's Python domain: Sphinx's major version is pinned)
-    "docs": ["sphinx>=8,<10", "myst-parser>=4", "furo>=2024.1"],
 }
 EXTRAS["all"] = sorted(set(EXTRAS["analysis"] + EXTRAS["studies"]))
+# the documentation site: Sphinx, MyST and a theme (docs/conf.py subclasses Sphinx's Python domain, so Sphinx's major
+# version is pinned), and everything `all` installs, since the API reference imports every module
+EXTRAS["docs"] = sorted(set(["sphinx>=8,<10", "myst-parser>=4", "furo>=2024.1"] + EXTRAS["all"]))
 #: The test-suite cross-checks the analyses against MDAnalysis' test files and the MDAKits that compute the same.
 CROSS_CHECKS = ["MDAnalysisTests>=2.7", "waterdynamics>=1.2", "transport-analysis>=0.1.2", "tidynamics>=1.1"]
 EXTRAS["test"] = sorted(set(["pytest>=7", "pyelftools>=0.29"] + EXTRAS["all"] + EXTRAS["cluster"] + CROSS_CHECKS))

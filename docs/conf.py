@@ -39,7 +39,7 @@ extensions = [
 
 source_suffix = {".rst": "restructuredtext", ".md": "markdown"}
 root_doc = "index"
-exclude_patterns = ["_build"]
+exclude_patterns = ["_build", "data"]  # data: studies' committed results (docs/data/fidelity), not pages
 
 # -- the pages (MyST) --------------------------------------------------------------------------------------
 #: Markdown headings up to this level get GitHub-style anchors, so that links such as thermostat.md#api work.
@@ -83,7 +83,7 @@ nitpick_ignore_regex = [
 def _modules():
     """Every module of the package, packages before their modules, in name order (build outputs left out)."""
     pkg = importlib.import_module(PACKAGE)
-    names = [PACKAGE] + [m.name for m in pkgutil.walk_packages(pkg.__path__, PACKAGE + ".")]
+    names = [PACKAGE] + [m.name for m in pkgutil.walk_packages(pkg.__path__, PACKAGE + ".", onerror=lambda name: None)]
     return sorted(n for n in names if not API_SKIP.fullmatch(n) and not any(p.startswith("_") for p in n.split(".")))
 
 
@@ -113,10 +113,17 @@ def _write_api_pages(app):
     (``openmm_symprk.stats.drift`` is both), which makes it document the function in place of the module."""
     out = os.path.join(app.srcdir, API_DIR)
     os.makedirs(out, exist_ok=True)
-    names = _modules()
+    names, modules = [], {}
+    for name in _modules():
+        try:
+            modules[name] = importlib.import_module(name)
+            names.append(name)
+        except ImportError as exc:  # a warning (an error under -W) that says what to install, not a traceback
+            _LOG.warning(f"API reference: {name} does not import ({exc}); pip install -e '.[docs]' installs what every "
+                         f"module needs")
     pages = {}
     for name in names:
-        module = importlib.import_module(name)
+        module = modules[name]
         title = f"``{name}``"
         lines = [title, "=" * len(title), "", f".. automodule:: {name}", ""]
         summary = []
@@ -124,7 +131,7 @@ def _write_api_pages(app):
         if children:
             summary += ["", ".. rubric:: Modules", ""]
             for child in children:
-                doc = inspect.getdoc(importlib.import_module(child)) or ""
+                doc = inspect.getdoc(modules[child]) or ""
                 first = [doc.split("\n\n")[0].replace("\n", " ").strip()]
                 first[0] = _ROLE.sub(lambda m: f"``{m.group(2).lstrip('.')}``", first[0])  # relative to the child
                 _norm_bars(app, "module", child, None, None, first)

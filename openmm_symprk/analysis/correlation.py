@@ -29,17 +29,23 @@ def check_max_lag(n_frames: int, max_lag: int | None) -> int:
     return max_lag
 
 
-def origin_averaged_correlation(a, max_lag: int | None = None) -> np.ndarray:
+def origin_averaged_correlation(a, max_lag: int | None = None, chunk: int = 256) -> np.ndarray:
     """c(m) = <a(t0) a(t0 + m)> averaged over time origins t0, for every series in ``a``.
 
     ``a``: (n_frames, ...) - time first, any number of independent series after it.  Returns
-    (max_lag + 1, ...), lags 0..max_lag frames (default n_frames // 2), same trailing shape, float64.
+    (max_lag + 1, ...), lags 0..max_lag frames (default n_frames // 2), same trailing shape, float64.  The
+    series are transformed ``chunk`` at a time (the padded transforms of all at once would hold 8 times the
+    input).
     """
-    a = np.asarray(a, dtype=np.float64)
+    a = np.asarray(a)
     n = a.shape[0]
     max_lag = check_max_lag(n, max_lag)
     size = 1 << int(np.ceil(np.log2(2 * n)))  # zero padding to >= 2n: no wrap-around
-    f = np.fft.rfft(a, size, axis=0)
-    c = np.fft.irfft(f * np.conj(f), size, axis=0)[:max_lag + 1]
-    counts = (n - np.arange(max_lag + 1)).reshape((-1,) + (1,) * (a.ndim - 1))
-    return c / counts
+    flat = a.reshape(n, -1)
+    out = np.empty((max_lag + 1, flat.shape[1]))
+    for k in range(0, flat.shape[1], chunk):
+        f = np.fft.rfft(flat[:, k:k + chunk].astype(np.float64), size, axis=0)
+        f *= np.conj(f)
+        out[:, k:k + chunk] = np.fft.irfft(f, size, axis=0)[:max_lag + 1]
+    out /= (n - np.arange(max_lag + 1))[:, None]
+    return out.reshape((max_lag + 1,) + a.shape[1:])

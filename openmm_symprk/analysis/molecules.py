@@ -46,13 +46,17 @@ def make_whole(x, molecules, box) -> np.ndarray:
     """Positions (F, n, k, 3) nm of the k atoms of each of the n ``molecules`` in ``x`` (F, N, 3) nm, each atom
     moved to the periodic image nearest the molecule's first atom in the orthorhombic ``box`` (3 edges nm, or
     (F, 3) one per frame; None: ``x`` is whole already)."""
-    x = _trajectory(x, "x")
-    xg = x[:, molecule_index(molecules)]
+    x = np.asarray(x)
+    if x.ndim != 3 or x.shape[2] != 3:
+        raise ValueError(f"x must have shape (n_frames, n_atoms, 3) in nm, got {x.shape}")
+    xg = x[:, molecule_index(molecules)].astype(np.float64)
     if box is not None:
         b = check_box(box, x.shape[0])[:, None, None, :]
         d = xg - xg[:, :, :1]
-        d -= b * np.round(d / b)
-        xg = xg[:, :, :1] + d
+        shift = np.divide(d, b)
+        np.round(shift, out=shift)
+        shift *= b
+        xg -= shift
     return xg
 
 
@@ -83,16 +87,27 @@ def trajectory_frames(x, v, m, molecules) -> MoleculeFrames:
     return MoleculeFrames(*(a.reshape((f, n) + a.shape[1:]) for a in fr))
 
 
-def centre_of_mass_trajectory(x, m, molecules, box=None) -> np.ndarray:
+def centre_of_mass_trajectory(x, m, molecules, box=None, chunk: int = 256) -> np.ndarray:
     """Centres of mass (F, n, 3) nm of the molecules along the trajectory ``x`` (F, N, 3) nm with masses ``m``
     (N,) Da (the :func:`~openmm_symprk.physics.momenta.molecule_frames` centre, without the rest of the
-    frame); with ``box``, of the molecules made whole first (:func:`make_whole`)."""
-    xg = make_whole(x, molecules, box)
+    frame); with ``box``, of the molecules made whole first (:func:`make_whole`).  Computed ``chunk`` frames at a
+    time, so that float32 frames are never copied whole into float64."""
+    x = np.asarray(x)
+    if x.ndim != 3 or x.shape[2] != 3:
+        raise ValueError(f"x must have shape (n_frames, n_atoms, 3) in nm, got {x.shape}")
     m = np.asarray(m, dtype=np.float64)
-    if m.shape != (np.asarray(x).shape[1],):
-        raise ValueError(f"m must have shape ({np.asarray(x).shape[1]},) (one mass per atom, Da), got {m.shape}")
-    mg = m[molecule_index(molecules)]
+    if m.shape != (x.shape[1],):
+        raise ValueError(f"m must have shape ({x.shape[1]},) (one mass per atom, Da), got {m.shape}")
+    idx = molecule_index(molecules)
+    mg = m[idx]
     total = mg.sum(axis=1)
     if np.any(total <= 0):
         raise ValueError("a molecule has no mass: no centre of mass")
-    return np.einsum("nk,fnkd->fnd", mg / total[:, None], xg)
+    w = mg / total[:, None]
+    boxes = None if box is None else check_box(box, x.shape[0])
+    out = np.empty((x.shape[0], len(idx), 3))
+    for a in range(0, x.shape[0], chunk):
+        b = min(a + chunk, x.shape[0])
+        xg = make_whole(x[a:b], idx, None if boxes is None else boxes[a:b])
+        out[a:b] = np.einsum("nk,fnkd->fnd", w, xg)
+    return out

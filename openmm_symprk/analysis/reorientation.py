@@ -30,7 +30,7 @@ from .correlation import origin_averaged_correlation
 from .molecules import make_whole, molecule_index
 
 __all__ = ["atom_vectors", "bisector_vectors", "dipole_vectors", "legendre_correlation", "correlation_time",
-           "CorrelationTime", "reorientation_time"]
+           "CorrelationTime", "reorientation_time", "molecules_correlation_time"]
 
 
 def _positions(x, molecules, box):
@@ -136,7 +136,13 @@ def reorientation_time(u, order: int, dt_ps: float, *, n_groups: int = 20, max_l
     error) for unit vectors ``u`` (F, n, 3) every ``dt_ps``.  The error is the delete-one-group jackknife over
     ``n_groups`` disjoint groups of molecules (:func:`openmm_symprk.stats.jackknife`)."""
     c = legendre_correlation(u, order, max_lag)
-    mean = c.mean(axis=1)
-    result = correlation_time(mean, dt_ps, c_cut, c_fit)
+    return c.mean(axis=1), molecules_correlation_time(c, dt_ps, n_groups=n_groups, c_cut=c_cut, c_fit=c_fit)
+
+
+def molecules_correlation_time(c, dt_ps: float, *, n_groups: int = 20, c_cut: float = 0.1,
+                               c_fit: float = 0.5) -> CorrelationTime:
+    """:class:`CorrelationTime` of the molecule average of ``c`` (L, n), one correlation function per molecule
+    (from :func:`legendre_correlation`), with its jackknife error over ``n_groups`` groups of molecules."""
+    result = correlation_time(np.asarray(c).mean(axis=1), dt_ps, c_cut, c_fit)
     _, result.se = jackknife(c, lambda m: correlation_time(m, dt_ps, c_cut, c_fit).tau, n_groups)
-    return mean, result
+    return result

@@ -11,8 +11,8 @@ One place for the statistics every study, the bench and the reporters use:
   molecules (a correlation time) or replicas.
 """
 from .compare import Estimate, agrees, combine, difference, no_larger, paired
-from .slope import Drift, RunningLine, drift
 from .jackknife import jackknife
+from .slope import Drift, RunningLine, drift
 from .timeseries import SeriesStats, block_stats, equilibrated_from, series_stats, statistical_inefficiency
 
 __all__ = ["Estimate", "agrees", "combine", "difference", "no_larger", "paired", "Drift", "RunningLine", "drift",

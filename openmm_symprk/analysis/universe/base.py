@@ -9,7 +9,8 @@ OpenMM System's through ``masses=``), charges the topology's where it has them.
 
 Frames (:class:`WaterFrames`): each frame's water positions (and velocities where asked) are copied as
 float32 (what the file stores), with the box; every computation runs once over all frames at the end, in
-float64, vectorised over frames and molecules (no Python loop per molecule).  Memory: 12 bytes per site and
+float64 (the centres of mass a chunk of frames at a time), vectorised over frames and molecules (no Python
+loop per molecule).  Memory: 12 bytes per site and
 frame for positions, as much again for velocities (1000 frames of 216 waters: 7.8 MB).  Boxes must be
 orthorhombic; without a box, positions are taken as continuous and molecules as whole.
 """
@@ -129,10 +130,12 @@ class WaterFrames(AnalysisBase):
             self._box[i] = dims[:3]
 
     def _conclude(self):
-        x = self._x.astype(np.float64) * ANGSTROM_IN_NM
-        v = None if self._v is None else self._v.astype(np.float64) * ANGSTROM_IN_NM
+        x, v = self._x, self._v
+        x *= ANGSTROM_IN_NM  # in place, float32 (what the file stored): the kernels compute in float64
+        if v is not None:
+            v *= ANGSTROM_IN_NM
         box = None if np.isnan(self._box).any() else self._box * ANGSTROM_IN_NM
-        self._x = self._v = None  # the float64 copies are all that is kept, for the computation only
+        self._x = self._v = None
         self._analyse(x, v, box)
 
     def frame_interval_ps(self) -> float:

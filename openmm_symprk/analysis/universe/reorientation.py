@@ -15,7 +15,7 @@ VECTORS = ("dipole", "HH", "OH")
 class Reorientation(WaterFrames):
     """Legendre correlation functions C_1, C_2 of water's dipole, H-H and O-H unit vectors over every time
     origin, and their correlation times tau_1, tau_2 (ps) with jackknife errors over ``n_groups`` groups of
-    molecules (:func:`~openmm_symprk.analysis.reorientation.reorientation_time`: the integral of C_l to where it
+    molecules (:func:`~openmm_symprk.analysis.reorientation.molecules_correlation_time`: the integral of C_l to where it
     falls to ``c_cut``, an exponential tail fitted between ``c_fit`` and ``c_cut``).
 
     The dipole is sum q_i x_i from the topology's charges (massless charge sites included), or the H-H
@@ -62,12 +62,10 @@ class Reorientation(WaterFrames):
             r.C[name], r.tau[name], r.notes[name] = {}, {}, {}
             for order in self._orders:
                 c = reorientation.legendre_correlation(u, order, o["max_lag"])
-                mean = c.mean(axis=1)
-                r.C[name][f"C{order}"] = mean
+                r.C[name][f"C{order}"] = c.mean(axis=1)
                 try:
-                    _, tau = reorientation.reorientation_time(u, order, dt, n_groups=o["n_groups"],
-                                                              max_lag=o["max_lag"], c_cut=o["c_cut"],
-                                                              c_fit=o["c_fit"])
+                    tau = reorientation.molecules_correlation_time(c, dt, n_groups=o["n_groups"], c_cut=o["c_cut"],
+                                                                   c_fit=o["c_fit"])
                 except ValueError as exc:
                     tau = None
                     r.notes[name][f"tau{order}"] = str(exc)

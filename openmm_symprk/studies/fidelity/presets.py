@@ -53,14 +53,14 @@ def full() -> dict:
     """The study of docs/fidelity.md: rigid SPC/E, 216 waters at 0.997 g/cm^3 (the equipartition study's box and
     replica states), 16 replicas; per run 2 ps to settle, 2 ps with frames every 4 fs (the angular-velocity
     correlation), then 20 ps with a frame every 24 fs (temperatures, energies, diffusion, reorientation; g(r)
-    from every 5th frame); wall time per simulated ps timed in turns, 3 blocks of 200 fs per row.  About 3 hours on 2
+    from every 5th frame); wall time per simulated ps timed in turns, 3 blocks of 1 ps per row (200 fs gave ratios off by 3x on a loaded machine).  About 3 hours on 2
     cores (18 rows x 16 replicas; more cores with --scheduler)."""
     return {
         "model": "spce", "n_waters": 216, "cutoff_nm": 0.9, "density_g_cm3": 0.997, "temperature": 300.0,
         "seed": 2024, "equilibrate_ps": 20.0, "spacing_ps": 5.0, "threads": 1, "replicas": 16,
         "settle_ps": 2.0, "omega_ps": 2.0, "omega_fs": 4.0, "omega_max_lag_ps": 0.5,
         "length_ps": 20.0, "sample_fs": 24.0, "rdf_every": 5,
-        "msd_window_ps": [2.0, 8.0], "tau_fit": [0.1, 0.5], "rdf_r_min_nm": 0.2, "timing_fs": 200.0,
+        "msd_window_ps": [2.0, 8.0], "tau_fit": [0.1, 0.5], "rdf_r_min_nm": 0.2, "timing_fs": 1000.0,
         "rows": list(ROWS), "references": dict(REFERENCES),
     }
 
