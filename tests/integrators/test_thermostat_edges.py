@@ -26,15 +26,25 @@ def _native_reason():
 
 BACKENDS = ["custom", pytest.param("native", marks=pytest.mark.skipif(_native_reason() is not None,
                                                                         reason=str(_native_reason())))]
-#: items whose native side (the C++ kernels) is the plugin's own change: expected to fail on native until it is in
-#: this build (non-strict: an XPASS then says the mark can go)
-NATIVE_PENDING = ["custom", pytest.param("native", marks=[
-    pytest.mark.skipif(_native_reason() is not None, reason=str(_native_reason())),
-    pytest.mark.xfail(reason="the native kernels' side of this item is not in this build yet", strict=False)])]
 
 
-def context(system, ig, x, v, platform=REF):
-    ctx = mm.Context(system, ig, mm.Platform.getPlatformByName(platform))
+#: the linear-system tests on native also run the Common (device) kernel, in double precision, where it is built
+LINEAR_CASES = ["custom", pytest.param("native", marks=pytest.mark.skipif(_native_reason() is not None,
+                                                                          reason=str(_native_reason()))),
+                pytest.param("native-opencl", marks=pytest.mark.skipif(
+                    _native_reason() is not None or "OpenCL" not in plugin.platforms(),
+                    reason="no native OpenCL kernel here"))]
+
+
+def _linear_case(case):
+    """(backend, platform, properties) of a LINEAR_CASES entry."""
+    if case == "native-opencl":
+        return "native", "OpenCL", {"Precision": "double"}
+    return case, REF, {}
+
+
+def context(system, ig, x, v, platform=REF, properties=None):
+    ctx = mm.Context(system, ig, mm.Platform.getPlatformByName(platform), properties or {})
     ctx.setPositions(x)
     ctx.setVelocities(v)
     return ctx
@@ -116,7 +126,9 @@ def test_angular_momentum_kept_far_from_the_origin(backend, distance):
     m = np.array([scene.system.getParticleMass(i).value_in_unit(unit.dalton)
                   for i in range(scene.system.getNumParticles())])
     change = {}
-    for kind, options in (("nve", {}), ("nvt", dict(temperature=300, collision_time=0.01, random_seed=3))):
+    # the ends placement (the bound of the middle one, 20x, is in test_thermostat_native_placement)
+    nvt = dict(temperature=300, collision_time=0.01, random_seed=3, thermostat_position="ends")
+    for kind, options in (("nve", {}), ("nvt", nvt)):
         ig = SymplecticIntegrator(0.002, "verlet", system=scene.system, backend=backend, **options)
         ctx = context(scene.system, ig, x, scene.velocities)
 
@@ -165,10 +177,11 @@ def test_no_peculiar_kinetic_energy_warns_once_and_scales_nothing(backend, motio
 
 
 # -- linear isolated systems -----------------------------------------------------------------------------------------
-@pytest.mark.parametrize("backend", NATIVE_PENDING)
-def test_isolated_diatomic_has_one_degree_of_freedom_and_keeps_l(backend):
+@pytest.mark.parametrize("case", LINEAR_CASES)
+def test_isolated_diatomic_has_one_degree_of_freedom_and_keeps_l(case):
     """A harmonic diatomic in vacuum: 6 - 3 (centre of mass) - 2 (rotations of a linear system) = 1 degree of
     freedom, the vibration; its thermostat keeps P and L and samples <K_vib> = kT/2."""
+    backend, platform, properties = _linear_case(case)
     system = mm.System()
     for mass in (12.0, 16.0):
         system.addParticle(mass)
@@ -180,7 +193,7 @@ def test_isolated_diatomic_has_one_degree_of_freedom_and_keeps_l(backend):
     assert ig.thermostat_dof == 1
     x = np.array([[0.0, 0.0, 0.0], [0.115, 0.01, 0.0]])
     v = np.array([[0.1, 0.5, -0.2], [-0.3, -0.2, 0.4]])
-    ctx = context(system, ig, x, v)
+    ctx = context(system, ig, x, v, platform, properties)
     m = np.array([12.0, 16.0])
     L0 = (m[:, None] * np.cross(x, v)).sum(0)
     ig.step(2000)
@@ -210,12 +223,13 @@ def test_loading_a_checkpoint_keeps_the_current_temperature(backend, cluster):
         assert ig.getGlobalVariableByName(tp.TEMPERATURE_VAR) == 450
 
 
-@pytest.mark.parametrize("backend", NATIVE_PENDING)
-def test_linear_triatomic_keeps_p_and_l(backend):
+@pytest.mark.parametrize("case", LINEAR_CASES)
+def test_linear_triatomic_keeps_p_and_l(case):
     """A flexible CO2-like triatomic, isolated, started on a line with velocities along it and a rotation about a
     perpendicular axis: it stays linear, its inertia tensor is singular, and the kept rotation (w = 2 L / tr I) keeps
     L and P through the thermostat's events.  (Its degrees of freedom count 3 rotations: the System does not say it
     is linear, docs/thermostat.md.)"""
+    backend, platform, properties = _linear_case(case)
     system = mm.System()
     for mass in (16.0, 12.0, 16.0):
         system.addParticle(mass)
@@ -225,10 +239,11 @@ def test_linear_triatomic_keeps_p_and_l(backend):
     system.addForce(bond)
     ig = SymplecticIntegrator(0.0005, "verlet", system=system, backend=backend, temperature=300,
                               collision_time=0.02, random_seed=5)
+    assert ig.thermostat_dof == 9 - 3 - 3  # fixed before positions exist: 3 rotations (docs/thermostat.md)
     x = np.array([[-0.118, 0.0, 0.0], [0.0, 0.0, 0.0], [0.117, 0.0, 0.0]])
     v = np.array([[0.3, 0.2, 0.0], [-0.1, 0.0, 0.0], [-0.2, -0.2, 0.0]])  # spins about z, drifts along x
     m = np.array([16.0, 12.0, 16.0])
-    ctx = context(system, ig, x, v)
+    ctx = context(system, ig, x, v, platform, properties)
     L0 = (m[:, None] * np.cross(x, v)).sum(0)
     ig.step(2000)
     st = ctx.getState(getPositions=True, getVelocities=True)

@@ -23,9 +23,15 @@ Vec3 SymPRKPlugin::solveInertia(Vec3 d, Vec3 o, Vec3 rhs, bool regularise) {
     const double trace = Ixx+Iyy+Izz;
     double det;
     if (!regularise) {
+        // The thermostat's kept rotation: the exact inverse, or for a linear system (det below 1e-10 trace^3, the
+        // custom backend's LINEAR), whose moment about its axis is 0, w = 2 rhs/trace: its two equal moments are
+        // trace/2 and its angular momentum is perpendicular to the axis.
         Vec3 exact = adjugateTimes(Ixx, Iyy, Izz, Ixy, Ixz, Iyz, rhs, det);
-        if (std::isfinite(det) && fabs(det) > 1e-9*trace*trace*trace)
+        if (std::isfinite(det) && fabs(det) > 1e-10*trace*trace*trace)
             return exact/det;
+        if (std::isfinite(trace) && trace > 0)
+            return rhs*(2.0/trace);
+        return Vec3();
     }
     double shift = 1e-12*trace;
     Vec3 shifted = adjugateTimes(Ixx+shift, Iyy+shift, Izz+shift, Ixy, Ixz, Iyz, rhs, det);

@@ -71,16 +71,20 @@ inline DEVICE symprk_acc3 symprkAdjugateTimes(symprk_acc Ixx, symprk_acc Iyy, sy
  * I^-1 rhs for the inertia tensor about the centre of mass given by d = (sum m x^2, sum m y^2, sum m z^2) and
  * o = (sum m xy, sum m xz, sum m yz) (the operations of the host's SymPRKPlugin::solveInertia).  regularise: I
  * shifted by 1e-12 of its trace, 0 if still singular; else the exact inverse unless the determinant is below
- * 1e-9 trace^3 (then the regularised one).
+ * 1e-10 trace^3 (a linear system: 2 rhs/trace).
  */
 inline DEVICE symprk_acc3 symprkSolveInertia(symprk_acc3 d, symprk_acc3 o, symprk_acc3 rhs, int regularise) {
     const symprk_acc Ixx = d.y+d.z, Iyy = d.x+d.z, Izz = d.x+d.y, Ixy = -o.x, Ixz = -o.y, Iyz = -o.z;
     const symprk_acc trace = Ixx+Iyy+Izz;
     symprk_acc det;
     if (!regularise) {
+        // the thermostat's kept rotation; a linear system (det below 1e-10 trace^3): w = 2 rhs/trace
         symprk_acc3 exact = symprkAdjugateTimes(Ixx, Iyy, Izz, Ixy, Ixz, Iyz, rhs, &det);
-        if (isfinite(det) && fabs(det) > (symprk_acc) 1e-9*trace*trace*trace)
+        if (isfinite(det) && fabs(det) > (symprk_acc) 1e-10*trace*trace*trace)
             return make_symprk_acc3(exact.x/det, exact.y/det, exact.z/det);
+        if (isfinite(trace) && trace > 0)
+            return make_symprk_acc3(2*rhs.x/trace, 2*rhs.y/trace, 2*rhs.z/trace);
+        return make_symprk_acc3(0, 0, 0);
     }
     const symprk_acc shift = (symprk_acc) 1e-12*trace;
     symprk_acc3 shifted = symprkAdjugateTimes(Ixx+shift, Iyy+shift, Izz+shift, Ixy, Ixz, Iyz, rhs, &det);

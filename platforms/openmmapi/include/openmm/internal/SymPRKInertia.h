@@ -15,7 +15,8 @@ namespace SymPRKPlugin {
  * o = (sum m xy, sum m xz, sum m yz) (positions relative to the centre of mass).
  * regularise true: I shifted by 1e-12 of its trace (a linear molecule or a single particle then gives a finite
  * result; the shift changes a round-off-sized torque by 1e-12 of itself); 0 if still singular.
- * regularise false: the exact inverse, unless the determinant is below 1e-9 trace^3 (then the regularised one).
+ * regularise false (the thermostat's kept rotation): the exact inverse, unless the determinant is below 1e-10 trace^3:
+ * a linear system, whose rotation is 2 rhs/trace (its two equal moments are trace/2), 0 for a zero trace.
  */
 OPENMM_EXPORT_SYMPRK OpenMM::Vec3 solveInertia(OpenMM::Vec3 d, OpenMM::Vec3 o, OpenMM::Vec3 rhs, bool regularise = true);
 
