@@ -36,8 +36,9 @@ class SymplecticIntegrator(IntegratorBase):
       (see :class:`~openmm_symprk.integrators.custom_backend.PRKIntegrator`);
     * NVT: ``temperature`` (K, needs ``system=``), ``collision_time`` (ps, default 0.1), ``thermostat_interval``
       (default 1, at most 2**31 - 1), ``random_seed`` (default 0: fresh per Context) and ``thermostat_position``
-      ("ends", the default: half events around the step; "middle": one event at the step's centre, exact
-      configurations for Verlet; "auto": the better of the two for the method, docs/thermostat.md) add stochastic
+      ("auto", the default: the better placement for the method, middle for verlet and ends for the others,
+      docs/thermostat.md; "ends": half events around the step; "middle": one event at the step's centre, exact
+      configurations for Verlet) add stochastic
       velocity rescaling, keeping total momentum (and angular momentum of an isolated System) exactly
       (:mod:`openmm_symprk.integrators.thermostat`); accessors ``getTemperature``, ``setTemperature``,
       ``computeHeatBathEnergy``, ``thermostat_kinetic_energy``, ``thermostat_dof``... (:class:`~.base.IntegratorBase`).

@@ -36,7 +36,7 @@ MAX_SEED = 2**31 - 1
 #: Largest thermostat interval: the native plugin holds it in a 32-bit signed int (and a longer one is an NVE run).
 MAX_INTERVAL = 2**31 - 1
 #: Where the thermostat sits when ``thermostat_position`` is not given (see :func:`check_position`).
-DEFAULT_POSITION = "ends"
+DEFAULT_POSITION = "auto"
 
 
 def temperature_in_kelvin(temperature) -> float:

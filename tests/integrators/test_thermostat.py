@@ -169,7 +169,7 @@ def test_errors_about_the_system(backend):
 @pytest.mark.parametrize("backend", BACKENDS)
 def test_accessors_and_their_errors(backend, cluster):
     ig = SymplecticIntegrator(0.002, "verlet", system=cluster.system, backend=backend, temperature=310,
-                              collision_time=50 * unit.femtoseconds, thermostat_interval=4, random_seed=7)
+                              collision_time=50 * unit.femtoseconds, thermostat_interval=4, random_seed=7, thermostat_position="ends")
     assert ig.getTemperature() == 310 * unit.kelvin
     assert ig.getCollisionTime().value_in_unit(unit.picoseconds) == pytest.approx(0.05, rel=1e-15)
     assert ig.getThermostatInterval() == 4 and ig.getRandomNumberSeed() == 7
@@ -194,7 +194,7 @@ def test_accessors_and_their_errors(backend, cluster):
 # -- the event is physics.velocity_rescaling's, bit for bit (CustomIntegrator program) ---------------------------
 def test_custom_event_computes_rescaling_factor_exactly(cluster):
     ig = SymplecticIntegrator(0.002, "verlet", system=cluster.system, backend="custom", temperature=300,
-                              random_seed=3)
+                              random_seed=3, thermostat_position="ends")
     ctx = context(cluster.system, ig, cluster.positions, cluster.velocities)
     m = masses(cluster.system)
     settings = ig.thermostat
@@ -281,7 +281,9 @@ def _add_other(ig, kind, var, expr):
                                              ("yoshida-4", {"groups": [(0, 2)]})])
 def test_thermostat_off_is_the_nve_program_bit_for_bit(cluster, method, options):
     nve = SymplecticIntegrator(0.002, method, system=cluster.system, backend="custom", **options)
-    nvt = SymplecticIntegrator(0.002, method, system=cluster.system, backend="custom", temperature=300, **options)
+    # the ends placement adds its events around the unchanged NVE step (the middle one splits the central drift)
+    nvt = SymplecticIntegrator(0.002, method, system=cluster.system, backend="custom", temperature=300,
+                               thermostat_position="ends", **options)
     xml = mm.XmlSerializer.serialize(nve)
     assert tp.PREFIX not in xml and "gaussian" not in xml and nve.thermostat is None
     # the thermostat only adds its own computations (two half events) and variables to the NVE program
@@ -321,7 +323,7 @@ def test_ideal_gas_kinetic_energy_is_gamma_distributed(backend):
     system, x, v = ideal_gas(20, seed=4)
     T = 300.0
     ig = SymplecticIntegrator(0.002, "verlet", system=system, backend=backend, temperature=T,
-                              collision_time=0.004, thermostat_interval=5, random_seed=11)
+                              collision_time=0.004, thermostat_interval=5, random_seed=11, thermostat_position="ends")
     dof = ig.thermostat_dof
     assert dof == 3 * 20 - 6
     ctx = context(system, ig, x, v)
@@ -393,7 +395,7 @@ def _water_box_run(backend, system, x, steps, seed=5, platform="CPU", equilibrat
 
     T = 300.0
     ig = SymplecticIntegrator(0.002, "verlet", system=system, backend=backend, temperature=T,
-                              collision_time=collision_time, random_seed=seed)
+                              collision_time=collision_time, random_seed=seed, thermostat_position="ends")
     top = app.Topology()
     chain = top.addChain()
     for _ in range(system.getNumParticles() // 3):
@@ -485,7 +487,7 @@ def test_periodic_box_keeps_momentum(backend, box, barostat):
         force.setRandomNumberSeed(3)
         system.addForce(force)
     ig = SymplecticIntegrator(0.002, "verlet", system=system, backend=backend, temperature=400,
-                              collision_time=0.02, random_seed=31)
+                              collision_time=0.02, random_seed=31, thermostat_position="ends")
     v = maxwell_boltzmann(system, x, 300.0, 3) + np.array([0.3, -0.2, 0.1])  # a moving box: P is not zero
     ctx = context(system, ig, x, v)
     m = masses(system)
@@ -505,7 +507,7 @@ def test_isolated_cluster_keeps_momentum_and_angular_momentum(backend, cluster, 
     P and L (about the origin) to round-off after 300 steps, and the velocity constraints stay satisfied."""
     system = cluster.system
     ig = SymplecticIntegrator(0.002, "verlet", system=system, backend=backend, temperature=500,
-                              collision_time=0.01, random_seed=2, **options)
+                              collision_time=0.01, random_seed=2, **options, thermostat_position="ends")
     ctx = context(system, ig, cluster.positions, cluster.velocities)
     m = masses(system)
     x0, v0, _ = state_arrays(ctx)
@@ -566,7 +568,7 @@ def test_every_n_steps_half_events_around_n_steps(backend, cluster):
     """thermostat_interval=3: a half event before steps 0, 3, 6, ... and after steps 2, 5, 8, ...: the heat-bath
     energy changes in exactly those steps (in between, the NVE steps do not touch it)."""
     ig = SymplecticIntegrator(0.002, "verlet", system=cluster.system, backend=backend, temperature=400,
-                              thermostat_interval=3, random_seed=4)
+                              thermostat_interval=3, random_seed=4, thermostat_position="ends")
     ctx = context(cluster.system, ig, cluster.positions, cluster.velocities)
     heat = [ig.computeHeatBathEnergy()._value]
     for _ in range(9):
@@ -585,7 +587,7 @@ def test_mts_thermostat_wraps_the_outer_step(backend, cluster):
         if isinstance(f, mm.NonbondedForce):
             f.setForceGroup(1)
     ig = SymplecticIntegrator(0.004, "verlet", system=system, backend=backend, temperature=300,
-                              groups=[(1, 1), (0, 3)], random_seed=8)
+                              groups=[(1, 1), (0, 3)], random_seed=8, thermostat_position="ends")
     if backend == "custom":
         assert sum("gaussian" in e for _, _, e in _computations(ig)) == 4
     ctx = context(system, ig, cluster.positions, cluster.velocities)
@@ -605,7 +607,7 @@ def test_checkpoint_continues_bit_for_bit(backend, cluster):
     for bit (Reference), in the same Context and in a new one."""
     def make():
         return SymplecticIntegrator(0.002, "verlet", system=cluster.system, backend=backend, temperature=350,
-                                    collision_time=0.02, random_seed=12)
+                                    collision_time=0.02, random_seed=12, thermostat_position="ends")
 
     ig = make()
     ctx = context(cluster.system, ig, cluster.positions, cluster.velocities)
@@ -633,7 +635,7 @@ def test_checkpoint_continues_bit_for_bit(backend, cluster):
 @pytest.mark.parametrize("how", ["xml", "pickle", "deepcopy"])
 def test_copies_keep_the_thermostat(backend, cluster, how):
     ig = SymplecticIntegrator(0.002, "omelyan-2", system=cluster.system, backend=backend, temperature=320,
-                              collision_time=0.3, thermostat_interval=2, random_seed=21)
+                              collision_time=0.3, thermostat_interval=2, random_seed=21, thermostat_position="ends")
     ig.setTemperature(330)  # changed after creation: the copy has the current value
     copied = {"xml": lambda: deserialize(mm.XmlSerializer.serialize(ig)),
               "pickle": lambda: pickle.loads(pickle.dumps(ig)),
@@ -666,7 +668,7 @@ def test_no_conservation_warning_for_its_own_thermostat(backend, cluster):
     with warnings.catch_warnings():
         warnings.simplefilter("error", ConservationWarning)
         ig = SymplecticIntegrator(0.002, "verlet", system=cluster.system, backend=backend, temperature=300,
-                                  random_seed=1)
+                                  random_seed=1, thermostat_position="ends")
         sim = app.Simulation(cluster.topology, cluster.system, ig, mm.Platform.getPlatformByName(REF))
         sim.context.setPositions(cluster.positions)
         sim.context.setVelocities(cluster.velocities)
@@ -684,7 +686,7 @@ def test_general_tableaux_take_the_thermostat_too(method):
 
     scene = morse_molecule()
     ig = SymplecticIntegrator(0.0005, method, system=scene.system, temperature=600, collision_time=0.01,
-                              random_seed=6)
+                              random_seed=6, thermostat_position="ends")
     assert ig.backend == "custom" and ig.thermostat_dof == 6
     assert sum("gaussian" in e for _, _, e in _computations(ig)) == 4
     ctx = context(scene.system, ig, scene.positions, scene.velocities)

@@ -99,7 +99,7 @@ def test_one_event_rescales_peculiar_velocities_by_one_factor(platform, props, t
     velocity and rigid rotation), massless particles untouched, P and L unchanged, and the heat-bath energy
     -(K' - K_pec) = -(alpha^2 - 1) K_pec; over more steps K + heat-bath energy stays K(0)."""
     system, m, x, v = _ideal_gas(massless=False)
-    ig = N(0.002, "verlet", system=system, temperature=300, collision_time=0.01, thermostat_interval=2, random_seed=7)
+    ig = N(0.002, "verlet", system=system, temperature=300, collision_time=0.01, thermostat_interval=2, random_seed=7, thermostat_position="ends")
     assert ig.thermostat_dof == 3 * 20 - 6 and ig.thermostat.keep_rotation
     ctx = mm.Context(system, ig, _platform(platform), props)
     ctx.setPositions(x)
@@ -135,7 +135,7 @@ def test_massless_particles_are_untouched():
     neither counts in the sums nor moves."""
     system, m, x, v = _ideal_gas(n=10)
     with pytest.warns(Warning, match="massless"):
-        ig = N(0.002, "verlet", system=system, temperature=300, collision_time=0.01, random_seed=7)
+        ig = N(0.002, "verlet", system=system, temperature=300, collision_time=0.01, random_seed=7, thermostat_position="ends")
     assert ig.thermostat_dof == 3 * 10 - 3 and not ig.thermostat.keep_rotation
     ctx = mm.Context(system, ig, _platform("Reference"))
     ctx.setPositions(x)
@@ -172,7 +172,7 @@ def test_momentum_to_round_off_in_a_periodic_box(platform, props, bound):
     the single-precision forces alone move P by ~1e-8 of sum m|v| per step;
     the events there are checked on free particles above)."""
     system, x, m = _cutoff_water_box()
-    ig = N(2 * unit.femtoseconds, "verlet", system=system, temperature=300, collision_time=0.02, random_seed=5)
+    ig = N(2 * unit.femtoseconds, "verlet", system=system, temperature=300, collision_time=0.02, random_seed=5, thermostat_position="ends")
     assert not ig.thermostat.keep_rotation  # periodic: only the centre-of-mass velocity is kept
     ctx = mm.Context(system, ig, _platform(platform), props)
     ctx.setPositions(x)
@@ -194,7 +194,7 @@ def test_npt_with_a_monte_carlo_barostat_keeps_momentum():
     the thermostat still keeps P to round-off (pairwise forces on Reference)."""
     system, x, m = _cutoff_water_box()
     system.addForce(mm.MonteCarloBarostat(1 * unit.bar, 300 * unit.kelvin, 5))
-    ig = N(2 * unit.femtoseconds, "verlet", system=system, temperature=300, random_seed=8)
+    ig = N(2 * unit.femtoseconds, "verlet", system=system, temperature=300, random_seed=8, thermostat_position="ends")
     ctx = mm.Context(system, ig, _platform("Reference"))
     ctx.setPositions(x)
     ctx.setVelocitiesToTemperature(300, 3)
@@ -234,7 +234,7 @@ def test_angular_momentum_to_round_off_for_an_isolated_cluster(platform, props, 
 def _ideal_gas_kinetic_samples(platform, props, samples, seed=21):
     """K_pec after every step of a free gas thermostatted with tau << the interval (nearly independent draws)."""
     system, m, x, v = _ideal_gas(n=16, seed=seed, massless=False)
-    ig = N(0.01, "verlet", system=system, temperature=250, collision_time=0.001, random_seed=seed)
+    ig = N(0.01, "verlet", system=system, temperature=250, collision_time=0.001, random_seed=seed, thermostat_position="ends")
     ctx = mm.Context(system, ig, _platform(platform), props)
     ctx.setPositions(x)
     ctx.setVelocities(v)
@@ -274,7 +274,7 @@ def test_water_box_mean_temperature(tmp_path):
 
     system, _, x = water_box(n_waters=64, cutoff_nm=0.55)
     m = np.array([system.getParticleMass(i).value_in_unit(unit.dalton) for i in range(system.getNumParticles())])
-    ig = N(2 * unit.femtoseconds, "omelyan-2", system=system, temperature=320, collision_time=0.05, random_seed=3)
+    ig = N(2 * unit.femtoseconds, "omelyan-2", system=system, temperature=320, collision_time=0.05, random_seed=3, thermostat_position="ends")
     dof = ig.getThermostatDegreesOfFreedom()
     assert dof == 3 * 192 - 192 - 3
     ctx = mm.Context(system, ig, _platform("CPU"), {"Threads": "1"})
@@ -301,7 +301,7 @@ def test_checkpoint_continues_bit_for_bit(platform, props, water8):
     (Bit for bit on OpenCL too here: its fixed-point force sums are deterministic.)"""
     def integrator():
         return N(2 * unit.femtoseconds, "yoshida-4", system=water8.system, temperature=300, thermostat_interval=3,
-                 random_seed=17)
+                 random_seed=17, thermostat_position="ends")
 
     ig = integrator()
     ctx = water8.context(ig, platform, props)
@@ -334,7 +334,7 @@ def test_xml_pickle_and_restore_keep_the_thermostat(water8):
     import pickle
 
     ig = N(1.5 * unit.femtoseconds, "omelyan-2", system=water8.system, temperature=280 * unit.kelvin,
-           collision_time=0.2 * unit.picoseconds, thermostat_interval=4, random_seed=99)
+           collision_time=0.2 * unit.picoseconds, thermostat_interval=4, random_seed=99, thermostat_position="ends")
     xml = mm.XmlSerializer.serialize(ig)
     assert "<Thermostat" in xml and 'randomSeed="99"' in xml
     for back in (deserialize(xml), pickle.loads(pickle.dumps(ig)), copy.deepcopy(ig)):
@@ -361,7 +361,7 @@ def test_without_temperature_the_program_is_the_nve_one(water8, morse):
         ig = N(1 * unit.femtoseconds, "yoshida-4", system=scene.system)
         assert not ig.hasThermostat() and ig.thermostat is None and ig.thermostat_dof is None
         assert "<Thermostat" not in mm.XmlSerializer.serialize(ig) and "thermostat" not in ig.describe()
-        warm = N(1 * unit.femtoseconds, "yoshida-4", system=scene.system, temperature=300)
+        warm = N(1 * unit.femtoseconds, "yoshida-4", system=scene.system, temperature=300, thermostat_position="ends")
         assert warm.getProgramSignature() != ig.getProgramSignature()
         ctx = scene.context(ig)
         ig.step(30)
@@ -377,7 +377,7 @@ def test_without_temperature_the_program_is_the_nve_one(water8, morse):
 
 # -- accessors and errors -------------------------------------------------------------------------------------------
 def test_temperature_changes_mid_run_and_the_rest_is_refused_clearly(water8):
-    ig = N(2 * unit.femtoseconds, "verlet", system=water8.system, temperature=300, random_seed=4)
+    ig = N(2 * unit.femtoseconds, "verlet", system=water8.system, temperature=300, random_seed=4, thermostat_position="ends")
     ig.setCollisionTime(0.05 * unit.picoseconds)  # before the Context: allowed
     assert ig.getCollisionTime() == 0.05 * unit.picoseconds
     ctx = water8.context(ig)
@@ -416,7 +416,7 @@ def test_mts_thermostat_wraps_the_outer_step(water8):
 
     system = mm.XmlSerializer.clone(water8.system)
     groups = split_forces(system, slow="nonbonded", substeps=2)
-    ig = N(2 * unit.femtoseconds, "verlet", system=system, groups=groups, temperature=300, random_seed=2)
+    ig = N(2 * unit.femtoseconds, "verlet", system=system, groups=groups, temperature=300, random_seed=2, thermostat_position="ends")
     assert "around the outer step" in ig.describe()
     ctx = mm.Context(system, ig, _platform("Reference"))
     ctx.setPositions(water8.positions)
@@ -440,7 +440,7 @@ def test_native_and_custom_backends_sample_the_same_distribution():
     for backend in ("native", "custom"):
         try:
             ig = SymplecticIntegrator(0.01, "verlet", system=system, temperature=250, collision_time=0.001,
-                                      random_seed=21, backend=backend)
+                                      random_seed=21, backend=backend, thermostat_position="ends")
         except NotImplementedError as exc:
             pytest.skip(f"the custom backend's thermostat is not there yet: {exc}")
         ctx = mm.Context(system, ig, _platform("Reference"))
@@ -469,7 +469,7 @@ def test_native_seeded_run_repeats_whatever_the_reporting():
 
     def run(energies):
         ig = SymplecticIntegrator(2 * unit.femtoseconds, "verlet", system=scene.system, backend="native",
-                                  temperature=300, random_seed=7)
+                                  temperature=300, random_seed=7, thermostat_position="ends")
         ctx = mm.Context(scene.system, ig, mm.Platform.getPlatformByName("Reference"))
         ctx.setPositions(scene.positions)
         ctx.setVelocities(scene.velocities)

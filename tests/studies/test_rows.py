@@ -114,7 +114,9 @@ def test_build_ours():
     assert Row.parse("verlet 2 fs").build(system).options.thermostat is None
 
 
-def test_thermostat_position_is_passed_only_when_asked():
+def test_a_row_without_a_position_word_runs_the_ends():
+    """Stored results of rows without a position word were run with the ends placement: such a row still runs
+    the ends, though the integrator's default ("auto") puts verlet's thermostat in the middle."""
     system = _system()
     if "thermostat_position" not in NATIVE_OPTIONS:
         with pytest.raises(TypeError, match="thermostat_position"):
@@ -122,7 +124,9 @@ def test_thermostat_position_is_passed_only_when_asked():
         pytest.skip("SymplecticIntegrator has no thermostat_position yet")
     ig = Row.parse("verlet 2 fs SVR 0.1 ps middle custom").build(system)
     assert ig.options.thermostat.position == "middle"
-    assert Row.parse("verlet 2 fs SVR 0.1 ps custom").build(system).options.thermostat.position == "ends"
+    assert Row.parse("verlet 2 fs SVR 0.1 ps custom").build(system).thermostat_position == "ends"
+    assert Row.parse("verlet 2 fs SVR 0.1 ps auto custom").build(system).thermostat_position == "middle"
+    assert Row.parse("verlet 2 fs SVR 0.1 ps").label == Row.parse("verlet 2 fs SVR 0.1 ps ends").label
 
 
 def test_leapfrog_state_lags_half_a_step():

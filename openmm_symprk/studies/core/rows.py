@@ -451,8 +451,9 @@ class Row:
             options.update(temperature=self.temperature, collision_time=self.tau_ps, random_seed=seed)
             if self.every != 1:
                 options["thermostat_interval"] = int(self.every)
-            if self.position != "ends":  # passed only when asked: rows run before and after the option exists
-                options["thermostat_position"] = self.position
+            # always passed: a row without a position word means "ends", what its stored results were run with,
+            # whatever the integrator's default placement
+            options["thermostat_position"] = self.position
         return SymplecticIntegrator(h, self.method, system=system, **options)
 
 
