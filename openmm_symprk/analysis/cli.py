@@ -20,7 +20,10 @@ from ..support import require
 
 __all__ = ["OBSERVED", "observe", "build_parser", "main"]
 
-#: (key, description, unit) of what ``symprk observe`` reports, in its order.
+#: (key, description, unit) of what ``symprk observe`` reports, in its order.  It reads like
+#: :data:`openmm_symprk.analysis.observe.OBSERVABLES` on purpose but is not that table: that one's keys are the keys
+#: of the fidelity study's stored runs (and hold PE and drift, which a trajectory alone cannot give), these are the
+#: keys of ``--json`` (with D_inf and O-H, which the study does not report).
 OBSERVED = [
     ("D", "self-diffusion D_PBC (centres of mass)", "1e-5 cm2/s"),
     ("D_inf", "D + Yeh-Hummer correction", "1e-5 cm2/s"),

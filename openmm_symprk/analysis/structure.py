@@ -4,8 +4,9 @@ first peak.  Units: nm.
 g(r) (:func:`radial_distribution`) is MDAnalysis' ``InterRDF`` (every distinct pair by the minimum image, bins of
 width dr up to r_max <= half the shortest edge, each bin's count divided by the ideal-gas count, so that uniform
 random points give g = 1), run on the frames given as arrays through an in-memory Universe.  It is used, not
-re-implemented: a numpy all-pairs histogram was no faster (216 sites, 200 frames: 0.73 s against InterRDF's
-0.83 s, and InterRDF's grid search scales with N, not N^2; docs/analysis.md).  Its error: the frames cut into
+re-implemented: against a numpy all-pairs histogram neither was faster by a margin that held on the
+216-water benchmark (examples/analysis_benchmark.py, docs/analysis.md), and InterRDF's grid search scales
+with N, not N^2.  Its error: the frames cut into
 ``n_blocks`` consecutive blocks, g of each block, standard deviation / sqrt(n_blocks).
 
 First peak (:func:`first_peak`): the first run of bins beyond ``r_min`` where g > 1 (``above``), its

@@ -131,9 +131,13 @@ def test_one_version():
 def test_extras():
     """The extras the package's import guards name, and the test extra holds everything the suite uses."""
     extras = _setup_module().EXTRAS
-    assert {"analysis", "studies", "cluster", "all", "test", "cuda12"} <= set(extras)
+    assert {"analysis", "studies", "cluster", "all", "test", "cuda12", "docs"} <= set(extras)
     names = {k: {r.split(">")[0].split("<")[0].split("[")[0].lower() for r in v} for k, v in extras.items()}
-    assert names["analysis"] == {"mdanalysis", "scipy"}
+    assert names["analysis"] == {"mdanalysis", "scipy", "tqdm"}
     assert names["studies"] == {"matplotlib", "tqdm", "pymbar", "scipy", "mdanalysis"}
     assert names["all"] == names["analysis"] | names["studies"]
-    assert names["test"] == {"pytest", "pyelftools"} | names["all"] | names["cluster"]
+    # the docs' API reference imports every module, so the docs extra holds all of `all`
+    assert names["docs"] == {"sphinx", "myst-parser", "furo"} | names["all"]
+    # the suite cross-checks the analyses against MDAnalysis' test files and the MDAKits computing the same
+    cross_checks = {"mdanalysistests", "waterdynamics", "transport-analysis", "tidynamics"}
+    assert names["test"] == {"pytest", "pyelftools"} | names["all"] | names["cluster"] | cross_checks

@@ -436,6 +436,8 @@ KERNEL void symprkThermostatEvent(GLOBAL const real4* RESTRICT posq, GLOBAL cons
     const symprk_acc twiceKinetic = total[7], chi2 = total[8];
     for (int k = 0; k < 10; k++)
         s[k] = 0;
+    // Pass (2): the same walk over the particles with mass as pass (1), now about the centre of mass (the two
+    // passes are the point of the event's arithmetic, see above, so their loop heads are alike on purpose).
     for (int index = tid; index < NUM_ATOMS; index += WORK_GROUP_SIZE) {
         mixed4 v = velm[index];
         if (v.w != 0) {
