@@ -1,6 +1,6 @@
 """``symprk nvt cost`` and ``symprk nvt drift``: the thermostat's measurements (docs/thermostat.md).
 
-    symprk nvt cost [--quick] [--scenes water,villin] [--threads 2] [--no-forces]  # time per step vs LangevinMiddle
+    symprk nvt cost [--quick] [--scenes water,villin] [--threads 2] [--no-forces] [--platform OpenCL]  # time per step vs LangevinMiddle
     symprk nvt drift [--quick] [--replicas 3] [--length-ps 20] [--rows omelyan-2@4,...] [--chart PNG]  # = symprk drift nvt
 
 ``--quick`` runs in seconds (small box, few steps: a check of the pipeline, not a measurement).
@@ -31,6 +31,7 @@ def build_parser():
     c.add_argument("--steps", type=positive(int), default=None, help="steps per timed block")
     c.add_argument("--rounds", type=positive(int), default=None, help="rounds of blocks (each row keeps its fastest)")
     c.add_argument("--threads", type=positive(int), default=2, help="CPU platform threads (default 2)")
+    c.add_argument("--platform", default="CPU", help="OpenMM platform: CPU (default) or OpenCL, CUDA, Reference")
     c.add_argument("--no-forces", action="store_true",
                    help="remove every force (constraints stay): time the integrators' own work, the thermostat's cost")
     c.add_argument("--json", default=None, help="also write the tables as JSON to this file")
@@ -54,7 +55,7 @@ def _cost(args):
 
     scenes = args.scenes or (["water"] if args.quick else ["water", "villin"])
     tables = run(scenes, quick=args.quick, steps=args.steps, rounds=args.rounds, threads=args.threads,
-                 no_forces=args.no_forces)
+                 no_forces=args.no_forces, platform=args.platform)
     if args.json:
         write_json(args.json, tables)
         print(f"wrote {args.json}")

@@ -1,12 +1,13 @@
 """Time per step of NVT integrators against OpenMM's LangevinMiddleIntegrator, in the same run (``symprk nvt cost``).
 
 Every row is timed with :func:`openmm_symprk.studies.timing.interleaved` (the rows take turns in blocks of about
-the same duration, round after round), on the CPU platform with a fixed thread count, from one shared state.  The
+the same duration, round after round), on the CPU platform with a fixed thread count (or another platform: ``--platform OpenCL``), from one shared state.  The
 ratio of a row is the median over rounds of its time per step over LangevinMiddleIntegrator's (2 fs) in the same
 round, with the quartiles (blocks run moments apart share the machine's load); rows that replace another OpenMM
 integrator (MTSLangevinIntegrator, VerletIntegrator) also get the ratio to it.  "per ps" divides by the step
 size, for rows whose method is run at a longer step.  The thermostat's own cost follows from the rows without
-it: (t[verlet + thermostat] - t[verlet NVE]) / 2 per event (two half events per step).
+it: (t[verlet + thermostat] - t[verlet NVE]) / 2 per event (two half events per step); the "... middle" rows
+time the middle placement (one whole event per step) beside the ends one.
 
 Scenes: the periodic rigid TIP3P water box of the bench (``water-box-pme``, about 5,800 atoms, PME 0.9 nm) and
 the solvated villin headpiece (``villin-pme``, 8,867 atoms, HBonds, rigid water; equilibrated only briefly: a
@@ -71,7 +72,9 @@ def measure(system, positions, velocities, rows, steps, rounds: int, threads: in
     def stepper(ctx, ig):
         def advance(n):
             ig.step(n)
-            ctx.getState(getEnergy=False)  # the work is done (a no-op on CPU, a sync elsewhere)
+            # the work is done: an empty State is no sync on OpenCL/CUDA (a step there only queues kernels), the
+            # positions are (one download per block, the same for every row)
+            ctx.getState(getPositions=platform != "CPU")
         return advance
 
     timings = interleaved({k: stepper(*v) for k, v in contexts.items()}, steps, rounds=rounds)
@@ -129,14 +132,16 @@ def format_table(title: str, table: list) -> str:
 
 
 def run(scenes=("water", "villin"), quick: bool = False, steps=None, rounds: int | None = None,
-        threads: int = 2, no_forces: bool = False, log=print) -> dict:
+        threads: int = 2, no_forces: bool = False, platform: str = "CPU", log=print) -> dict:
     """Measure and print the cost table of every scene; returns {scene: table}.  ``no_forces``: every force
-    removed (constraints stay), so the table times the integrators' own work: the thermostat event's cost."""
+    removed (constraints stay), so the table times the integrators' own work: the thermostat event's cost.
+    ``platform``: "CPU" (``threads`` threads) or another OpenMM platform, e.g. "OpenCL" (PoCL on a CPU)."""
     from ... import plugin
 
     if not plugin.available():
         raise RuntimeError(f"the native backend is unavailable: {plugin.unavailable_reason()}")
-    log(f"openmm {mm.version.full_version}, platform CPU, {threads} threads, load average before "
+    where = f"platform CPU, {threads} threads" if platform == "CPU" else f"platform {platform}"
+    log(f"openmm {mm.version.full_version}, {where}, load average before "
         f"{os.getloadavg()[0]:.2f} (other processes slow some blocks; each row keeps its fastest)")
     rows = [r for r in default_rows() if not (no_forces and r[1].mts)]  # no forces, no groups
     out = {}
@@ -148,7 +153,7 @@ def run(scenes=("water", "villin"), quick: bool = False, steps=None, rounds: int
             title += ", no forces (the integrators' own work)"
         n = steps or (0.01 if quick else 0.3)
         k = rounds or (2 if quick else 15)
-        best = measure(system, x, v, rows, n, k, threads)
+        best = measure(system, x, v, rows, n, k, threads, platform)
         out[name] = ratios(best, rows)
         blocks = f"{n} steps" if isinstance(n, int) else f"blocks of ~{n:g} s"
         log(format_table(f"{title}: {k} rounds, {blocks}, fastest block per row", out[name]))

@@ -21,8 +21,10 @@ COST_ROWS = [
     ("OpenMM Verlet (NVE)", "openmm-verlet 2 fs", ""),
     ("verlet (NVE)", "verlet 2 fs native", "OpenMM Verlet (NVE)"),
     ("verlet + thermostat", "verlet 2 fs SVR 0.1 ps native", ""),
+    ("verlet + thermostat middle", "verlet 2 fs SVR 0.1 ps middle native", ""),
     ("verlet + thermostat /10", "verlet 2 fs SVR 0.1 ps every 10 native", ""),
     ("omelyan-2 + thermostat", "omelyan-2 4 fs SVR 0.1 ps native", ""),
+    ("omelyan-2 + thermostat middle", "omelyan-2 4 fs SVR 0.1 ps middle native", ""),
     ("MTSLangevin 1x1+0x2", "mts-langevin 4/2 fs friction 1/ps", ""),
     ("verlet MTS 1x1+0x2 + thermostat", "verlet 4/2 fs SVR 0.1 ps native", "MTSLangevin 1x1+0x2"),
 ]
