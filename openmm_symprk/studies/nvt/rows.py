@@ -13,7 +13,8 @@ from ..core.rows import Row
 #: The thermostats' target temperature (K).
 TEMPERATURE = 300.0
 
-#: The cost table: (name printed, row, the OpenMM row it replaces -- its ratio is printed too).
+#: The cost table: (name printed, row, the OpenMM row it replaces -- its ratio is printed too); data, one line a
+#: row, so its lines are alike on purpose.
 COST_ROWS = [
     ("LangevinMiddle", "langevin 2 fs friction 1/ps", ""),
     ("NoseHoover (chain 3)", "nose-hoover 2 fs 1/ps", ""),
