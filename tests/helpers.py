@@ -1,6 +1,7 @@
 """Small float64 measurements shared by the OpenMM tests (built on openmm_symprk.conservation)."""
 import numpy as np
 import openmm.app as app
+import pytest
 import openmm.unit as unit
 
 from openmm_symprk.conservation import angular_momentum, linear_momentum
@@ -120,3 +121,33 @@ def virtual_site_error(system, x) -> float:
             expect = sum(vs.getWeight(k) * x[vs.getParticle(k)] for k in range(vs.getNumParticles()))
             err = max(err, float(np.abs(x[i] - expect).max()))
     return err
+
+
+def native_skip_reason():
+    """Why the native backend cannot run here (its plugin did not build or load), or None."""
+    from openmm_symprk import plugin
+
+    return None if plugin.available() else f"native backend unavailable: {plugin.unavailable_reason()}"
+
+
+#: Both backends as pytest parameters; native is skipped only where its plugin is missing, so that a native
+#: regression fails instead of hiding behind a probe.
+BACKENDS = ["custom", pytest.param("native", marks=pytest.mark.skipif(
+    native_skip_reason() is not None, reason=str(native_skip_reason())))]
+
+
+def context(system, integrator, x, v, platform="Reference", properties=None):
+    """A Context on ``platform`` with positions ``x`` and velocities ``v``."""
+    import openmm as mm
+
+    ctx = mm.Context(system, integrator, mm.Platform.getPlatformByName(platform), properties or {})
+    ctx.setPositions(x)
+    ctx.setVelocities(v)
+    return ctx
+
+
+def positions_velocities(ctx):
+    """(positions nm, velocities nm/ps) of a Context as float64 arrays."""
+    st = ctx.getState(getPositions=True, getVelocities=True)
+    return (np.asarray(st.getPositions(asNumpy=True).value_in_unit(unit.nanometer)),
+            np.asarray(st.getVelocities(asNumpy=True).value_in_unit(unit.nanometer / unit.picosecond)))

@@ -13,6 +13,7 @@ import openmm.app as app
 import openmm.unit as unit
 import pytest
 
+from helpers import BACKENDS, context
 from openmm_symprk import SymplecticIntegrator, plugin
 from openmm_symprk.integrators import deserialize
 from openmm_symprk.integrators import thermostat_program as tp
@@ -69,31 +70,6 @@ def cluster():
 
 
 # -- backends ----------------------------------------------------------------------------------------------
-def _native_reason():
-    if not plugin.available():
-        return f"native backend unavailable: {plugin.unavailable_reason()}"
-    system, _, _ = ideal_gas(4)
-    try:
-        ig = SymplecticIntegrator(0.001, "verlet", system=system, backend="native", temperature=300)
-    except Exception as exc:  # noqa: BLE001 - any failure means: not there yet
-        return f"NativeSymplecticIntegrator(..., temperature=...) is not available yet ({exc})"
-    if getattr(ig, "thermostat", None) is None:
-        return "NativeSymplecticIntegrator(..., temperature=...) is not available yet (it ignores temperature=)"
-    return None
-
-
-NATIVE_REASON = _native_reason()
-BACKENDS = ["custom", pytest.param("native", marks=pytest.mark.skipif(NATIVE_REASON is not None,
-                                                                        reason=str(NATIVE_REASON)))]
-
-
-def context(system, ig, x, v, platform=REF):
-    ctx = mm.Context(system, ig, mm.Platform.getPlatformByName(platform))
-    ctx.setPositions(x)
-    ctx.setVelocities(v)
-    return ctx
-
-
 def state_arrays(ctx):
     st = ctx.getState(getPositions=True, getVelocities=True, getEnergy=True, enforcePeriodicBox=False)
     return (np.asarray(st.getPositions(asNumpy=True).value_in_unit(unit.nanometer)),

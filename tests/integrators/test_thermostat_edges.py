@@ -10,6 +10,7 @@ import openmm as mm
 import openmm.unit as unit
 import pytest
 
+from helpers import BACKENDS, context, native_skip_reason
 from openmm_symprk import SymplecticIntegrator, plugin
 from openmm_symprk.integrators import deserialize
 from openmm_symprk.systems.scenes import water_cluster
@@ -18,21 +19,11 @@ REF = "Reference"
 pytestmark = pytest.mark.filterwarnings("ignore::openmm_symprk.systems.checks.ConservationWarning")
 
 
-def _native_reason():
-    if not plugin.available():
-        return f"native backend unavailable: {plugin.unavailable_reason()}"
-    return None
-
-
-BACKENDS = ["custom", pytest.param("native", marks=pytest.mark.skipif(_native_reason() is not None,
-                                                                        reason=str(_native_reason())))]
-
-
 #: the linear-system tests on native also run the Common (device) kernel, in double precision, where it is built
-LINEAR_CASES = ["custom", pytest.param("native", marks=pytest.mark.skipif(_native_reason() is not None,
-                                                                          reason=str(_native_reason()))),
+LINEAR_CASES = ["custom", pytest.param("native", marks=pytest.mark.skipif(native_skip_reason() is not None,
+                                                                          reason=str(native_skip_reason()))),
                 pytest.param("native-opencl", marks=pytest.mark.skipif(
-                    _native_reason() is not None or "OpenCL" not in plugin.platforms(),
+                    native_skip_reason() is not None or "OpenCL" not in plugin.platforms(),
                     reason="no native OpenCL kernel here"))]
 
 
@@ -41,13 +32,6 @@ def _linear_case(case):
     if case == "native-opencl":
         return "native", "OpenCL", {"Precision": "double"}
     return case, REF, {}
-
-
-def context(system, ig, x, v, platform=REF, properties=None):
-    ctx = mm.Context(system, ig, mm.Platform.getPlatformByName(platform), properties or {})
-    ctx.setPositions(x)
-    ctx.setVelocities(v)
-    return ctx
 
 
 def velocities(ctx):

@@ -17,6 +17,7 @@ import openmm as mm
 import openmm.unit as unit
 import pytest
 
+from helpers import positions_velocities
 from openmm_symprk import SymplecticIntegrator, plugin
 from openmm_symprk.integrators import NativeSymplecticIntegrator as N
 from openmm_symprk.integrators import deserialize
@@ -37,12 +38,6 @@ PLATFORMS = [("Reference", {}, 1e-12), ("CPU", {}, 1e-12),
 
 def _platform(name):
     return mm.Platform.getPlatformByName(name)
-
-
-def _xv(ctx):
-    st = ctx.getState(getPositions=True, getVelocities=True)
-    return (st.getPositions(asNumpy=True).value_in_unit(unit.nanometer),
-            st.getVelocities(asNumpy=True).value_in_unit(unit.nanometer / unit.picosecond))
 
 
 def _ideal_gas(n=20, seed=3, massless=True):
@@ -104,9 +99,9 @@ def test_one_event_rescales_peculiar_velocities_by_one_factor(platform, props, t
     ctx = mm.Context(system, ig, _platform(platform), props)
     ctx.setPositions(x)
     ctx.setVelocities(v)
-    x0, v0 = _xv(ctx)  # as the platform stores them
+    x0, v0 = positions_velocities(ctx)  # as the platform stores them
     ig.step(1)
-    _, v1 = _xv(ctx)
+    _, v1 = positions_velocities(ctx)
     k_pec, u = _peculiar_kinetic(x0, v0, m)
     w = m[m > 0, None]
     d0, d1 = v0[m > 0] - u, v1[m > 0] - u
@@ -124,7 +119,7 @@ def test_one_event_rescales_peculiar_velocities_by_one_factor(platform, props, t
     # K changes only through the events (no forces): K + heat-bath energy is conserved
     k0 = 0.5 * float(np.sum(m[:, None] * v0 ** 2))
     ig.step(9)
-    _, v10 = _xv(ctx)
+    _, v10 = positions_velocities(ctx)
     k10 = 0.5 * float(np.sum(m[:, None] * v10 ** 2))
     bath = ig.computeHeatBathEnergy().value_in_unit(unit.kilojoule_per_mole)
     assert abs(k10 + bath - k0) <= 20 * tol * k0
@@ -140,9 +135,9 @@ def test_massless_particles_are_untouched():
     ctx = mm.Context(system, ig, _platform("Reference"))
     ctx.setPositions(x)
     ctx.setVelocities(v)
-    x0, v0 = _xv(ctx)
+    x0, v0 = positions_velocities(ctx)
     ig.step(3)
-    x1, v1 = _xv(ctx)
+    x1, v1 = positions_velocities(ctx)
     np.testing.assert_array_equal(v1[m == 0], v0[m == 0])
     np.testing.assert_array_equal(x1[m == 0], x0[m == 0])
     p0, p1 = (m[:, None] * v0).sum(axis=0), (m[:, None] * v1).sum(axis=0)
@@ -181,9 +176,9 @@ def test_momentum_to_round_off_in_a_periodic_box(platform, props, bound):
     v = st.getVelocities(asNumpy=True)._value + np.array([0.2, -0.1, 0.05])  # a net momentum to keep
     ctx.setVelocities(v)
     ctx.applyVelocityConstraints(1e-10)
-    _, v0 = _xv(ctx)
+    _, v0 = positions_velocities(ctx)
     ig.step(60)
-    _, v1 = _xv(ctx)
+    _, v1 = positions_velocities(ctx)
     p0, p1 = (m[:, None] * v0).sum(axis=0), (m[:, None] * v1).sum(axis=0)
     assert np.linalg.norm(p1 - p0) <= bound * float(np.sum(m[:, None] * np.abs(v0)))
     assert ig.computeHeatBathEnergy().value_in_unit(unit.kilojoule_per_mole) != 0
@@ -198,10 +193,10 @@ def test_npt_with_a_monte_carlo_barostat_keeps_momentum():
     ctx = mm.Context(system, ig, _platform("Reference"))
     ctx.setPositions(x)
     ctx.setVelocitiesToTemperature(300, 3)
-    _, v0 = _xv(ctx)
+    _, v0 = positions_velocities(ctx)
     volume = ctx.getState().getPeriodicBoxVolume()
     ig.step(150)
-    _, v1 = _xv(ctx)
+    _, v1 = positions_velocities(ctx)
     assert ctx.getState().getPeriodicBoxVolume() != volume
     p0, p1 = (m[:, None] * v0).sum(axis=0), (m[:, None] * v1).sum(axis=0)
     assert np.linalg.norm(p1 - p0) <= 1e-13 * float(np.sum(m[:, None] * np.abs(v0)))
@@ -220,10 +215,10 @@ def test_angular_momentum_to_round_off_for_an_isolated_cluster(platform, props, 
            random_seed=9, exact_momentum=exact, thermostat_position=position)
     assert ig.thermostat.keep_rotation
     ctx = water8.context(ig, platform, props)
-    x0, v0 = _xv(ctx)
+    x0, v0 = positions_velocities(ctx)
     p0, l0 = _momenta(x0, v0, m)
     ig.step(100)
-    x1, v1 = _xv(ctx)
+    x1, v1 = positions_velocities(ctx)
     p1, l1 = _momenta(x1, v1, m)
     assert np.linalg.norm(l1 - l0) <= bound * np.linalg.norm(l0)
     assert np.linalg.norm(p1 - p0) <= bound * float(np.sum(m[:, None] * np.abs(v0)))
@@ -241,7 +236,7 @@ def _ideal_gas_kinetic_samples(platform, props, samples, seed=21):
     out = []
     for _ in range(samples):
         ig.step(1)
-        xs, vs = _xv(ctx)
+        xs, vs = positions_velocities(ctx)
         out.append(_peculiar_kinetic(xs, vs, m)[0])
     return np.array(out), ig.thermostat_dof, 250 * R_KJ
 
@@ -285,7 +280,7 @@ def test_water_box_mean_temperature(tmp_path):
     temps = []
     for _ in range(600):
         ig.step(10)
-        _, v = _xv(ctx)
+        _, v = positions_velocities(ctx)
         pec = v - (m[:, None] * v).sum(axis=0) / m.sum()
         temps.append(float(np.sum(m[:, None] * pec ** 2)) / (dof * R_KJ))
     s = block_stats(temps, 24)
@@ -308,16 +303,16 @@ def test_checkpoint_continues_bit_for_bit(platform, props, water8):
     ig.step(25)
     chk = ctx.createCheckpoint()
     ig.step(40)
-    straight, bath = _xv(ctx), ig.computeHeatBathEnergy()
+    straight, bath = positions_velocities(ctx), ig.computeHeatBathEnergy()
     ctx.loadCheckpoint(chk)
     ig.step(40)
-    again = _xv(ctx), ig.computeHeatBathEnergy()
+    again = positions_velocities(ctx), ig.computeHeatBathEnergy()
     ig2 = integrator()
     ig2.setRandomNumberSeed(1)  # the checkpoint's random state wins over the seed
     ctx2 = mm.Context(water8.system, ig2, _platform(platform), props)
     ctx2.loadCheckpoint(chk)
     ig2.step(40)
-    fresh = _xv(ctx2), ig2.computeHeatBathEnergy()
+    fresh = positions_velocities(ctx2), ig2.computeHeatBathEnergy()
     for (x, v), b in (again, fresh):
         np.testing.assert_array_equal(straight[0], x)
         np.testing.assert_array_equal(straight[1], v)
@@ -348,7 +343,7 @@ def test_xml_pickle_and_restore_keep_the_thermostat(water8):
     for integrator in (ig, deserialize(xml)):
         ctx = water8.context(integrator)
         integrator.step(20)
-        runs.append(_xv(ctx))
+        runs.append(positions_velocities(ctx))
         del ctx
     np.testing.assert_array_equal(runs[0][0], runs[1][0])
     np.testing.assert_array_equal(runs[0][1], runs[1][1])
@@ -365,11 +360,11 @@ def test_without_temperature_the_program_is_the_nve_one(water8, morse):
         assert warm.getProgramSignature() != ig.getProgramSignature()
         ctx = scene.context(ig)
         ig.step(30)
-        a = _xv(ctx)
+        a = positions_velocities(ctx)
         custom = SymplecticIntegrator(1 * unit.femtoseconds, "yoshida-4", system=scene.system, backend="custom")
         ctx2 = scene.context(custom)
         custom.step(30)
-        b = _xv(ctx2)
+        b = positions_velocities(ctx2)
         np.testing.assert_array_equal(a[0], b[0])
         np.testing.assert_array_equal(a[1], b[1])
         assert ig.computeHeatBathEnergy() == 0 * unit.kilojoule_per_mole
@@ -422,9 +417,9 @@ def test_mts_thermostat_wraps_the_outer_step(water8):
     ctx.setPositions(water8.positions)
     ctx.setVelocities(water8.velocities)
     m = water8.masses()
-    x0, v0 = _xv(ctx)
+    x0, v0 = positions_velocities(ctx)
     ig.step(50)
-    x1, v1 = _xv(ctx)
+    x1, v1 = positions_velocities(ctx)
     (p0, l0), (p1, l1) = _momenta(x0, v0, m), _momenta(x1, v1, m)
     assert np.linalg.norm(l1 - l0) <= 1e-11 * np.linalg.norm(l0)
     assert np.linalg.norm(p1 - p0) <= 1e-11 * float(np.sum(m[:, None] * np.abs(v0)))
@@ -449,7 +444,7 @@ def test_native_and_custom_backends_sample_the_same_distribution():
         k = []
         for _ in range(1500):
             ig.step(1)
-            xs, vs = _xv(ctx)
+            xs, vs = positions_velocities(ctx)
             k.append(_peculiar_kinetic(xs, vs, m)[0])
         means.append(series_stats(k))
         del ctx

@@ -18,6 +18,7 @@ import openmm as mm
 import openmm.unit as unit
 import pytest
 
+from helpers import positions_velocities
 from openmm_symprk import SymplecticIntegrator, plugin
 from openmm_symprk.physics.temperature import R_KJ
 from openmm_symprk.systems.properties import masses
@@ -37,12 +38,6 @@ def _context(system, ig, x, v, platform="Reference", properties=None):
     ctx.setPositions(x)
     ctx.setVelocities(v)
     return ctx
-
-
-def _xv(ctx):
-    st = ctx.getState(getPositions=True, getVelocities=True)
-    return (np.asarray(st.getPositions(asNumpy=True).value_in_unit(unit.nanometer)),
-            np.asarray(st.getVelocities(asNumpy=True).value_in_unit(unit.nanometer / unit.picosecond)))
 
 
 def _native(system, step, method="verlet", **options):
@@ -96,7 +91,7 @@ def test_oscillators_sample_the_known_answer(platform, h_omega, position):
     q2, v2, event = [], [], []
     for _ in range(1600):
         ig.step(1)
-        X, V = _xv(ctx)
+        X, V = positions_velocities(ctx)
         q2.append(OMEGA ** 2 * np.sum(X ** 2) / dof_kT)
         v2.append(np.sum(V ** 2) / dof_kT)
         event.append(2 * ig.thermostat_kinetic_energy().value_in_unit(unit.kilojoule_per_mole) / dof_kT)
@@ -183,7 +178,7 @@ def _angular_drift(scene, offset, **options):
     ctx = _context(system, ig, x, scene.velocities)
 
     def angular():
-        X, V = _xv(ctx)
+        X, V = positions_velocities(ctx)
         r = X - (m[:, None] * X).sum(0) / m.sum()
         return (m[:, None] * np.cross(r, V)).sum(0)
 
@@ -224,10 +219,10 @@ def test_no_peculiar_motion_is_left_as_it_is_and_warned_about(motion, position, 
     v = np.zeros_like(x) if motion == "rest" else np.tile([0.31, -0.17, 0.05], (len(x), 1))
     ig = _native(system, 0.002, temperature=300, random_seed=9, thermostat_position=position, thermostat_interval=2)
     ctx = _context(system, ig, x, v, platform, {"Precision": "double"} if platform == "OpenCL" else None)
-    _, v0 = _xv(ctx)
+    _, v0 = positions_velocities(ctx)
     with pytest.warns(RuntimeWarning, match="no peculiar kinetic energy to scale.*setVelocitiesToTemperature"):
         ig.step(6)
-    _, v6 = _xv(ctx)
+    _, v6 = positions_velocities(ctx)
     assert v6.tobytes() == v0.tobytes()
     assert ig.computeHeatBathEnergy() == 0 * unit.kilojoule_per_mole
     assert ig.getSkippedThermostatEvents() == (3 if position == "middle" else 6)

@@ -16,6 +16,7 @@ import openmm as mm
 import openmm.unit as unit
 import pytest
 
+from helpers import BACKENDS, context, positions_velocities
 from openmm_symprk import SymplecticIntegrator, plugin
 from openmm_symprk.integrators import deserialize
 from openmm_symprk.integrators.thermostat import MAX_INTERVAL
@@ -29,42 +30,6 @@ from openmm_symprk.systems.scenes import water_cluster
 
 REF = "Reference"
 pytestmark = pytest.mark.filterwarnings("ignore::openmm_symprk.systems.checks.ConservationWarning")
-
-
-def _native_middle_reason():
-    if not plugin.available():
-        return f"native backend unavailable: {plugin.unavailable_reason()}"
-    s = mm.System()
-    for _ in range(3):
-        s.addParticle(1.0)
-    try:
-        ig = SymplecticIntegrator(0.001, "verlet", system=s, backend="native", temperature=300,
-                                  thermostat_position="middle")
-        ctx = mm.Context(s, ig, mm.Platform.getPlatformByName(REF))
-        ctx.setPositions(np.eye(3))
-        ig.step(1)
-        ig.thermostat_kinetic_energy()
-    except Exception as exc:  # noqa: BLE001 - any failure means: not there yet
-        return f"the native backend does not run thermostat_position='middle' yet ({type(exc).__name__}: {exc})"
-    return None
-
-
-NATIVE_REASON = _native_middle_reason()
-BACKENDS = ["custom", pytest.param("native", marks=pytest.mark.skipif(NATIVE_REASON is not None,
-                                                                        reason=str(NATIVE_REASON)))]
-
-
-def context(system, ig, x, v, platform=REF):
-    ctx = mm.Context(system, ig, mm.Platform.getPlatformByName(platform))
-    ctx.setPositions(x)
-    ctx.setVelocities(v)
-    return ctx
-
-
-def arrays(ctx):
-    st = ctx.getState(getPositions=True, getVelocities=True)
-    return (np.asarray(st.getPositions(asNumpy=True).value_in_unit(unit.nanometer)),
-            np.asarray(st.getVelocities(asNumpy=True).value_in_unit(unit.nanometer / unit.picosecond)))
 
 
 # -- resolve ------------------------------------------------------------------------------------------------------
@@ -225,7 +190,7 @@ def sample_oscillators(backend, method, position, h_omega, steps=1600, h=0.002):
     q2, v2, event = [], [], []
     for _ in range(steps):
         ig.step(1)
-        X, V = arrays(ctx)
+        X, V = positions_velocities(ctx)
         q2.append(k * np.sum(X ** 2) / dof_kT)
         v2.append(np.sum(V ** 2) / dof_kT)
         event.append(2 * ig.thermostat_kinetic_energy().value_in_unit(unit.kilojoule_per_mole) / dof_kT)
@@ -268,10 +233,10 @@ def test_middle_keeps_momentum_and_angular_momentum(backend, method, options):
                               collision_time=0.01, random_seed=2, thermostat_position="middle", **options)
     ctx = context(system, ig, scene.positions, scene.velocities)
     m = masses(system)
-    x0, v0 = arrays(ctx)
+    x0, v0 = positions_velocities(ctx)
     P0, L0 = (m[:, None] * v0).sum(0), (m[:, None] * np.cross(x0, v0)).sum(0)
     ig.step(300)
-    x, v = arrays(ctx)
+    x, v = positions_velocities(ctx)
     P, L = (m[:, None] * v).sum(0), (m[:, None] * np.cross(x, v)).sum(0)
     assert np.linalg.norm(P - P0) < 1e-12 * float(np.sum(m[:, None] * np.abs(v)))
     assert np.linalg.norm(L - L0) < 1e-11 * np.linalg.norm(L0)
@@ -325,11 +290,11 @@ def test_middle_checkpoint_and_copies_continue_bit_for_bit(backend):
     ig.step(31)
     chk = ctx.createCheckpoint()
     ig.step(30)
-    x1, v1 = arrays(ctx)
+    x1, v1 = positions_velocities(ctx)
     heat1 = ig.computeHeatBathEnergy()
     ctx.loadCheckpoint(chk)
     ig.step(30)
-    x2, v2 = arrays(ctx)
+    x2, v2 = positions_velocities(ctx)
     assert (x2.tobytes(), v2.tobytes(), ig.computeHeatBathEnergy()) == (x1.tobytes(), v1.tobytes(), heat1)
     del ctx
     fresh = make()
@@ -342,7 +307,7 @@ def test_middle_checkpoint_and_copies_continue_bit_for_bit(backend):
         assert integrator.thermostat_position == "middle"
         c = context(scene.system, integrator, scene.positions, scene.velocities)
         integrator.step(10)
-        runs.append((arrays(c)[1].tobytes(), integrator.computeHeatBathEnergy()))
+        runs.append((positions_velocities(c)[1].tobytes(), integrator.computeHeatBathEnergy()))
         del c
     assert all(r == runs[0] for r in runs[1:])
 
@@ -371,7 +336,7 @@ def test_conservation_reporter_shows_the_temperature_at_the_thermostat(backend):
         sim.reporters.append(reporter)
         sim.step(20)
         assert "T at the thermostat (K)" in out.getvalue().splitlines()[0]
-        x, v = arrays(sim.context)
+        x, v = positions_velocities(sim.context)
         m = masses(scene.system)
         u = kept_velocities(x, v, m, True)
         on_step = float(np.sum(m[:, None] * (v - u) ** 2)) / (ig.thermostat_dof * R_KJ)
