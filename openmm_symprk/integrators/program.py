@@ -193,7 +193,7 @@ class _Emitter:
                 self.ig.addComputePerDof("v", f"v + {_num(c)}*dt*{force}/m")
 
     def project_velocities(self):
-        """A velocity projection inside a step (a drift flagged ``project_before``, see
+        """A velocity projection inside a step (a drift or a thermostat event flagged ``project_before``, see
         :func:`openmm_symprk.methods.resolved.projected_drifts`)."""
         if not self.constraints:
             return
@@ -252,6 +252,8 @@ def _compile_splitting(integrator, method: ResolvedMethod, constraints: bool, op
             if options.thermostat is None:
                 raise ValueError(f"{method.name}: the method was resolved with a thermostat sub-step, but the options "
                                  f"have no thermostat (temperature=)")
+            if sub.project_before:
+                em.project_velocities()
             em.middle_thermostat_event(c)
         elif sub.kind == SubstepKind.DRIFT:
             if sub.project_before:

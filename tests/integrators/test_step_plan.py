@@ -93,7 +93,9 @@ def _expected_plan(ig, constrained):
         out.append(("thermostat", None, None, None, 0))
     for s in range(ig.getNumSubsteps()):
         flags = ig.getSubstepFlags(s)
-        if ig.getSubstepKind(s) == ig.Thermostat:
+        if ig.getSubstepKind(s) == ig.Thermostat:  # after a kick, under constraints: velocities projected first
+            if constrained and flags & ig.ProjectVelocitiesBefore:
+                out.append(("project", s, None, None, None))
             out.append(("thermostat", s, None, None, (interval - 1) // 2))
         elif ig.getSubstepKind(s) == ig.Kick:
             mask = ig.getSubstepForceGroups(s)

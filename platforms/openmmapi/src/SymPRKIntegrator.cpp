@@ -65,9 +65,9 @@ void SymPRKIntegrator::setSubsteps(const vector<int>& newKinds, const vector<dou
         else if (newKinds[i] == Thermostat && !(newCoefficients[i] > 0 && std::isfinite(newCoefficients[i])))
             msg << " is a thermostat event with the coefficient " << newCoefficients[i] << "; expected a finite fraction > 0 "
                    "of the thermostat's interval (1: one whole event)";
-        else if (newKinds[i] == Thermostat && (newGroups[i] != -1 || newFlags[i] != 0))
+        else if (newKinds[i] == Thermostat && (newGroups[i] != -1 || (newFlags[i] & ~ProjectVelocitiesBefore) != 0))
             msg << " is a thermostat event with force-group mask " << newGroups[i] << " and flags " << newFlags[i]
-                << "; a thermostat event takes -1 and 0";
+                << "; a thermostat event takes -1 and flags 0 or " << ProjectVelocitiesBefore << " (project velocities first)";
         else if (!std::isfinite(newCoefficients[i]) || newCoefficients[i] == 0.0)
             msg << " has the coefficient " << newCoefficients[i] << "; expected a finite non-zero number (leave a zero sub-step out)";
         else if (newKinds[i] == Kick && (newGroups[i] == 0 || newGroups[i] < -1))
@@ -76,9 +76,9 @@ void SymPRKIntegrator::setSubsteps(const vector<int>& newKinds, const vector<dou
             msg << " is a drift with force-group mask " << newGroups[i] << "; a drift takes -1";
         else if ((newFlags[i] & ~(ProjectVelocitiesBefore | ForcesCached)) != 0)
             msg << " has flags " << newFlags[i] << "; expected a combination of " << ProjectVelocitiesBefore
-                << " (project velocities before a drift) and " << ForcesCached << " (a kick on cached forces)";
+                << " (project velocities before a drift or a thermostat event) and " << ForcesCached << " (a kick on cached forces)";
         else if (newKinds[i] == Kick && (newFlags[i] & ProjectVelocitiesBefore) != 0)
-            msg << " is a kick flagged ProjectVelocitiesBefore, which only a drift takes";
+            msg << " is a kick flagged ProjectVelocitiesBefore, which only a drift or a thermostat event takes";
         else if (newKinds[i] == Drift && (newFlags[i] & ForcesCached) != 0)
             msg << " is a drift flagged ForcesCached, which only a kick takes";
         else

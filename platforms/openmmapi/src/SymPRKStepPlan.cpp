@@ -67,6 +67,8 @@ SymPRKStepPlan::SymPRKStepPlan(const SymPRKIntegrator& integrator, bool hasConst
         const double c = integrator.getSubstepCoefficient(s);
         const int flags = integrator.getSubstepFlags(s);
         if (integrator.getSubstepKind(s) == SymPRKIntegrator::Thermostat) {
+            if (constraints && (flags & SymPRKIntegrator::ProjectVelocitiesBefore) != 0)
+                operations.push_back(operation(ProjectVelocities, s, 0.0));
             operations.push_back(operation(ThermostatEvent, s, c, interval, tau));
             operations.back().phase = (interval-1)/2;
         }

@@ -61,7 +61,11 @@ public:
     };
     /** Bits of a sub-step's flags (openmm_symprk.methods.resolved.SubstepFlag has the same numbers). */
     enum SubstepFlag {
-        /** A drift: project the velocities onto the constraints first (only where the System has constraints). */
+        /**
+         * A drift or a thermostat event: project the velocities onto the constraints first (only where the System
+         * has constraints).  An event that follows a kick needs it: the kick leaves the constraint forces' share in
+         * the velocities, a kinetic energy along the constraints that the event would otherwise rescale.
+         */
         ProjectVelocitiesBefore = 1,
         /** A kick: no drift since the previous kick of its force groups; its forces are reused when still valid. */
         ForcesCached = 2
@@ -82,7 +86,7 @@ public:
      * step size (finite, non-zero; a Thermostat sub-step's fraction of interval*dt/tau, > 0), groups[i] a kick's
      * force groups as a bit mask (as in Context::getState), or -1 for the integrator's integration force groups
      * (drifts and thermostat events: -1), flags[i] a combination of SubstepFlag bits (ProjectVelocitiesBefore on
-     * drifts only, ForcesCached on kicks only, none on thermostat events).  Kicks of different groups make a
+     * drifts and thermostat events only, ForcesCached on kicks only).  Kicks of different groups make a
      * multiple-time-step method; the forces of every group are kept until the positions change.  Cannot be
      * called once the integrator is bound to a Context.
      */
