@@ -392,6 +392,11 @@ def test_the_answer_is_the_cheapest_match_and_its_speed_against_openmms_cheapest
     table[3]["s_per_ps"] = None  # not timed: picked by force evaluations, no ratio claimed
     a = answer(table, "NVT")
     assert a["by"] == "force evaluations" and a["speedup_vs_openmm"] is None
+    from openmm_symprk.studies.fidelity.report import answer_lines
+
+    lines = answer_lines({"rows": table, "cheapest": {"NVT": a}, "references": {"NVT": "ref"}, "reference": "ref"})
+    assert lines[1] == ("  NVT: this package's cheapest match ours fast against OpenMM's cheapest match openmm: not "
+                        "timed; 2.00x fewer force evaluations per ps (500 against 1000)")
 
 
 def test_the_replicas_needed_scale_as_the_square_of_the_error():
