@@ -27,7 +27,7 @@ ROWS = [
     "verlet 0.5 fs SVR 0.1 ps middle",
     # NVE: the package
     "verlet 1 fs", "verlet 2 fs", "verlet 3 fs",
-    "omelyan-2 4 fs", "omelyan-2 5 fs", "omelyan-2 6 fs", "pefrl 4 fs",
+    "omelyan-2 4 fs", "omelyan-2 5 fs", "omelyan-2 6 fs", "omelyan-2 7 fs", "pefrl 4 fs",
     "verlet 4 fs HMR 3 Da", "omelyan-2 4 fs HMR 3 Da",
     "verlet 4/2 fs", "omelyan-2 6/2 fs",  # the package's MTS: reciprocal-space PME once per outer step
     # NVE: OpenMM
@@ -36,7 +36,7 @@ ROWS = [
     "verlet 2 fs SVR 0.1 ps", "verlet 2 fs SVR 1 ps", "omelyan-2 4 fs SVR 0.1 ps", "omelyan-2 4 fs SVR 1 ps",
     "verlet 2 fs SVR 0.1 ps middle", "verlet 3 fs SVR 0.1 ps middle", "verlet 4 fs SVR 0.1 ps middle",
     # omelyan-2 at its best placement (methods.placement.best_position: "ends")
-    "omelyan-2 5 fs SVR 0.1 ps", "omelyan-2 6 fs SVR 0.1 ps",
+    "omelyan-2 5 fs SVR 0.1 ps", "omelyan-2 6 fs SVR 0.1 ps", "omelyan-2 7 fs SVR 0.1 ps",
     "verlet 4/2 fs SVR 0.1 ps middle", "omelyan-2 6/2 fs SVR 0.1 ps",
     # NVT: OpenMM
     "langevin 1 fs friction 0.1/ps", "langevin 2 fs friction 0.1/ps", "langevin 3 fs friction 0.1/ps",
