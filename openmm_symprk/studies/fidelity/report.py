@@ -478,7 +478,9 @@ def chart(summary: dict, path: str, x: str = "evals_per_ps"):
     xlabel = "force evaluations per ps" if x == "evals_per_ps" else "wall seconds per simulated ps"
     for ax in axes[:len(OBSERVABLES)]:
         ax.set_xlabel(xlabel, fontsize=8)
-    fig.suptitle(f"Bias against {summary['reference']} (paired by replica, error bars ± {K_SE:g} SE) against cost")
+    refs = summary.get("references") or {"NVE": summary["reference"]}
+    against = " and ".join(f"{lab} ({ens} rows)" for ens, lab in refs.items()) if len(refs) > 1 else summary["reference"]
+    fig.suptitle(f"Bias against {against} (paired by replica, error bars ± {K_SE:g} SE) against cost")
     fig.tight_layout()
     fig.savefig(path, dpi=90)
     plt.close(fig)
