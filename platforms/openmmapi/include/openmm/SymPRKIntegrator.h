@@ -12,8 +12,8 @@
  * never moved; virtual sites are placed before every force evaluation and at the end of the step.
  *
  * The flags are decided by whoever builds the sequence (openmm_symprk.methods.resolved, the one place
- * that states the rules), not here: ProjectVelocitiesBefore on a drift projects the velocities onto the
- * constraints first (where the System has constraints); ForcesCached on a kick says that no drift came
+ * that states the rules), not here: ProjectVelocitiesBefore on a drift or a thermostat event projects the
+ * velocities onto the constraints first (where the System has constraints); ForcesCached on a kick says that no drift came
  * since the previous kick of its force groups (cyclically, so a closing kick's forces serve the next
  * step's opening kick), so its forces are reused whenever they are still valid.  A step then costs
  * getForceEvaluationsPerStep() force evaluations in steady state.
