@@ -40,7 +40,6 @@ import openmm.unit as unit
 
 from ..physics import momenta
 from ..physics.temperature import R_KJ, kinetic_temperatures
-from ..physics.velocity_rescaling import kept_velocities
 from ..support import require
 from ..stats.slope import RunningLine
 from ..systems.checks import conservation_issues, integrator_issues, warn_conservation, warn_once
@@ -139,7 +138,8 @@ class ConservationReporter:
                 f"{rec['dL_rel']:.4g}", f"{rec['constraint_error']:.4g}", f"{rec['T_trans']:.5g}",
                 f"{rec['T_rot']:.5g}"]
         if self._thermostat is not None:
-            rec["T_thermostat"] = self._thermostat_temperature(simulation.integrator, x, v, m)
+            # the temperature the thermostat samples (its last event's peculiar kinetic energy over its degrees of freedom)
+            rec["T_thermostat"] = float(simulation.integrator.computeSystemTemperature().value_in_unit(unit.kelvin))
             vals.append(f"{rec['T_thermostat']:.5g}")
         self.records.append(rec)
         print(self._sep.join(vals), file=self._out)
@@ -149,17 +149,6 @@ class ConservationReporter:
             pass
 
     # -- helpers ----------------------------------------------------------------------------------
-    def _thermostat_temperature(self, integrator, x, v, m) -> float:
-        """The temperature of the velocities at the thermostat point, just after its last event: 2 K_pec/(N_f k),
-        the kept part (centre-of-mass motion, and rigid rotation of an isolated System; unchanged by events and
-        conserved between them) taken from the State.  With the thermostat in the middle of the step the State's
-        on-step velocities read lower for stiff modes (T (1 - h^2 w^2/4)); this is the temperature sampled."""
-        settings = self._thermostat
-        event = float(integrator.thermostat_kinetic_energy().value_in_unit(_KJ))
-        u = kept_velocities(x, v, m, settings.keep_rotation)
-        kept = momenta.kinetic_energy(u, m)
-        return 2.0 * (event - kept) / (settings.dof * R_KJ)
-
     @staticmethod
     def _heat_bath(simulation) -> float:
         """The heat-bath energy (kJ/mol) of an integrator of this package run with ``temperature=``, else 0."""

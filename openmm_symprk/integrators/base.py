@@ -37,8 +37,9 @@ import warnings
 import openmm as mm
 import openmm.unit as unit
 
+from ..physics.temperature import R_KJ
 from .quantities import positive_quantity
-from .thermostat import check_seed
+from .thermostat import check_seed, on_step_temperature
 
 __all__ = ["IntegratorBase", "SimulationBlowUpError", "ConvergenceWarning", "SystemMismatchError",
            "CheckpointMismatchError", "step_size_in_ps"]
@@ -84,7 +85,7 @@ class IntegratorBase:
     program_info = None  # the ProgramInfo of its compiled program (.program)
     thermostat = None  # ThermostatSettings as the program runs them now, None without a thermostat (NVE)
     #: attributes a copy does not carry (the C++ object, per-Context handles)
-    _transient: tuple = ("this", "thisown")
+    _transient: tuple = ("this", "thisown", "_context_ref")
 
     # -- what it runs -----------------------------------------------------------------------------------
     @property
@@ -173,8 +174,13 @@ class IntegratorBase:
     # -- conveniences ------------------------------------------------------------------------------
     @property
     def steps_taken(self) -> int:
-        """Steps taken since the integrator was bound (kept in checkpoints)."""
+        """Steps taken since the integrator was bound, or its Context reinitialized (kept in checkpoints)."""
+        self._sync_run_state()
         return int(self._raw_steps_taken())
+
+    def _sync_run_state(self):
+        """Before the run's values are read between steps: bring them up to what the Context holds now (a backend
+        that notices a reinitialized Context or a loaded checkpoint only when it steps)."""
 
     def describe(self) -> str:
         """The integrator's program: backend, stages, constraint handling, force evaluations per step."""
@@ -186,6 +192,7 @@ class IntegratorBase:
         return self.thermostat is not None
 
     def _require_thermostat(self, what: str):
+        self._sync_run_state()
         if self.thermostat is None:
             raise ValueError(f"{type(self).__name__}({self.method_name}).{what}: this integrator was created without "
                              f"temperature=, so it runs NVE and has no thermostat; create it with e.g. "
@@ -245,6 +252,7 @@ class IntegratorBase:
         NoseHooverIntegrator.computeHeatBathEnergy).  0 without a thermostat."""
         if self.thermostat is None:
             return 0.0 * unit.kilojoule_per_mole
+        self._sync_run_state()
         return float(self._heat_bath_energy()) * unit.kilojoule_per_mole
 
     def thermostat_kinetic_energy(self):
@@ -255,6 +263,32 @@ class IntegratorBase:
         half drifts) read T.  With the ends placement both agree.  0 before the first event."""
         self._require_thermostat("thermostat_kinetic_energy()")
         return float(self._thermostat_kinetic_energy()) * unit.kilojoule_per_mole
+
+    def computeSystemTemperature(self):
+        """The temperature (a Quantity in K) OpenMM's reporters print: StateDataReporter asks an integrator that has
+        this method instead of computing one from the State's kinetic energy and its own count of degrees of freedom.
+
+        With a thermostat it is the temperature the thermostat samples: 2 K' / (N_f R) from the peculiar kinetic energy
+        K' just after the last event and the thermostat's degrees of freedom N_f (:attr:`thermostat_dof`).  With the
+        thermostat in the middle of the step the on-step velocities are not the canonical ones (a stiff mode of angular
+        frequency w reads T (1 - h^2 w^2/4) there), so a temperature computed from a State reads low; this one does
+        not.  Without a thermostat, and before the first event, it is the kinetic temperature of the Context's current
+        velocities with the same count: the peculiar kinetic energy (less the centre-of-mass motion, and the rigid
+        rotation of an isolated System) over 3 per particle with mass - constraints - 3 (- 3)."""
+        if self.thermostat is not None:
+            self._sync_run_state()
+            kinetic = float(self._thermostat_peculiar_kinetic_energy())
+            if kinetic > 0:
+                return 2 * kinetic / (self.thermostat.dof * R_KJ) * unit.kelvin
+        context = self._bound_context()
+        if context is None:
+            raise RuntimeError(f"{type(self).__name__}({self.method_name}).computeSystemTemperature(): the integrator is "
+                               f"not bound to a Context (create one, or a Simulation, first)")
+        return on_step_temperature(context) * unit.kelvin
+
+    def _thermostat_peculiar_kinetic_energy(self) -> float:
+        """K' (kJ/mol) of the last thermostat event: the peculiar kinetic energy it left (0 before the first)."""
+        raise NotImplementedError
 
     @property
     def thermostat_position(self) -> str | None:
@@ -271,6 +305,21 @@ class IntegratorBase:
 
     def _apply_thermostat(self, settings):
         raise NotImplementedError
+
+    # -- the Context ---------------------------------------------------------------------------------------------
+    _context_ref = None
+
+    def _bound_context(self):
+        """The Context this integrator is bound to (found once among the live Contexts, then kept weakly), or None."""
+        context = self._context_ref() if self._context_ref is not None else None
+        if context is None:
+            import gc
+            import weakref
+
+            context = next((o for o in gc.get_objects()
+                            if isinstance(o, mm.Context) and getattr(o, "_integrator", None) is self), None)
+            self._context_ref = weakref.ref(context) if context is not None else None
+        return context
 
     # -- copies ---------------------------------------------------------------------------------------
     def _python_state(self) -> dict:

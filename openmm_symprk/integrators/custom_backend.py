@@ -121,7 +121,6 @@ class PRKIntegrator(IntegratorBase, mm.CustomIntegrator):
             self.setPerDofVariableByName(fresh.getPerDofVariableName(i), fresh.getPerDofVariable(i))
 
     # -- per-Context checks ----------------------------------------------------------------------------
-    _transient = IntegratorBase._transient + ("_context_ref",)
 
     def _reset_binding(self):
         self._context_ref = None
@@ -137,10 +136,7 @@ class PRKIntegrator(IntegratorBase, mm.CustomIntegrator):
         if not self._checked_context:
             self._check_context()
         elif self._bound_values_may_be_lost():
-            if self._bound_context().getStepCount() == 0:
-                # Context.reinitialize(): a new run, as on the native backend (heat bath, step counter, first-step
-                # probe as a fresh integrator has them; the random stream starts again from the seed)
-                self._forget_run_state(per_dof=False)
+            self._start_new_run_if_reinitialized()
             self._check_context()  # per-DOF values set while bound were dropped: set them again before stepping
         stored = self.getGlobalVariable(0)
         if stored != self.program_info.signature:
@@ -153,6 +149,19 @@ class PRKIntegrator(IntegratorBase, mm.CustomIntegrator):
                 f"(positions and velocities) instead.")
         if self.thermostat is not None:
             self._keep_thermostat_settings()
+
+    def _start_new_run_if_reinitialized(self):
+        """Context.reinitialize() (its step count back at 0): a new run, as on the native backend, whose kernel is made
+        anew (heat bath, step counter, thermostat counters and first-step probe as a fresh integrator has them; the
+        random stream starts again from the seed).  Idempotent until the next step."""
+        if self._bound_context().getStepCount() == 0:
+            self._forget_run_state(per_dof=False)
+
+    def _sync_run_state(self):
+        """Between steps, what the native backend reports at once: after Context.reinitialize() the values of a new run
+        (else they would change only at the next step)."""
+        if self._bound_values_may_be_lost():
+            self._start_new_run_if_reinitialized()
 
     def _keep_thermostat_settings(self):
         """Give the program the integrator's current temperature and collision time if a checkpoint (or a State's
@@ -216,14 +225,23 @@ class PRKIntegrator(IntegratorBase, mm.CustomIntegrator):
         self.setPerDofVariableByName(thermostat_program.MASK_VAR,
                                      thermostat_program.mask_values(m, self.thermostat.dof))
 
-    def _thermostat_values(self):
-        """The settings with the temperature and collision time the program holds now (a checkpoint restores
-        the ones it was saved with) and the seed OpenMM will use."""
+    def _program_thermostat_values(self):
+        """The settings with the temperature and collision time the program's variables hold (an integrator read from
+        XML: as they were last set) and the seed OpenMM will use."""
         if self.thermostat is None:
             return None
-        return replace(self.thermostat, temperature=self.getGlobalVariableByName(thermostat_program.TEMPERATURE_VAR),
-                       collision_time=self.getGlobalVariableByName(thermostat_program.COLLISION_TIME_VAR),
+        get = self.getGlobalVariableByName
+        return replace(self.thermostat, temperature=get(thermostat_program.TEMPERATURE_VAR),
+                       collision_time=get(thermostat_program.COLLISION_TIME_VAR),
                        seed=int(mm.CustomIntegrator.getRandomNumberSeed(self)))
+
+    def _thermostat_values(self):
+        """The integrator's settings (the ones the next step runs: a checkpoint or a State that brought back the program's
+        older temperature or collision time is overruled before it, :meth:`_keep_thermostat_settings`, as on the native
+        backend) with the seed OpenMM will use."""
+        if self.thermostat is None:
+            return None
+        return replace(self.thermostat, seed=int(mm.CustomIntegrator.getRandomNumberSeed(self)))
 
     def _apply_thermostat(self, settings):
         self.setGlobalVariableByName(thermostat_program.TEMPERATURE_VAR, settings.temperature)
@@ -241,6 +259,9 @@ class PRKIntegrator(IntegratorBase, mm.CustomIntegrator):
 
     def _thermostat_kinetic_energy(self) -> float:
         return thermostat_program.event_kinetic_energy(self)
+
+    def _thermostat_peculiar_kinetic_energy(self) -> float:
+        return self.getGlobalVariableByName(thermostat_program.NEW_KINETIC_VAR)
 
     def _after_step(self):
         self._remember_step_count()
@@ -316,18 +337,6 @@ class PRKIntegrator(IntegratorBase, mm.CustomIntegrator):
         result = super().setStepSize(size)
         self._dt = self.getStepSize().value_in_unit(unit.picosecond)
         return result
-
-    def _bound_context(self):
-        """The Context this integrator is bound to (found once among the live Contexts, then kept weakly)."""
-        context = self._context_ref() if self._context_ref is not None else None
-        if context is None:
-            import gc
-            import weakref
-
-            context = next((o for o in gc.get_objects()
-                            if isinstance(o, mm.Context) and getattr(o, "_integrator", None) is self), None)
-            self._context_ref = weakref.ref(context) if context is not None else None
-        return context
 
     def describe(self) -> str:
         info, r = self.program_info, self.resolved

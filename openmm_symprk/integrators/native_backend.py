@@ -155,9 +155,15 @@ class NativeSymplecticIntegrator(SymplecticIntegrator, _PluginIntegrator, backen
     def _thermostat_kinetic_energy(self) -> float:
         return float(self.getThermostatKineticEnergy())
 
+    def _thermostat_peculiar_kinetic_energy(self) -> float:
+        return float(self.getThermostatPeculiarKineticEnergy())
+
     def _skipped_thermostat_events(self) -> int:
         """Events that found no peculiar kinetic energy (IntegratorBase warns once, for both backends)."""
         return int(self.getSkippedThermostatEvents())
+
+    def _still(self) -> bool:
+        return bool(self.getLastThermostatEventSkipped())
 
     # -- conveniences ----------------------------------------------------------------------------------------
     @property

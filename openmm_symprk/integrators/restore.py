@@ -77,7 +77,7 @@ def _restore_custom(integrator: mm.CustomIntegrator):
     obj._set_program(resolved, options, replace(info, notes=(*info.notes, "restored from XML")))
     obj.__dict__.update(_masses=None, thermostat=options.thermostat)
     # the program holds the temperature and collision time as they were last set (the metadata: as created)
-    obj.thermostat = obj._thermostat_values()
+    obj.thermostat = obj._program_thermostat_values()
     obj._reset_binding()
     obj._forget_run_state()
     return obj

@@ -18,14 +18,14 @@ import openmm.unit as unit
 
 from ..methods.placement import POSITIONS
 from ..physics.temperature import R_KJ
-from ..physics.velocity_rescaling import relaxation_factor
+from ..physics.velocity_rescaling import peculiar_kinetic_energy, relaxation_factor
 from ..systems.checks import EXACT_MOMENTUM_FORBIDDEN, check_system_type, conservation_issues
-from ..systems.properties import thermostat_degrees_of_freedom
+from ..systems.properties import masses, thermostat_degrees_of_freedom
 from .quantities import positive_quantity
 
 __all__ = ["ThermostatSettings", "thermostat_settings", "temperature_in_kelvin", "collision_time_in_ps",
            "check_interval", "check_seed", "system_is_isolated", "DEFAULT_COLLISION_TIME", "THERMOSTAT_OPTIONS",
-           "MAX_SEED", "MAX_INTERVAL", "DEFAULT_POSITION", "check_position"]
+           "MAX_SEED", "MAX_INTERVAL", "DEFAULT_POSITION", "check_position", "on_step_temperature"]
 
 #: Default collision time tau (ps) when ``temperature`` is given without ``collision_time``.
 DEFAULT_COLLISION_TIME = 0.1
@@ -94,6 +94,21 @@ def system_is_isolated(system: mm.System) -> bool:
     """True for a System that conserves angular momentum: not periodic, no frozen (massless, non virtual-site)
     particles and no external field (the facts of :func:`openmm_symprk.systems.checks.conservation_issues`)."""
     return not any(key in EXACT_MOMENTUM_FORBIDDEN for key, _ in conservation_issues(system))
+
+
+def on_step_temperature(context: mm.Context) -> float:
+    """The kinetic temperature (K) of a Context's current velocities with the thermostat's count of degrees of freedom:
+    2 K_pec / (N_f R), K_pec the kinetic energy without the centre-of-mass motion (and the rigid rotation, for an isolated
+    System), N_f = 3 per particle with mass - constraints - 3 (- 3)."""
+    system = context.getSystem()
+    isolated = system_is_isolated(system)
+    dof = thermostat_degrees_of_freedom(system, isolated)
+    if dof <= 0:
+        return 0.0
+    state = context.getState(getPositions=True, getVelocities=True)
+    x = state.getPositions(asNumpy=True).value_in_unit(unit.nanometer)
+    v = state.getVelocities(asNumpy=True).value_in_unit(unit.nanometer / unit.picosecond)
+    return 2.0 * peculiar_kinetic_energy(x, v, masses(system), isolated) / (dof * R_KJ)
 
 
 @dataclass(frozen=True)

@@ -31,7 +31,7 @@ from .thermostat import ThermostatSettings
 
 __all__ = ["PREFIX", "LOST_MASK_VAR", "TEMPERATURE_VAR", "COLLISION_TIME_VAR", "HEAT_BATH_VAR", "MASK_VAR", "ALPHA_VAR",
            "KINETIC_VAR", "NEW_KINETIC_VAR", "add_variables", "emit_half_event", "emit_event", "mask_values",
-           "TOTAL_KINETIC_VAR", "SKIPPED_VAR", "event_kinetic_energy"]
+           "TOTAL_KINETIC_VAR", "SKIPPED_VAR", "event_kinetic_energy", "emit_noise", "R1_VAR", "CHI2_VAR"]
 
 PREFIX = "symprk_ts_"
 TEMPERATURE_VAR = PREFIX + "temperature"  # K
@@ -190,8 +190,7 @@ def emit_event(integrator: mm.CustomIntegrator, settings: ThermostatSettings, fr
     K = KINETIC_VAR
     ig.addComputeGlobal(K, f"{v('K')} - ({kept})")
     # the noise, and (alpha, K') as physics.velocity_rescaling.rescaling_factor writes them
-    ig.addComputeGlobal(v("r1"), "gaussian")
-    ig.addComputeSum(v("chi2"), f"gaussian*gaussian*{MASK_VAR}")
+    emit_noise(ig)
     ig.addComputeGlobal(v("c"), f"exp(-{_num(fraction * settings.interval)}*dt/{COLLISION_TIME_VAR})")
     ig.addComputeGlobal(v("s"), f"{_num(0.5 * dof * R_KJ)}*{TEMPERATURE_VAR}/{dof}")  # target / dof
     c, s, r1, chi2 = v("c"), v("s"), v("r1"), v("chi2")
@@ -216,6 +215,18 @@ def emit_event(integrator: mm.CustomIntegrator, settings: ThermostatSettings, fr
     else:
         u = _comb("Vx", "Vy", "Vz")
     ig.addComputePerDof("v", f"select(m, {u} + {alpha}*(v - {u}), v)")
+
+
+#: the global variables holding the last event's noise: a standard normal, and a chi-squared variate of dof - 1
+R1_VAR, CHI2_VAR = _v("r1"), _v("chi2")
+
+
+def emit_noise(integrator: mm.CustomIntegrator) -> None:
+    """Append the noise of one event: ``R1_VAR`` a standard normal, ``CHI2_VAR`` the sum of squared standard normals
+    over the per-DOF mask (:func:`mask_values`: dof - 1 of them, a chi-squared variate of dof - 1 degrees of freedom).
+    Every event draws it so; :mod:`.noise` draws it alone, to check the numbers."""
+    integrator.addComputeGlobal(R1_VAR, "gaussian")
+    integrator.addComputeSum(CHI2_VAR, f"gaussian*gaussian*{MASK_VAR}")
 
 
 def event_kinetic_energy(integrator: mm.CustomIntegrator) -> float:

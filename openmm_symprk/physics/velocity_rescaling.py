@@ -29,10 +29,10 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .momenta import angular_momentum, centre_of_mass, inertia_tensor, linear_momentum
+from .momenta import angular_momentum, centre_of_mass, inertia_tensor, kinetic_energy, linear_momentum
 
 __all__ = ["thermostat_dof", "relaxation_factor", "rescaling_factor", "draw_noise", "Resampled", "resample",
-           "kept_velocities", "ROUNDOFF", "no_peculiar_motion"]
+           "kept_velocities", "peculiar_kinetic_energy", "ROUNDOFF", "no_peculiar_motion"]
 
 #: A peculiar kinetic energy at most this fraction of the total is round-off (a system at rest, or moving only as a
 #: rigid whole): an event leaves it alone, since sqrt(K'/K_pec) ~ 1e8 would amplify round-off into the kept motion.
@@ -118,3 +118,10 @@ def kept_velocities(x, v, m, keep_rotation: bool) -> np.ndarray:
                             rcond=None)[0]
         kept += np.cross(w, r)
     return kept
+
+
+def peculiar_kinetic_energy(x, v, m, keep_rotation: bool) -> float:
+    """The kinetic energy (kJ/mol) of the peculiar velocities v - :func:`kept_velocities`: what the thermostat rescales,
+    and with its degrees of freedom (:func:`thermostat_dof`) the kinetic temperature 2 K / (N_f R)."""
+    v = np.asarray(v, dtype=np.float64)
+    return kinetic_energy(v - kept_velocities(x, v, m, keep_rotation), m)

@@ -116,8 +116,11 @@ public:
     void setRandomNumberSeed(int seed);
     double getHeatBathEnergy() const;
     double getThermostatKineticEnergy() const;
+    double getThermostatPeculiarKineticEnergy() const;
     long long getSkippedThermostatEvents() const;
+    bool getLastThermostatEventSkipped() const;
     long long getHostTransfers() const;
+    std::vector<double> sampleThermostatNoise(int count);
     static std::vector<double> computeRescalingFactor(double kinetic, double target, int dof, double c, double r1, double chi2);
     static void registerMissingKernelFactories();
     void step(int steps);

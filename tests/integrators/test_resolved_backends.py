@@ -122,12 +122,38 @@ def test_checkpoint_of_the_old_format_is_refused(water8):
     ctx = water8.context(ig)
     ig.step(2)
     chk = ctx.createCheckpoint()
-    magic = struct.pack("<q", 0x53796d50524b0004)
-    assert chk.count(magic) == 1  # format 4 (3 and the thermostat's block)
+    magic = struct.pack("<q", 0x53796d50524b0005)
+    assert chk.count(magic) == 1  # format 5 (3, the thermostat's block and its run state)
     for old in (2, 3):
         with pytest.raises(Exception, match=f"older openmm_symprk .checkpoint format {old}"):
             ctx.loadCheckpoint(chk.replace(magic, struct.pack("<q", 0x53796d50524b0000 + old)))
+    ctx.loadCheckpoint(chk.replace(magic, struct.pack("<q", 0x53796d50524b0004)))  # NVE: format 4 is the same block
     ctx.loadCheckpoint(chk)
+
+
+@needs_native
+def test_checkpoint_of_format_4_still_loads_with_its_thermostat(water8):
+    """Format 4 had the heat-bath energy and the random state but not the kinetic energies after the last event nor the
+    skipped events (the integrator's block ends the Context's checkpoint, and those are its last 32 bytes): it loads,
+    and the run continues as from the format-5 checkpoint, bit for bit."""
+    ig = NativeSymplecticIntegrator(0.001, "verlet", system=water8.system, temperature=300, random_seed=9)
+    ctx = water8.context(ig)
+    ig.step(5)
+    chk = ctx.createCheckpoint()
+    heat = ig.computeHeatBathEnergy()
+    magic = struct.pack("<q", 0x53796d50524b0005)
+    tail = struct.pack("<dd", ig.getThermostatKineticEnergy(), ig.getThermostatPeculiarKineticEnergy()) + bytes(16)
+    assert chk.count(magic) == 1 and chk.endswith(tail)
+    old = chk.replace(magic, struct.pack("<q", 0x53796d50524b0004))[:-32]
+    runs = []
+    for checkpoint in (chk, old):
+        ctx.loadCheckpoint(checkpoint)
+        assert ig.computeHeatBathEnergy() == heat
+        runs.append(ig.getThermostatKineticEnergy())
+        ig.step(5)
+        runs.append(ctx.getState(getVelocities=True).getVelocities(asNumpy=True)._value.tobytes())
+    assert runs[0] != 0 and runs[2] == 0  # format 4 knows no kinetic energy of the last event
+    assert runs[1] == runs[3]
 
 
 @pytest.mark.parametrize("backend", BACKENDS)

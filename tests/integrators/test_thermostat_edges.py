@@ -160,6 +160,22 @@ def test_no_peculiar_kinetic_energy_warns_once_and_scales_nothing(backend, motio
     assert ig.computeHeatBathEnergy() != 0 * unit.kilojoule_per_mole
 
 
+@pytest.mark.parametrize("backend", BACKENDS)
+@pytest.mark.parametrize("position", ["ends", "middle"])
+def test_a_run_started_at_rest_that_moves_does_not_warn(backend, position, cluster):
+    """Only the first event of a cluster started at rest finds nothing to scale (its forces set it moving): no warning,
+    on either backend (the native one warned for that single skipped event before issue 36)."""
+    ig = SymplecticIntegrator(0.002, "verlet", system=cluster.system, backend=backend, temperature=300, random_seed=2,
+                              thermostat_position=position)
+    ctx = context(cluster.system, ig, cluster.positions, np.zeros((cluster.system.getNumParticles(), 3)))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        ig.step(10)
+    assert ig._skipped_thermostat_events() == (1 if position == "ends" else 0)
+    assert ig.computeHeatBathEnergy() != 0 * unit.kilojoule_per_mole
+    del ctx
+
+
 # -- linear isolated systems -----------------------------------------------------------------------------------------
 @pytest.mark.parametrize("case", LINEAR_CASES)
 def test_isolated_diatomic_has_one_degree_of_freedom_and_keeps_l(case):
@@ -236,3 +252,41 @@ def test_linear_triatomic_keeps_p_and_l(case):
     assert ig.computeHeatBathEnergy() != 0 * unit.kilojoule_per_mole
     assert np.linalg.norm((m[:, None] * (V - v)).sum(0)) < 1e-12 * np.sum(m[:, None] * np.abs(V))
     assert np.linalg.norm((m[:, None] * np.cross(X, V)).sum(0) - L0) < 1e-9 * np.linalg.norm(L0)
+
+
+# -- between a reinitialize or a checkpoint and the next step both backends report the same run (issue 36) -------------
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_reinitialized_context_reports_a_new_run_at_once(backend, cluster):
+    """Before issue 36 the custom backend went on reporting the old run's heat-bath energy, kinetic energy and step
+    count until the next step, and the native one kept its step count."""
+    ig = SymplecticIntegrator(0.002, "verlet", system=cluster.system, backend=backend, temperature=300, random_seed=3)
+    ctx = context(cluster.system, ig, cluster.positions, cluster.velocities)
+    ig.step(20)
+    kj = unit.kilojoule_per_mole
+    assert ig.computeHeatBathEnergy() != 0 * kj and ig.steps_taken == 20
+    ctx.reinitialize()
+    assert ig.computeHeatBathEnergy() == 0 * kj
+    assert ig.thermostat_kinetic_energy() == 0 * kj
+    assert ig.steps_taken == 0
+    ctx.setPositions(cluster.positions)
+    ctx.setVelocities(cluster.velocities)
+    ig.step(3)
+    assert ig.steps_taken == 3 and ig.computeHeatBathEnergy() != 0 * kj
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_loaded_checkpoint_reports_its_run_and_the_integrators_temperature(backend, cluster):
+    """After loadCheckpoint, before any step: the checkpoint's heat-bath energy, kinetic energy at the thermostat and
+    step count, and the temperature the next step will use (the integrator's).  Before issue 36 the custom backend
+    read back the checkpoint's temperature, the native one the kinetic energy of the run it left."""
+    ig = SymplecticIntegrator(0.002, "verlet", system=cluster.system, backend=backend, temperature=300, random_seed=3)
+    ctx = context(cluster.system, ig, cluster.positions, cluster.velocities)
+    ig.step(20)
+    chk = ctx.createCheckpoint()
+    saved = (ig.computeHeatBathEnergy(), ig.thermostat_kinetic_energy())
+    ig.setTemperature(350)
+    ig.step(10)
+    assert (ig.computeHeatBathEnergy(), ig.thermostat_kinetic_energy()) != saved
+    ctx.loadCheckpoint(chk)
+    assert (ig.computeHeatBathEnergy(), ig.thermostat_kinetic_energy()) == saved
+    assert ig.getTemperature() == 350 * unit.kelvin and ig.steps_taken == 20

@@ -59,10 +59,13 @@ void CommonIntegrateSymPRKStepKernel::initialize(const System& system, const Sym
     if (plan.hasThermostatEvents()) {
         thermostatEventKernel = program->createKernel("symprkThermostatEvent");
         thermostatApplyKernel = program->createKernel("symprkThermostatApply");
+        thermostatNoiseKernel = program->createKernel("symprkThermostatNoise");
+        for (int i = 0; i < 5; i++)
+            thermostatNoiseKernel->addArg();  // random, its index, dof, the output, the sample: set per call
         // double where the device has it (symprk_acc in the device source)
         const int accSize = (cc.getSupportsDoublePrecision() ? sizeof(double) : sizeof(float));
         thermostatEventData.initialize(cc, 11, accSize, "symprkThermostatEvent");
-        thermostatState.initialize(cc, 3, accSize, "symprkThermostatState");
+        thermostatState.initialize(cc, 5, accSize, "symprkThermostatState");
     }
     groupForces.clear();
     groupForcesValid.clear();
@@ -305,6 +308,37 @@ void CommonIntegrateSymPRKStepKernel::thermostatEvent(const SymPRKIntegrator& in
     thermostatApplyKernel->execute(cc.getNumAtoms());
 }
 
+vector<double> CommonIntegrateSymPRKStepKernel::sampleThermostatNoise(ContextImpl& context, int dof, int count) {
+    // Event by event, as thermostatEvent takes its numbers (one prepareRandomNumbers block each), into one array read
+    // back at the end.
+    vector<double> values(2*(size_t) count, 0.0);
+    if (count == 0 || !thermostatNoiseKernel)
+        return values;
+    ContextSelector selector(cc);
+    IntegrationUtilities& integration = cc.getIntegrationUtilities();
+    const int accSize = (cc.getSupportsDoublePrecision() ? sizeof(double) : sizeof(float));
+    ComputeArray out;
+    out.initialize(cc, 2*count, accSize, "symprkThermostatNoise");
+    thermostatNoiseKernel->setArg(2, dof);
+    thermostatNoiseKernel->setArg(3, out);
+    for (int i = 0; i < count; i++) {
+        const int index = integration.prepareRandomNumbers((dof+3)/4);
+        thermostatNoiseKernel->setArg(0, integration.getRandom());
+        thermostatNoiseKernel->setArg(1, index);
+        thermostatNoiseKernel->setArg(4, i);
+        thermostatNoiseKernel->execute(projectionBlockSize, projectionBlockSize);
+    }
+    if (accSize == sizeof(double))
+        out.download(values);
+    else {
+        vector<float> single;
+        out.download(single);
+        values.assign(single.begin(), single.end());
+    }
+    hostTransfers++;
+    return values;
+}
+
 void CommonIntegrateSymPRKStepKernel::initializeThermostat(int seed) {
     // The platform's generator is set up with or without a thermostat, so that the Context's checkpoints have the
     // same layout (its random state comes before the integrator's block) and an NVE checkpoint loaded into an NVT
@@ -318,56 +352,44 @@ void CommonIntegrateSymPRKStepKernel::initializeThermostat(int seed) {
     catch (OpenMMException&) {
         // already seeded (with another seed): shared
     }
-    if (!thermostatState.isInitialized())
-        return;
-    const vector<double> zero(3, 0.0);
-    if (thermostatState.getElementSize() == sizeof(double))
-        thermostatState.upload(zero);
-    else
-        thermostatState.upload(vector<float>(3, 0.0f));
-    hostTransfers++;
+    setThermostatRunState(SymPRKThermostat::RunState());
 }
 
-vector<double> CommonIntegrateSymPRKStepKernel::downloadThermostatState() {
-    vector<double> values(3, 0.0);
+// The run state on the device: {heat-bath energy, kinetic energy after the last event, skipped events, last skipped,
+// peculiar kinetic energy after the last event}.
+SymPRKThermostat::RunState CommonIntegrateSymPRKStepKernel::getThermostatRunState() {
+    SymPRKThermostat::RunState run;
     if (!thermostatState.isInitialized())
-        return values;
+        return run;
     ContextSelector selector(cc);
+    vector<double> values(5, 0.0);
     if (thermostatState.getElementSize() == sizeof(double))
         thermostatState.download(values);
     else {
         vector<float> single;
         thermostatState.download(single);
-        for (int i = 0; i < 3; i++)
-            values[i] = single[i];
+        values.assign(single.begin(), single.end());
     }
     hostTransfers++;
-    return values;
+    run.heatBathEnergy = values[0];
+    run.kineticEnergy = values[1];
+    run.skippedEvents = (long long) values[2];
+    run.lastSkipped = (values[3] != 0);
+    run.peculiarKineticEnergy = values[4];
+    return run;
 }
 
-double CommonIntegrateSymPRKStepKernel::getHeatBathEnergy() {
-    return downloadThermostatState()[0];
-}
-
-void CommonIntegrateSymPRKStepKernel::setHeatBathEnergy(double energy) {
+void CommonIntegrateSymPRKStepKernel::setThermostatRunState(const SymPRKThermostat::RunState& run) {
     if (!thermostatState.isInitialized())
         return;
-    vector<double> values = downloadThermostatState();
-    values[0] = energy;
     ContextSelector selector(cc);
+    const vector<double> values = {run.heatBathEnergy, run.kineticEnergy, (double) run.skippedEvents, run.lastSkipped ? 1.0 : 0.0,
+                                   run.peculiarKineticEnergy};
     if (thermostatState.getElementSize() == sizeof(double))
         thermostatState.upload(values);
     else
         thermostatState.upload(vector<float>(values.begin(), values.end()));
     hostTransfers++;
-}
-
-double CommonIntegrateSymPRKStepKernel::getThermostatKineticEnergy() {
-    return downloadThermostatState()[1];
-}
-
-long long CommonIntegrateSymPRKStepKernel::getSkippedThermostatEvents() {
-    return (long long) downloadThermostatState()[2];
 }
 
 string CommonIntegrateSymPRKStepKernel::getRandomState() {

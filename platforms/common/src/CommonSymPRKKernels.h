@@ -40,10 +40,9 @@ public:
     /** The thermostat's state lives on the device (state[] of symprkThermostatEvent); its random numbers come from
      *  OpenMM's IntegrationUtilities generator, which the Context's own checkpoint carries. */
     void initializeThermostat(int seed);
-    double getHeatBathEnergy();
-    void setHeatBathEnergy(double energy);
-    double getThermostatKineticEnergy();
-    long long getSkippedThermostatEvents();
+    std::vector<double> sampleThermostatNoise(OpenMM::ContextImpl& context, int dof, int count);
+    SymPRKThermostat::RunState getThermostatRunState();
+    void setThermostatRunState(const SymPRKThermostat::RunState& run);
     std::string getRandomState();
     void setRandomState(const std::string& state);
     long long getHostTransfers() {
@@ -51,7 +50,6 @@ public:
     }
 private:
     /** The thermostat's device state (heat-bath energy, kinetic energy after the last event, skipped events). */
-    std::vector<double> downloadThermostatState();
     void setAccArg(OpenMM::ComputeKernel& kernel, int index, double value);
     void setKernelArguments(const SymPRKIntegrator& integrator, const SymPRKStepPlan& plan);
     void addArrayArgs(OpenMM::ComputeKernel& kernel, std::initializer_list<OpenMM::ArrayInterface*> arrays);
@@ -73,7 +71,7 @@ private:
     long long hostTransfers;
     double lastStepSize;
     OpenMM::ComputeArray projection, badStep, rigid, vBefore, thermostatEventData, thermostatState;
-    OpenMM::ComputeKernel thermostatEventKernel, thermostatApplyKernel;
+    OpenMM::ComputeKernel thermostatEventKernel, thermostatApplyKernel, thermostatNoiseKernel;
     OpenMM::ComputeKernel kickKernel, kickProjectedKernel, driftKernel, driftDeltaKernel, driftApplyKernel, projectionKernel,
             rigidSumsKernel, rigidApplyKernel;
 };

@@ -20,11 +20,14 @@ using namespace SymPRKPlugin;
 using namespace OpenMM;
 using namespace std;
 
-// Checkpoint format: "SymPRK" + version.  Version 4 (the thermostat's heat-bath energy and random state after the
-// method name) refuses the older versions 1-3 (3: sub-steps with flags, no thermostat block; 1-2: signatures
-// computed without the flags).
+// Checkpoint format: "SymPRK" + version.  Version 5: the thermostat block (after the method name) holds the heat-bath
+// energy, the generator's state, then the total and peculiar kinetic energies after the last event, the skipped
+// events and whether the last one was skipped.  Version 4 (the same block without the last four) still loads, with
+// those at 0; the older
+// versions 1-3 are refused (3: sub-steps with flags, no thermostat block; 1-2: signatures computed without the flags).
 static const int64_t CHECKPOINT_MAGIC_BASE = 0x53796d50524b0000LL;
-static const int64_t CHECKPOINT_MAGIC = CHECKPOINT_MAGIC_BASE + 4;
+static const int64_t CHECKPOINT_MAGIC = CHECKPOINT_MAGIC_BASE + 5;
+static const int64_t CHECKPOINT_MAGIC_V4 = CHECKPOINT_MAGIC_BASE + 4;
 
 SymPRKIntegrator::SymPRKIntegrator(double stepSize) : exactMomentum(false), forcesAreValid(false),
         methodName("verlet"), stepsTaken(0), blowUpStep(0), maxSpeed(0.0), expectedParticles(-1),
@@ -196,28 +199,47 @@ void SymPRKIntegrator::setThermostatTemperature(double temperature) {
     thermostatTemperature = temperature;
 }
 
-double SymPRKIntegrator::getHeatBathEnergy() const {
+SymPRKThermostat::RunState SymPRKIntegrator::thermostatRunState() const {
     if (!thermostat || context == NULL)
-        return 0.0;
-    return const_cast<Kernel&>(kernel).getAs<IntegrateSymPRKStepKernel>().getHeatBathEnergy();
+        return SymPRKThermostat::RunState();
+    return const_cast<Kernel&>(kernel).getAs<IntegrateSymPRKStepKernel>().getThermostatRunState();
+}
+
+double SymPRKIntegrator::getHeatBathEnergy() const {
+    return thermostatRunState().heatBathEnergy;
 }
 
 double SymPRKIntegrator::getThermostatKineticEnergy() const {
-    if (!thermostat || context == NULL)
-        return 0.0;
-    return const_cast<Kernel&>(kernel).getAs<IntegrateSymPRKStepKernel>().getThermostatKineticEnergy();
+    return thermostatRunState().kineticEnergy;
+}
+
+double SymPRKIntegrator::getThermostatPeculiarKineticEnergy() const {
+    return thermostatRunState().peculiarKineticEnergy;
 }
 
 long long SymPRKIntegrator::getSkippedThermostatEvents() const {
-    if (!thermostat || context == NULL)
-        return 0;
-    return const_cast<Kernel&>(kernel).getAs<IntegrateSymPRKStepKernel>().getSkippedThermostatEvents();
+    return thermostatRunState().skippedEvents;
+}
+
+bool SymPRKIntegrator::getLastThermostatEventSkipped() const {
+    return thermostatRunState().lastSkipped;
 }
 
 long long SymPRKIntegrator::getHostTransfers() const {
     if (context == NULL)
         return 0;
     return const_cast<Kernel&>(kernel).getAs<IntegrateSymPRKStepKernel>().getHostTransfers();
+}
+
+vector<double> SymPRKIntegrator::sampleThermostatNoise(int count) {
+    if (!thermostat)
+        throw OpenMMException("SymPRKIntegrator::sampleThermostatNoise: the integrator has no thermostat (setThermostat)");
+    if (context == NULL)
+        throw OpenMMException("SymPRKIntegrator::sampleThermostatNoise: the noise is drawn by the bound Context's kernel; "
+                              "create the Context first");
+    if (count < 0)
+        throw OpenMMException("SymPRKIntegrator::sampleThermostatNoise: count must be >= 0");
+    return kernel.getAs<IntegrateSymPRKStepKernel>().sampleThermostatNoise(*context, thermostatDof, count);
 }
 
 vector<double> SymPRKIntegrator::computeRescalingFactor(double kinetic, double target, int dof, double c, double r1, double chi2) {
@@ -320,6 +342,7 @@ void SymPRKIntegrator::initialize(ContextImpl& contextRef) {
     k.setBlowUpStep(contextRef, blowUpStep);
     k.initializeThermostat(randomSeed);
     k.getTrace().setEnabled(traceEnabled);
+    stepsTaken = 0;  // a new run (also after Context::reinitialize, as the CustomIntegrator backend counts it)
     forcesAreValid = false;
 }
 
@@ -394,28 +417,33 @@ void SymPRKIntegrator::createCheckpoint(ostream& stream) const {
     stream.write((const char*) &hasBath, sizeof(hasBath));
     if (thermostat) {
         IntegrateSymPRKStepKernel& k = const_cast<Kernel&>(kernel).getAs<IntegrateSymPRKStepKernel>();
-        double energy = k.getHeatBathEnergy();
+        const SymPRKThermostat::RunState run = k.getThermostatRunState();
         string state = k.getRandomState();
         int64_t size = state.size();
-        stream.write((const char*) &energy, sizeof(energy));
+        stream.write((const char*) &run.heatBathEnergy, sizeof(double));
         stream.write((const char*) &size, sizeof(size));
         stream.write(state.data(), state.size());
+        int64_t skipped[2] = {(int64_t) run.skippedEvents, run.lastSkipped ? 1 : 0};
+        stream.write((const char*) &run.kineticEnergy, sizeof(double));
+        stream.write((const char*) &run.peculiarKineticEnergy, sizeof(double));
+        stream.write((const char*) skipped, sizeof(skipped));
     }
 }
 
 void SymPRKIntegrator::loadCheckpoint(istream& stream) {
     int64_t values[3];
     stream.read((char*) values, sizeof(values));
-    if (stream && values[0] > CHECKPOINT_MAGIC_BASE && values[0] < CHECKPOINT_MAGIC) {
+    const bool version4 = (stream && values[0] == CHECKPOINT_MAGIC_V4);
+    if (stream && values[0] > CHECKPOINT_MAGIC_BASE && values[0] < CHECKPOINT_MAGIC_V4) {
         stringstream msg;
         msg << "SymPRKIntegrator: the checkpoint was written by an older openmm_symprk (checkpoint format "
-            << (values[0]-CHECKPOINT_MAGIC_BASE) << "; this one reads format " << (CHECKPOINT_MAGIC-CHECKPOINT_MAGIC_BASE)
+            << (values[0]-CHECKPOINT_MAGIC_BASE) << "; this one reads formats 4 and " << (CHECKPOINT_MAGIC-CHECKPOINT_MAGIC_BASE)
             << ", which carries the thermostat's heat-bath energy and random state" << (values[0]-CHECKPOINT_MAGIC_BASE < 3 ?
                " and whose program signature covers the sub-step flags" : "") << "): it cannot be loaded. Load the "
                "positions and velocities of the saved run (a State or a PDB/XML file) instead";
         throw OpenMMException(msg.str());
     }
-    if (!stream || values[0] != CHECKPOINT_MAGIC)
+    if (!stream || (values[0] != CHECKPOINT_MAGIC && !version4))
         throw OpenMMException("SymPRKIntegrator: the checkpoint was not written by a SymPRKIntegrator (a checkpoint "
                 "of openmm_symprk's CustomIntegrator backend? Load it into SymplecticIntegrator(..., backend='custom') "
                 "with the same method and options as when it was saved)");
@@ -433,11 +461,11 @@ void SymPRKIntegrator::loadCheckpoint(istream& stream) {
                 "method and options as when the checkpoint was saved");
     int64_t hasBath = 0;
     stream.read((char*) &hasBath, sizeof(hasBath));
-    double energy = 0.0;
+    SymPRKThermostat::RunState run;
     string state;
     if (stream && hasBath == 1) {
         int64_t size = 0;
-        stream.read((char*) &energy, sizeof(energy));
+        stream.read((char*) &run.heatBathEnergy, sizeof(double));
         stream.read((char*) &size, sizeof(size));
         if (stream && size > 0 && size < (1 << 20)) {
             state.resize(size);
@@ -445,13 +473,21 @@ void SymPRKIntegrator::loadCheckpoint(istream& stream) {
         }
         else
             stream.setstate(ios::failbit);
+        if (stream && !version4) {
+            int64_t skipped[2] = {0, 0};
+            stream.read((char*) &run.kineticEnergy, sizeof(double));
+            stream.read((char*) &run.peculiarKineticEnergy, sizeof(double));
+            stream.read((char*) skipped, sizeof(skipped));
+            run.skippedEvents = skipped[0];
+            run.lastSkipped = (skipped[1] != 0);
+        }
     }
     if (!stream || hasBath != (thermostat ? 1 : 0))
         throw OpenMMException("SymPRKIntegrator: the checkpoint is truncated or damaged (its thermostat block)");
     if (thermostat && context != NULL) {
         IntegrateSymPRKStepKernel& k = kernel.getAs<IntegrateSymPRKStepKernel>();
         k.setRandomState(state);
-        k.setHeatBathEnergy(energy);
+        k.setThermostatRunState(run);
     }
     stepsTaken = values[1];
     blowUpStep = values[2];
@@ -479,7 +515,11 @@ void SymPRKIntegrator::deserializeParameters(const SerializationNode& node) {
             throw OpenMMException("SymPRKIntegrator: the State holds a thermostat's heat-bath energy, but this integrator "
                                   "has no thermostat (a State saved by an NVT run, loaded into an NVE one): load it with "
                                   "getIntegratorParameters=False, or into an integrator with temperature=");
-        if (context != NULL)
-            kernel.getAs<IntegrateSymPRKStepKernel>().setHeatBathEnergy(child.getDoubleProperty("heatBathEnergy"));
+        if (context != NULL) {
+            IntegrateSymPRKStepKernel& k = kernel.getAs<IntegrateSymPRKStepKernel>();
+            SymPRKThermostat::RunState run = k.getThermostatRunState();
+            run.heatBathEnergy = child.getDoubleProperty("heatBathEnergy");
+            k.setThermostatRunState(run);
+        }
     }
 }

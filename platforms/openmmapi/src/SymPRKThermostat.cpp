@@ -11,7 +11,7 @@ using namespace SymPRKPlugin;
 using namespace OpenMM;
 using namespace std;
 
-SymPRKThermostat::SymPRKThermostat() : heatBathEnergy(0.0), kineticEnergy(0.0), skippedEvents(0) {
+SymPRKThermostat::SymPRKThermostat() {
 }
 
 void SymPRKThermostat::initialize(int seed) {
@@ -21,9 +21,7 @@ void SymPRKThermostat::initialize(int seed) {
     }
     else
         rng.seed((uint64_t) (uint32_t) seed);
-    heatBathEnergy = 0.0;
-    kineticEnergy = 0.0;
-    skippedEvents = 0;
+    run = RunState();
 }
 
 double SymPRKThermostat::boltzmann() {
@@ -60,19 +58,24 @@ double SymPRKThermostat::rescalingFactor(double kinetic, double target, int dof,
     return alpha;
 }
 
+void SymPRKThermostat::drawNoise(int dof, double& r1, double& chi2) {
+    normal_distribution<double> normal(0.0, 1.0);
+    r1 = normal(rng);
+    chi2 = 0.0;
+    if (dof > 1) {
+        gamma_distribution<double> gamma(0.5*(dof-1), 1.0);
+        chi2 = 2.0*gamma(rng);
+    }
+}
+
 SymPRKThermostat::Event SymPRKThermostat::event(const Sums& sums, double temperature, int dof, bool keepRotation, double c) {
     Event e;
     e.apply = false;
     e.alpha = 1.0;
     e.kinetic = e.newKinetic = 0.0;
     // The noise is drawn first, whatever follows, so that the random stream advances by one event per event.
-    normal_distribution<double> normal(0.0, 1.0);
-    const double r1 = normal(rng);
-    double chi2 = 0.0;
-    if (dof > 1) {
-        gamma_distribution<double> gamma(0.5*(dof-1), 1.0);
-        chi2 = 2.0*gamma(rng);
-    }
+    double r1, chi2;
+    drawNoise(dof, r1, chi2);
     const double M = sums.mass;
     if (!(M > 0))
         return e;
@@ -86,9 +89,12 @@ SymPRKThermostat::Event SymPRKThermostat::event(const Sums& sums, double tempera
     }
     if (!std::isfinite(kinetic) || !std::isfinite(total))
         return e;  // a blown-up state, which the blow-up check reports
-    kineticEnergy = total;
+    run.kineticEnergy = total;
+    run.peculiarKineticEnergy = kinetic;
+    run.lastSkipped = false;
     if (!(kinetic > negligiblePeculiarFraction()*total)) {
-        skippedEvents++;  // at rest or a rigid motion: only round-off to scale
+        run.skippedEvents++;  // at rest or a rigid motion: only round-off to scale
+        run.lastSkipped = true;
         return e;
     }
     const double target = 0.5*dof*BOLTZ*temperature;
@@ -100,7 +106,8 @@ SymPRKThermostat::Event SymPRKThermostat::event(const Sums& sums, double tempera
     e.alpha = alpha;
     e.kinetic = kinetic;
     e.newKinetic = newKinetic;
-    heatBathEnergy -= newKinetic-kinetic;
-    kineticEnergy = total-kinetic+newKinetic;
+    run.heatBathEnergy -= newKinetic-kinetic;
+    run.kineticEnergy = total-kinetic+newKinetic;
+    run.peculiarKineticEnergy = newKinetic;
     return e;
 }

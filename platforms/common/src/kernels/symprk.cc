@@ -387,9 +387,47 @@ KERNEL void symprkRigidApply(GLOBAL const real4* RESTRICT posq, GLOBAL const rea
  * L = sum m r x (v - V).  The noise: the dof standard normals n_k (k < dof) from OpenMM's generator,
  * component k%4 of random[randomIndex + k/4]: r1 = n_0, chi2 = sum_{k=1}^{dof-1} n_k^2.
  * Writes event[] = {apply, alpha, V (3), R (3), w (3)} for symprkThermostatApply and updates
- * state[] = {heat-bath energy, total kinetic energy after the event, skipped events}.
+ * state[] = {heat-bath energy, total kinetic energy after the event, skipped events, 1 if this event was skipped else 0,
+ * peculiar kinetic energy after the event}
+ * (SymPRKThermostat::RunState).
  */
 #define SYMPRK_EVENT_SIZE 11
+
+/**
+ * This thread's share of an event's chi-squared variate: sum of n_k^2 for 1 <= k < dof over the event's standard
+ * normals n_k, component k%4 of random[randomIndex + k/4] (n_0 is the event's r1).
+ */
+inline DEVICE symprk_acc symprkNoiseSquares(GLOBAL const float4* RESTRICT random, int randomIndex, int dof) {
+    symprk_acc sum = 0;
+    const int numRandom = (dof+3)/4;
+    for (int j = LOCAL_ID; j < numRandom; j += WORK_GROUP_SIZE) {
+        const float4 r = random[randomIndex+j];
+        const float n[4] = {r.x, r.y, r.z, r.w};
+        for (int q = 0; q < 4; q++) {
+            const int k = 4*j+q;
+            if (k >= 1 && k < dof)
+                sum += (symprk_acc) n[q]*(symprk_acc) n[q];
+        }
+    }
+    return sum;
+}
+
+/**
+ * The noise of one event as symprkThermostatEvent draws it (the same numbers, the same sums in the same order), for
+ * tests of the random numbers: out[2*sample] = r1, out[2*sample+1] = chi2.  One block of WORK_GROUP_SIZE threads.
+ */
+KERNEL void symprkThermostatNoise(GLOBAL const float4* RESTRICT random, int randomIndex, int dof, GLOBAL symprk_acc* RESTRICT out,
+        int sample) {
+    LOCAL symprk_acc partial[WORK_GROUP_SIZE];
+    LOCAL symprk_acc total[1];
+    symprk_acc s[1];
+    s[0] = symprkNoiseSquares(random, randomIndex, dof);
+    symprkBlockSums(s, 1, partial, total);
+    if (LOCAL_ID == 0) {
+        out[2*sample] = (symprk_acc) random[randomIndex].x;
+        out[2*sample+1] = total[0];
+    }
+}
 
 KERNEL void symprkThermostatEvent(GLOBAL const real4* RESTRICT posq, GLOBAL const real4* RESTRICT posqCorrection,
         GLOBAL const mixed4* RESTRICT velm, int withPositions, GLOBAL const float4* RESTRICT random, int randomIndex, int dof,
@@ -417,16 +455,7 @@ KERNEL void symprkThermostatEvent(GLOBAL const real4* RESTRICT posq, GLOBAL cons
             s[7] += m*(vx*vx+vy*vy+vz*vz);
         }
     }
-    const int numRandom = (dof+3)/4;
-    for (int j = tid; j < numRandom; j += WORK_GROUP_SIZE) {
-        const float4 r = random[randomIndex+j];
-        const float n[4] = {r.x, r.y, r.z, r.w};
-        for (int q = 0; q < 4; q++) {
-            const int k = 4*j+q;
-            if (k >= 1 && k < dof)
-                s[8] += (symprk_acc) n[q]*(symprk_acc) n[q];
-        }
-    }
+    s[8] = symprkNoiseSquares(random, randomIndex, dof);
     symprkBlockSums(s, 9, partial, total);
     const symprk_acc M = total[0];
     const symprk_acc invM = (M == 0 ? (symprk_acc) 0 : 1/M);
@@ -473,8 +502,12 @@ KERNEL void symprkThermostatEvent(GLOBAL const real4* RESTRICT posq, GLOBAL cons
         }
         if (M > 0 && isfinite(kinetic) && isfinite(totalKinetic)) {
             state[1] = totalKinetic;
-            if (!(kinetic > (symprk_acc) 1e-10*totalKinetic))
+            state[3] = 0;
+            state[4] = kinetic;
+            if (!(kinetic > (symprk_acc) 1e-10*totalKinetic)) {
                 state[2] += 1;  // at rest or a rigid motion: only round-off to scale
+                state[3] = 1;
+            }
             else {
                 // SymPRKThermostat::rescalingFactor
                 const symprk_acc r1 = (symprk_acc) random[randomIndex].x;
@@ -487,6 +520,7 @@ KERNEL void symprkThermostatEvent(GLOBAL const real4* RESTRICT posq, GLOBAL cons
                     apply = 1;
                     state[0] -= knew-kinetic;
                     state[1] = totalKinetic-kinetic+knew;
+                    state[4] = knew;
                 }
                 else
                     alpha = 1;

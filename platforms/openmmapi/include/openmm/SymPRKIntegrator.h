@@ -43,6 +43,7 @@
 #include "openmm/Integrator.h"
 #include "openmm/Kernel.h"
 #include "openmm/internal/SymPRKStepPlan.h"
+#include "openmm/internal/SymPRKThermostat.h"
 #include "openmm/internal/windowsExportSymPRK.h"
 #include <string>
 #include <vector>
@@ -206,10 +207,18 @@ public:
      */
     double getThermostatKineticEnergy() const;
     /**
+     * The peculiar kinetic energy (kJ/mol) just after the last thermostat event: K' of the event (the motion it may
+     * rescale, without the kept centre-of-mass motion and rotation), whose 2 K' / (dof k_B) is the thermostat's
+     * temperature.  0 before the first event.
+     */
+    double getThermostatPeculiarKineticEnergy() const;
+    /**
      * Thermostat events that changed nothing because the peculiar kinetic energy was at most 1e-10 of the total
      * (a System at rest, or moving only as a rigid whole: velocity rescaling has nothing to scale), since bound.
      */
     long long getSkippedThermostatEvents() const;
+    /** Whether the last thermostat event changed nothing for want of peculiar kinetic energy (false before the first). */
+    bool getLastThermostatEventSkipped() const;
     /**
      * Host-device transfers (downloads and uploads) this integrator's kernel has made since bound: 0 on
      * Reference/CPU; on the Common platforms a step makes none (reading the blow-up record, the heat-bath energy
@@ -217,6 +226,14 @@ public:
      * counted.
      */
     long long getHostTransfers() const;
+    /**
+     * For tests of the thermostat's random numbers: the noise of `count` events (r1 ~ N(0,1), chi2 ~ chi^2(dof-1)
+     * with this integrator's degrees of freedom; 2*count values, r1 and chi2 of each event in turn), drawn by the bound
+     * Context's kernel exactly as its events draw it and from the same stream, which it advances (Reference/CPU: the
+     * host generator of the checkpoints; OpenCL/CUDA: the platform's device generator, one block of numbers per event).
+     * Throws without a thermostat or when not bound.
+     */
+    std::vector<double> sampleThermostatNoise(int count);
     /**
      * (alpha, K'): the rescaling factor and the new peculiar kinetic energy for a peculiar kinetic energy
      * `kinetic` (kJ/mol), a target dof*kT/2, c = exp(-t/tau), a standard normal r1 and a chi-squared variable
@@ -271,6 +288,8 @@ protected:
     void deserializeParameters(const OpenMM::SerializationNode& node);
 
 private:
+    /** The thermostat's run-time state in the bound Context's kernel (all zero when not bound or without a thermostat). */
+    SymPRKThermostat::RunState thermostatRunState() const;
     /** index, after checking that it names a sub-step. */
     int substep(int index) const;
     /** The plan for the bound Context, made again if the integration force groups have changed. */

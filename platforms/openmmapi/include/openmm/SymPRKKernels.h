@@ -78,18 +78,12 @@ public:
     virtual void initializeThermostat(int seed) {
         thermostat.initialize(seed);
     }
-    virtual double getHeatBathEnergy() {
-        return thermostat.getHeatBathEnergy();
+    /** The heat-bath energy, the kinetic energy after the last event and the skipped events (SymPRKThermostat::RunState). */
+    virtual SymPRKThermostat::RunState getThermostatRunState() {
+        return thermostat.getRunState();
     }
-    virtual void setHeatBathEnergy(double energy) {
-        thermostat.setHeatBathEnergy(energy);
-    }
-    /** The total kinetic energy just after the last event (0 before the first). */
-    virtual double getThermostatKineticEnergy() {
-        return thermostat.getKineticEnergy();
-    }
-    virtual long long getSkippedThermostatEvents() {
-        return thermostat.getSkippedEvents();
+    virtual void setThermostatRunState(const SymPRKThermostat::RunState& state) {
+        thermostat.setRunState(state);
     }
     /** The random state a checkpoint of the integrator carries (text), and back. */
     virtual std::string getRandomState() {
@@ -97,6 +91,17 @@ public:
     }
     virtual void setRandomState(const std::string& state) {
         thermostat.setRandomState(state);
+    }
+    /**
+     * The noise of `count` thermostat events of `dof` degrees of freedom, drawn as the events draw it and from the
+     * stream they use (which it advances): r1, chi2 for each, 2*count values.  The host default is
+     * SymPRKThermostat::drawNoise; a kernel whose events draw on the device draws these there, event by event.
+     */
+    virtual std::vector<double> sampleThermostatNoise(OpenMM::ContextImpl& context, int dof, int count) {
+        std::vector<double> values(2*(size_t) count);
+        for (int i = 0; i < count; i++)
+            thermostat.drawNoise(dof, values[2*i], values[2*i+1]);
+        return values;
     }
     /** Host-device transfers the kernel has made (0 where the data is on the host). */
     virtual long long getHostTransfers() {

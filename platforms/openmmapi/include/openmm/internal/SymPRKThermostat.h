@@ -40,6 +40,17 @@ public:
         OpenMM::Vec3 velocity, centre, omega;  // omega = 0 unless the rotation is kept
         double kinetic, newKinetic;    // peculiar kinetic energy before and after (kJ/mol)
     };
+    /**
+     * What an event leaves behind for the integrator to report, per Context (kept in checkpoints): the heat-bath
+     * energy (kJ/mol, minus the kinetic energy the events added), the total and the peculiar kinetic energy just after
+     * the last event (0 before the first; the peculiar one is what the thermostat's temperature is made of), the events
+     * skipped for want of peculiar kinetic energy, and whether the last event was one.
+     */
+    struct RunState {
+        double heatBathEnergy = 0.0, kineticEnergy = 0.0, peculiarKineticEnergy = 0.0;
+        long long skippedEvents = 0;
+        bool lastSkipped = false;
+    };
     /** The fraction of the total kinetic energy at or below which the peculiar part counts as none (round-off). */
     static double negligiblePeculiarFraction() {
         return 1e-10;
@@ -55,18 +66,16 @@ public:
      * skipped (the noise is drawn all the same: one draw per event).
      */
     Event event(const Sums& sums, double temperature, int dof, bool keepRotation, double c);
-    double getHeatBathEnergy() const {
-        return heatBathEnergy;
+    /**
+     * The noise of one event, as event() draws it: r1 ~ N(0,1), then chi2 ~ chi^2(dof-1) (0 for dof = 1), from the
+     * generator in that order (a fresh distribution per call, so the generator's state is the whole random state).
+     */
+    void drawNoise(int dof, double& r1, double& chi2);
+    const RunState& getRunState() const {
+        return run;
     }
-    void setHeatBathEnergy(double energy) {
-        heatBathEnergy = energy;
-    }
-    /** The total kinetic energy just after the last event (0 before the first). */
-    double getKineticEnergy() const {
-        return kineticEnergy;
-    }
-    long long getSkippedEvents() const {
-        return skippedEvents;
+    void setRunState(const RunState& state) {
+        run = state;
     }
     /** The generator's state as text (std::mt19937_64's operator<<), and back. */
     std::string getRandomState() const;
@@ -80,8 +89,7 @@ public:
     static double boltzmann();
 private:
     std::mt19937_64 rng;
-    double heatBathEnergy, kineticEnergy;
-    long long skippedEvents;
+    RunState run;
 };
 
 } // namespace SymPRKPlugin

@@ -1,0 +1,150 @@
+"""``symprk nvt known``: the thermostat's known answers on this installation, per backend and platform.
+
+1. The noise each event draws (:func:`openmm_symprk.integrators.noise.sample_thermostat_noise`): r1 ~ N(0, 1) and
+   chi2 ~ chi^2(N_f - 1) for N_f - 1 = 20, 600, 3000, as z-scores of their means and variances against the exact
+   values, and the relative standard error of E[chi2] the draws resolve.
+2. The stationary state of N independent 3-d harmonic oscillators under Verlet with the thermostat at the ends or in
+   the middle (h w = 0.5): k<q^2>/kT and the kinetic temperature at the thermostat point, in units of the target,
+   against the exact values (ends: 1/(1 - h^2 w^2/4) and 1; middle: 1 and 1).
+
+The test-suite asserts the same numbers (tests/integrators/test_thermostat_known_answers.py).
+"""
+from __future__ import annotations
+
+import math
+import warnings
+from dataclasses import dataclass
+
+import numpy as np
+import openmm as mm
+import openmm.unit as unit
+
+from ...integrators.noise import sample_thermostat_noise
+from ...physics.temperature import R_KJ
+from ...stats import SeriesStats, series_stats
+
+__all__ = ["OSCILLATORS", "harmonic_oscillators", "stationary_temperatures", "exact_temperatures", "noise_draws",
+           "run"]
+
+#: the oscillators' case: count, temperature (K), step (ps), h w, collision time (ps; c = exp(-h/tau) = 0.018, so the
+#: kinetic energy at the thermostat point is nearly fresh every step)
+OSCILLATORS = dict(n=1000, temperature=300.0, step=0.002, h_omega=0.5, collision_time=0.0005)
+
+
+def harmonic_oscillators(n: int, k: float, temperature: float, seed: int = 2024):
+    """(System, x, v): ``n`` oscillators of mass 1 Da and force constant ``k`` (kJ/mol/nm^2) about the origin,
+    canonical positions and velocities at ``temperature`` with the centre of mass at rest at the origin, where it
+    stays (the thermostat keeps its velocity; the 3 n - 3 other degrees of freedom are the thermostatted ones)."""
+    system = mm.System()
+    force = mm.CustomExternalForce("0.5*k*(x*x + y*y + z*z)")
+    force.addGlobalParameter("k", k)
+    for i in range(n):
+        system.addParticle(1.0)
+        force.addParticle(i, [])
+    system.addForce(force)
+    rng = np.random.default_rng(seed)
+    kT = R_KJ * temperature
+    x = rng.normal(0.0, math.sqrt(kT / k), (n, 3))
+    v = rng.normal(0.0, math.sqrt(kT), (n, 3))
+    return system, x - x.mean(0), v - v.mean(0)
+
+
+def exact_temperatures(position: str, h_omega: float = OSCILLATORS["h_omega"]) -> tuple:
+    """(k<q^2>/kT, kinetic temperature at the thermostat point / T) of Verlet with the thermostat at ``position``."""
+    return (1 / (1 - h_omega ** 2 / 4) if position == "ends" else 1.0), 1.0
+
+
+@dataclass(frozen=True)
+class Stationary:
+    backend: str
+    platform: str
+    position: str
+    configurational: SeriesStats  # k<q^2> / ((3N - 3) kT)
+    kinetic: SeriesStats  # 2 K at the thermostat point / ((3N - 3) kT)
+
+
+def stationary_temperatures(backend: str, platform: str, position: str, samples: int, seed: int = 17,
+                            properties: dict | None = None) -> Stationary:
+    """The oscillators of :data:`OSCILLATORS` after 300 steps, sampled every step ``samples`` times."""
+    from ...integrators import SymplecticIntegrator
+    from ...systems.checks import ConservationWarning
+
+    case = OSCILLATORS
+    k = (case["h_omega"] / case["step"]) ** 2
+    system, x, v = harmonic_oscillators(case["n"], k, case["temperature"])
+    with warnings.catch_warnings():  # (the oscillators' external field breaks momentum conservation: known)
+        warnings.simplefilter("ignore", ConservationWarning)
+        ig = SymplecticIntegrator(case["step"], "verlet", system=system, backend=backend,
+                                  temperature=case["temperature"], collision_time=case["collision_time"],
+                                  random_seed=seed, thermostat_position=position)
+    ctx = mm.Context(system, ig, mm.Platform.getPlatformByName(platform), dict(properties or {}))
+    ctx.setPositions(x)
+    ctx.setVelocities(v)
+    ig.step(300)
+    dof_kT = (3 * case["n"] - 3) * R_KJ * case["temperature"]
+    q, kin = np.empty(samples), np.empty(samples)
+    kj = unit.kilojoule_per_mole
+    for i in range(samples):
+        ig.step(1)
+        q[i] = 2 * ctx.getState(getEnergy=True).getPotentialEnergy().value_in_unit(kj) / dof_kT
+        kin[i] = 2 * ig.thermostat_kinetic_energy().value_in_unit(kj) / dof_kT
+    del ctx
+    return Stationary(backend, platform, position, series_stats(q), series_stats(kin))
+
+
+def noise_draws(k: int, resolution: float = 0.0005) -> int:
+    """Events whose chi2 of ``k`` degrees of freedom resolves E[chi2] to ``resolution`` (one relative standard error)."""
+    return math.ceil(2.0 / (k * resolution ** 2))
+
+
+def _platforms() -> list:
+    return [mm.Platform.getPlatform(i).getName() for i in range(mm.Platform.getNumPlatforms())]
+
+
+def run(quick: bool = False, platforms=None, log=print) -> dict:
+    """Print both tables and return them as {"noise": [...], "oscillators": [...]} (plain numbers)."""
+    from ... import plugin
+
+    platforms = [p for p in (platforms or ["Reference", "CPU", "OpenCL"]) if p in _platforms()]
+    native = set(plugin.platforms()) if plugin.available() else set()
+    double = {"OpenCL": {"Precision": "double"}, "CUDA": {"Precision": "double"}}
+    out = {"noise": [], "oscillators": []}
+    log("The noise of a thermostat event: z-scores against the exact moments (|z| < 3 expected), and the relative "
+        "standard error of E[chi2]")
+    log(f"{'backend':8s} {'platform':10s} {'N_f-1':>6s} {'events':>8s} {'E[chi2]':>8s} {'Var':>6s} {'E[r1]':>6s} "
+        f"{'Var':>6s} {'corr':>6s} {'lag1':>6s} {'resolves':>9s}")
+    for backend in ("native", "custom"):
+        for platform in platforms:
+            if backend == "native" and platform not in native:
+                continue
+            for k in (20, 600, 3000):
+                n = noise_draws(k, 0.002 if quick else 0.0005)
+                if backend == "custom" and platform in ("OpenCL", "CUDA"):
+                    n = min(n, 40_000)  # a CustomIntegrator loop pass per event on the device: ~0.1 ms
+                s = sample_thermostat_noise(backend, k + 1, n, platform, seed=11 + k, properties=double.get(platform))
+                row = dict(backend=backend, platform=platform, k=k, events=n, chi2_mean_z=s.chi2.mean_z(k),
+                           chi2_var_z=s.chi2.variance_z(2 * k), r1_mean_z=s.r1.mean_z(0.0),
+                           r1_var_z=s.r1.variance_z(1.0), corr_z=s.r1_chi2 * math.sqrt(n),
+                           lag_z=s.chi2_lag1 * math.sqrt(n), resolution=s.chi2.mean_se / k)
+                out["noise"].append(row)
+                log(f"{backend:8s} {platform:10s} {k:6d} {n:8d} {row['chi2_mean_z']:+8.2f} {row['chi2_var_z']:+6.2f} "
+                    f"{row['r1_mean_z']:+6.2f} {row['r1_var_z']:+6.2f} {row['corr_z']:+6.2f} {row['lag_z']:+6.2f} "
+                    f"{100 * row['resolution']:8.3f}%")
+    samples = 2000 if quick else 16_000
+    case = OSCILLATORS
+    log(f"\n{case['n']} harmonic oscillators, verlet, h w = {case['h_omega']}, tau = {case['collision_time']} ps, "
+        f"{samples} steps: temperatures in units of the target (mean ± standard error; exact in brackets)")
+    log(f"{'backend':8s} {'platform':10s} {'position':8s} {'k<q^2>/kT':>22s} {'T at the thermostat':>22s}")
+    for backend, platform in (("custom", "Reference"), ("native", "Reference"), ("native", "OpenCL")):
+        if platform not in platforms or (backend == "native" and platform not in native):
+            continue
+        for position in ("ends", "middle"):
+            st = stationary_temperatures(backend, platform, position, samples, properties=double.get(platform))
+            exact = exact_temperatures(position)
+            out["oscillators"].append(dict(backend=backend, platform=platform, position=position,
+                                           q=st.configurational.mean, q_se=st.configurational.se, q_exact=exact[0],
+                                           kinetic=st.kinetic.mean, kinetic_se=st.kinetic.se))
+            log(f"{backend:8s} {platform:10s} {position:8s} "
+                f"{st.configurational.mean:.5f} ± {st.configurational.se:.5f} [{exact[0]:.4f}] "
+                f"{st.kinetic.mean:.5f} ± {st.kinetic.se:.5f} [{exact[1]:.4f}]")
+    return out
