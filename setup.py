@@ -232,7 +232,8 @@ def build_native(target: str, build_dir: str, log=print, requirements=None) -> d
     _configure(cmake, build_dir, sdk, omm_version)
     with open(os.path.join(build_dir, "_build_info.json")) as fh:
         info = json.load(fh)
-    jobs = ["--parallel", str(os.cpu_count() or 1)]
+    # CMake's own variable, where set, caps the jobs (a shared machine); else one job per core
+    jobs = ["--parallel", os.environ.get("CMAKE_BUILD_PARALLEL_LEVEL", "").strip() or str(os.cpu_count() or 1)]
     _run([cmake, "--build", build_dir, "--target", *CORE_TARGETS, *jobs], "building the native plugin")
     for platform in list(info["libraries"]):
         if platform in OPTIONAL_TARGETS:

@@ -19,8 +19,10 @@ C++17 compiler, and PyPI (or pip's cache) for the build requirements.  Linux onl
    read from the wheel's own ELF files (every libOpenMM* a binary needs that the wheel does not hold);
 4. checks the result and stops with a message if a check fails: the manylinux tag, nothing of OpenMM inside, the
    wheel's openmm requirement pinned to the minor series the plugin was compiled against, every required kernel
-   library present; then writes ``auditwheel show``'s report (auditwheel-show.txt) and release.json (what was
-   built, from which commit, the tag, the exclusions, the timings) into OUT.
+   library present, ``auditwheel show`` finding no external library but the OpenMM ones excluded (it calls the
+   wheel "linux_x86_64" overall for that reason: OpenMM's libraries are in no manylinux policy) and the tag its
+   symbol versions allow; then writes ``auditwheel show``'s report (auditwheel-show.txt) and release.json (what
+   was built, from which commit, the tag, the exclusions, the symbol versions, the timings) into OUT.
 
 OUT receives the sdist, the repaired wheel, and the wheel as built from the sdist before the repair (OUT/raw/).
 How a release is made from these, and what is and is not tested: docs/native.md, "Release".
@@ -29,6 +31,7 @@ from __future__ import annotations
 
 import argparse
 import email.parser
+import io
 import json
 import os
 import re
@@ -67,7 +70,6 @@ def tool_env() -> dict:
 
 def elf_needs(data: bytes) -> list:
     """The DT_NEEDED names of an ELF file's dynamic section (empty for anything that is not ELF)."""
-    import io
 
     from elftools.common.exceptions import ELFError
     from elftools.elf.dynamic import DynamicSection
@@ -212,6 +214,15 @@ def build_release(source: str, ref: str, out: str, require: str, plat: str | Non
     show = run([sys.executable, "-m", "auditwheel", "show", wheel], "auditwheel show", env=env)
     with open(os.path.join(out, "auditwheel-show.txt"), "w") as fh:
         fh.write(show)
+    # auditwheel show calls the wheel "linux" overall, since libraries outside every manylinux policy (OpenMM's) stay
+    # external: it must be those excluded, unresolved, and nothing else; the symbol versions give the wheel's tag
+    audit = json.loads(run([sys.executable, "-m", "auditwheel", "show", "--json", wheel], "auditwheel show --json",
+                           env=env))
+    if sorted(audit["external_libs"]) != excluded:
+        raise ReleaseError(f"auditwheel show finds the external libraries {sorted(audit['external_libs'])}, not the "
+                           f"OpenMM libraries excluded ({excluded})")
+    if audit["sym_tag"] != tag.split("-")[-1]:
+        raise ReleaseError(f"auditwheel show's symbol tag {audit['sym_tag']} is not the wheel's tag {tag}")
     report = {
         "version": metadata(after)["Version"],
         "commit": commit,
@@ -221,6 +232,8 @@ def build_release(source: str, ref: str, out: str, require: str, plat: str | Non
         "tag": tag,
         "excluded": excluded,
         "grafted": grafted,
+        "auditwheel": {key: audit[key] for key in ("overall_tag", "sym_tag", "versioned_symbols")}
+        | {"external_libs": sorted(audit["external_libs"])},
         "openmm_built": info["openmm_version"],
         "openmm_requirement": requirement,
         "kernels": sorted(k for k in info["libraries"] if k != "api"),
