@@ -1,6 +1,7 @@
 """What a user installs: the sdist, the wheel built from it, and the release wheel (tools/build_release_wheel.py).
 
-One release build serves the module (about 100 s on 2 cores; the whole module takes about 4-5 minutes): the script
+One release build serves the module (about 50 s on this project's 2 cores with pip's cache warm, the module about
+90 s; more where pip must first download the build requirements, openmm and NVIDIA's headers): the script
 clones this repository at HEAD (committed work only), builds the sdist and the wheel from the unpacked sdist in
 isolated environments with SYMPRK_REQUIRE_NATIVE_BUILD naming every kernel library, and repairs the wheel with
 auditwheel, OpenMM's libraries excluded.  Then:
