@@ -1,12 +1,17 @@
-"""Packaging for openmm_symprk: `pip install .` (extras: see EXTRAS below; `[test]` for the test-suite).
+"""The native build of openmm_symprk: ``build_ext`` compiles the OpenMM plugin with CMake (platforms/CMakeLists.txt).
 
-The build also compiles the native OpenMM plugin with CMake (platforms/CMakeLists.txt) against the openmm of
-the build environment (pyproject.toml pins it to the runtime's minor series).  The CMake build folder,
-build/native-<python>-<platform>/, persists between installs, so that an editable reinstall recompiles only
-what changed; its tests/ folder holds the C++ tests (tests/plugin/test_cpp.py runs them).  If the native
-build fails for any reason the package still installs and works through the CustomIntegrator backend: the
-build prints a warning and writes the reason to openmm_symprk/plugin/_build_error.txt, which
+The project's metadata (name, version, dependencies, extras, the ``symprk`` command) is in pyproject.toml; this file
+holds only what the native build needs.  The plugin is compiled against the openmm of the build environment
+(pyproject.toml pins it to the runtime dependency's minor series, and the build refuses an openmm outside that pin).
+The CMake build folder, build/native-<python>-<platform>/, persists between installs, so that an editable reinstall
+recompiles only what changed; its tests/ folder holds the C++ tests (tests/plugin/test_build.py runs them).
+
+If the native build fails for any reason the package still installs and works through the CustomIntegrator backend:
+the build prints a warning and writes the reason to openmm_symprk/plugin/_build_error.txt, which
 openmm_symprk.plugin.unavailable_reason() reports.  SYMPRK_NATIVE=0 skips the native build.
+SYMPRK_REQUIRE_NATIVE_BUILD turns a failed build into an error instead (CI and release builds set it): ``1`` requires
+the plugin (the API, the Reference kernel that also serves CPU, the SWIG module); a comma-separated list of kernel
+libraries (e.g. ``Reference,OpenCL,CUDA``) requires those kernels as well.
 """
 import filecmp
 import json
@@ -19,8 +24,9 @@ import sysconfig
 import time
 import traceback
 
-from setuptools import Distribution, find_packages, setup
+from setuptools import Distribution, setup
 from setuptools.command.build_ext import build_ext
+from setuptools.errors import ExecError
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 PLATFORMS = os.path.join(HERE, "platforms")
@@ -36,13 +42,9 @@ class NativeBuildError(RuntimeError):
     """The native plugin cannot be built here (the message says why)."""
 
 
-def version() -> str:
-    """The package's version, from openmm_symprk/__init__.py (its only definition)."""
-    with open(os.path.join(HERE, "openmm_symprk", "__init__.py"), encoding="utf-8") as fh:
-        match = re.search(r'^__version__\s*=\s*["\']([^"\']+)["\']', fh.read(), re.M)
-    if match is None:
-        raise RuntimeError("openmm_symprk/__init__.py defines no __version__")
-    return match.group(1)
+#: The environment variable that makes a failed native build an error (see the module's docstring).
+REQUIRE_VARIABLE = "SYMPRK_REQUIRE_NATIVE_BUILD"
+
 
 
 def build_directory() -> str:
@@ -61,6 +63,11 @@ def _run(cmd, what):
         out = res.stdout[-6000:]
         if "No CMAKE_CXX_COMPILER could be found" in out or "is not a full path to an existing compiler" in out:
             raise NativeBuildError("no C++ compiler: CMake found none (install g++ or clang++, or set CXX)\n" + out)
+        broken = re.search(r'The C\+\+ compiler\s+"([^"]+)"\s+is not able to compile a simple test program', out)
+        if broken:
+            raise NativeBuildError(f"no C++ compiler that works: {broken.group(1)} (CXX={os.environ.get('CXX', '')!r}) "
+                                   "did not compile CMake's test program (install g++ or clang++, or set CXX to "
+                                   "one)\n" + out)
         raise NativeBuildError(f"{what} failed:\n{' '.join(cmd)}\n{out}")
     return res.stdout
 
@@ -169,11 +176,47 @@ def _configure(cmake: str, build_dir: str, sdk: str, omm_version: str) -> None:
     _run(cmd + _header_dirs(build_dir), "configuring the native plugin (CMake)")
 
 
-def build_native(target: str, build_dir: str, log=print) -> dict:
+def _release(version: str) -> tuple:
+    """(major, minor, patch) at the start of an openmm version string such as "8.6.1.dev-b399af4"."""
+    match = re.match(r"(\d+)\.(\d+)(?:\.(\d+))?", version)
+    if match is None:
+        raise NativeBuildError(f"cannot read openmm's version {version!r}")
+    return tuple(int(g or 0) for g in match.groups())
+
+
+def check_openmm_pin(omm_version: str, requirements) -> None:
+    """Refuse to build against an openmm outside the minor series that the package's runtime dependency pins.
+
+    ``requirements`` are the package's dependencies (pyproject.toml's ``dependencies``).  The plugin links OpenMM's C++
+    library, whose ABI holds within a minor series only, so the installed package must require exactly the series it
+    was compiled against: the pin must admit ``omm_version`` and neither the next nor the previous minor series."""
+    try:
+        from packaging.requirements import Requirement
+        from packaging.version import Version
+    except ImportError:  # setuptools >= 71 makes its vendored copy importable; an older build environment skips this
+        return
+    pins = [Requirement(r) for r in requirements or []]
+    pins = [r for r in pins if r.name.lower() == "openmm"]
+    if not pins:
+        return
+    major, minor, patch = _release(omm_version)
+    spec = pins[0].specifier
+    neighbours = [f"{major}.{minor + 1}.0", f"{major}.{minor - 1}.9999" if minor else f"{major - 1}.9999"]
+    if not spec.contains(Version(f"{major}.{minor}.{patch}"), prereleases=True) or \
+            any(spec.contains(Version(v), prereleases=True) for v in neighbours):
+        raise NativeBuildError(
+            f"the build environment's openmm is {omm_version}, but the package requires openmm{spec} at run time: a "
+            f"plugin compiled against one openmm minor series loads only in that series, so the two must name the "
+            f"same one (pyproject.toml: the openmm build requirement and the dependency; see docs/native.md, Release)")
+
+
+def build_native(target: str, build_dir: str, log=print, requirements=None) -> dict:
     """Configure and build the plugin in ``build_dir`` and install it into ``target`` (openmm_symprk/plugin).
 
     The API, Reference and SWIG parts must build; a platform kernel (OpenCL, CUDA) that does not is left out,
-    with the reason in _build_info.json.  Raises NativeBuildError with the reason when nothing usable was built."""
+    with the reason in _build_info.json.  ``requirements``: the package's runtime dependencies, whose openmm pin
+    must be the build's openmm minor series (:func:`check_openmm_pin`).  Raises NativeBuildError with the reason
+    when nothing usable was built."""
     if _disabled():
         raise NativeBuildError("SYMPRK_NATIVE=0: native build disabled by the environment")
     cxx = os.environ.get("CXX")
@@ -185,10 +228,12 @@ def build_native(target: str, build_dir: str, log=print) -> dict:
     t0 = time.time()
     os.makedirs(build_dir, exist_ok=True)
     sdk, omm_version = _openmm_sdk(build_dir)
+    check_openmm_pin(omm_version, requirements)
     _configure(cmake, build_dir, sdk, omm_version)
     with open(os.path.join(build_dir, "_build_info.json")) as fh:
         info = json.load(fh)
-    jobs = ["--parallel", str(os.cpu_count() or 1)]
+    # CMake's own variable, where set, caps the jobs (a shared machine); else one job per core
+    jobs = ["--parallel", os.environ.get("CMAKE_BUILD_PARALLEL_LEVEL", "").strip() or str(os.cpu_count() or 1)]
     _run([cmake, "--build", build_dir, "--target", *CORE_TARGETS, *jobs], "building the native plugin")
     for platform in list(info["libraries"]):
         if platform in OPTIONAL_TARGETS:
@@ -199,7 +244,7 @@ def build_native(target: str, build_dir: str, log=print) -> dict:
                 info["libraries"].pop(platform)
                 info["skipped"][platform] = str(exc).splitlines()[0] + " (see the build log: pip install -v)"
                 log(f"openmm_symprk native: {platform} kernel left out: {exc}")
-    try:  # the C++ tests stay in the build folder (tests/plugin/test_cpp.py runs them)
+    try:  # the C++ tests stay in the build folder (tests/plugin/test_build.py runs them)
         _run([cmake, "--build", build_dir, "--target", *TEST_TARGETS, *jobs], "building the C++ tests")
     except NativeBuildError as exc:
         log(f"openmm_symprk native: the C++ tests did not build: {exc}")
@@ -228,30 +273,68 @@ def clean(target: str) -> None:
         shutil.rmtree(os.path.join(target, "lib"))
 
 
-def build_or_warn(target: str, build_dir: str, log=print) -> bool:
-    """build_native, turning any failure into a warning and openmm_symprk/plugin/_build_error.txt."""
+def required_kernels() -> list | None:
+    """What $SYMPRK_REQUIRE_NATIVE_BUILD requires: None (nothing: a failed build is a warning), [] (the plugin: API,
+    Reference kernel, SWIG module) or the kernel libraries named (e.g. ["Reference", "OpenCL", "CUDA"])."""
+    value = os.environ.get(REQUIRE_VARIABLE, "").strip()
+    if value.lower() in ("", "0", "no", "off", "false"):
+        return None
+    if value.lower() in ("1", "yes", "on", "true"):
+        return []
+    names = [v.strip() for v in value.split(",") if v.strip()]
+    known = ["Reference", *OPTIONAL_TARGETS]
+    unknown = [n for n in names if n not in known]
+    if unknown:
+        raise NativeBuildError(f"{REQUIRE_VARIABLE}={value!r} names {', '.join(unknown)}: it takes 1 (the plugin) "
+                               f"or kernel libraries among {', '.join(known)}")
+    return names
+
+
+def build_or_warn(target: str, build_dir: str, log=print, requirements=None) -> bool:
+    """build_native, turning any failure into a warning and openmm_symprk/plugin/_build_error.txt.
+
+    Where $SYMPRK_REQUIRE_NATIVE_BUILD asks for the plugin (see :func:`required_kernels`), a failure, or a required
+    kernel library left out, raises NativeBuildError instead, with the reason and the variable named."""
     os.makedirs(target, exist_ok=True)
+    required = required_kernels()
     try:
-        build_native(target, build_dir, log)
-        return True
+        info = build_native(target, build_dir, log, requirements)
     except Exception as exc:  # noqa: BLE001 - any failure must leave the pure-Python install working
         reason = str(exc) if isinstance(exc, NativeBuildError) else traceback.format_exc()
         clean(target)
         with open(os.path.join(target, "_build_error.txt"), "w") as fh:
             fh.write(reason)
         bar = "=" * 78
+        if required is not None:
+            sys.stderr.write(f"\n{bar}\nERROR: openmm_symprk's native plugin was not built, and "
+                             f"{REQUIRE_VARIABLE}={os.environ[REQUIRE_VARIABLE]} requires it.\n"
+                             f"Reason: {reason.strip()}\n{bar}\n\n")
+            raise NativeBuildError(f"openmm_symprk's native plugin was not built, and {REQUIRE_VARIABLE}="
+                                   f"{os.environ[REQUIRE_VARIABLE]} requires it: {reason.strip().splitlines()[0]} "
+                                   f"(unset {REQUIRE_VARIABLE} to install without it)") from exc
         sys.stderr.write(f"\n{bar}\nWARNING: openmm_symprk's native plugin was not built; the package installs "
                          f"and works\nthrough the CustomIntegrator backend only.\nReason: {reason.strip()}\n{bar}\n\n")
         return False
+    missing = [k for k in required or [] if k not in info["libraries"]]
+    if missing:
+        why = "; ".join(f"{k}: {info['skipped'].get(k, 'not configured')}" for k in missing)
+        raise NativeBuildError(f"openmm_symprk's {', '.join(missing)} kernel library was left out of the native build, "
+                               f"and {REQUIRE_VARIABLE}={os.environ[REQUIRE_VARIABLE]} requires it ({why})")
+    return True
 
 
 class BuildNative(build_ext):
-    """Build the native plugin into the package (in place for editable installs); never fail the install."""
+    """Build the native plugin into the package (in place for editable installs); a failure leaves the install
+    working (a warning), unless $SYMPRK_REQUIRE_NATIVE_BUILD makes it an error."""
 
     def run(self):
         inplace = bool(self.inplace or getattr(self, "editable_mode", False))
         target = os.path.join(HERE if inplace else self.build_lib, "openmm_symprk", "plugin")
-        build_or_warn(target, build_directory(), log=lambda msg: sys.stderr.write(msg + "\n"))
+        try:
+            build_or_warn(target, build_directory(), log=lambda msg: sys.stderr.write(msg + "\n"),
+                          requirements=self.distribution.install_requires)
+        except NativeBuildError as exc:  # setuptools prints "error: <message>", no traceback, and the build fails
+            raise ExecError(str(exc)) from exc
 
     def get_outputs(self):
         return []
@@ -264,42 +347,5 @@ class BinaryDistribution(Distribution):
         return True
 
 
-#: Optional dependencies by use; the core (integrators, methods, rigid bodies, diagnostics, `symprk demo`) needs
-#: only openmm, numpy and scipy.  The package names the extra in its error when a missing one is used.
-EXTRAS = {
-    "analysis": ["MDAnalysis>=2.7", "scipy>=1.10", "tqdm>=4.60"],
-    "studies": ["matplotlib>=3.7", "tqdm>=4.60", "pymbar>=4", "scipy>=1.10", "MDAnalysis>=2.7"],
-    "cluster": ["dask[distributed]>=2023.1"],
-    "cuda12": ["openmm-cuda-12>=8.6,<8.7"],
-}
-EXTRAS["all"] = sorted(set(EXTRAS["analysis"] + EXTRAS["studies"]))
-# the documentation site: Sphinx, MyST and a theme (docs/conf.py subclasses Sphinx's Python domain, so Sphinx's major
-# version is pinned), and everything `all` installs, since the API reference imports every module
-EXTRAS["docs"] = sorted(set(["sphinx>=8,<10", "myst-parser>=4", "furo>=2024.1"] + EXTRAS["all"]))
-#: The test-suite cross-checks the analyses against MDAnalysis' test files and the MDAKits that compute the same.
-CROSS_CHECKS = ["MDAnalysisTests>=2.7", "waterdynamics>=1.2", "transport-analysis>=0.1.2", "tidynamics>=1.1"]
-EXTRAS["test"] = sorted(set(["pytest>=7", "pyelftools>=0.29"] + EXTRAS["all"] + EXTRAS["cluster"] + CROSS_CHECKS))
-
 if __name__ == "__main__":
-    setup(
-        name="openmm_symprk",
-        version=version(),
-        description="Symplectic partitioned Runge-Kutta and RATTLE integrators for OpenMM, "
-                    "with exact momentum conservation and conservation diagnostics",
-        long_description=open(os.path.join(HERE, "README.md"), encoding="utf-8").read()
-        if os.path.exists(os.path.join(HERE, "README.md")) else "",
-        long_description_content_type="text/markdown",
-        python_requires=">=3.11",
-        packages=find_packages(include=["openmm_symprk", "openmm_symprk.*"]),
-        package_data={"openmm_symprk.methods": ["data/*.toml"]},
-        install_requires=["openmm>=8.6,<8.7", "numpy>=1.24"],
-        extras_require=EXTRAS,
-        entry_points={"console_scripts": ["symprk=openmm_symprk.cli:main"]},
-        cmdclass={"build_ext": BuildNative},
-        distclass=BinaryDistribution,
-        classifiers=[
-            "Programming Language :: Python :: 3",
-            "Topic :: Scientific/Engineering :: Chemistry",
-            "Topic :: Scientific/Engineering :: Physics",
-        ],
-    )
+    setup(cmdclass={"build_ext": BuildNative}, distclass=BinaryDistribution)

@@ -28,7 +28,7 @@ from .integrators import (CheckpointMismatchError, CustomSymplecticIntegrator, N
 from .methods import PRKTableau, ResolvedMethod, Splitting, TableauError, UnknownMethodError, compose, get_method, resolve
 from .methods.catalogue import methods as catalogue
 
-__version__ = "0.2.0"
+__version__ = "0.3.0"
 
 # name -> module that defines it, imported lazily (keeps `import openmm_symprk` light)
 _LAZY = {

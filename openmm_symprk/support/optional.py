@@ -1,8 +1,8 @@
 """Optional dependencies, imported where a feature needs them.
 
 The integrators need only OpenMM and numpy.  Analysis, charts, progress bars, statistics and cluster runs
-need more; each is installed by an extra of the package (setup.py's ``extras_require`` holds the same
-table as :data:`EXTRAS`)::
+need more; each is installed by an extra of the package (pyproject.toml's ``optional-dependencies`` holds the
+same table as :data:`EXTRAS`)::
 
     pip install 'openmm_symprk[analysis]'   # MDAnalysis, scipy, tqdm
     pip install 'openmm_symprk[studies]'    # matplotlib, tqdm, pymbar, scipy, MDAnalysis
@@ -23,7 +23,7 @@ import importlib
 PACKAGES = {"MDAnalysis": "MDAnalysis", "scipy": "scipy", "matplotlib": "matplotlib", "tqdm": "tqdm",
             "pymbar": "pymbar", "dask": "dask[distributed]", "distributed": "dask[distributed]"}
 
-#: The package's extras and the packages each installs (setup.py's ``extras_require`` names the same).
+#: The package's extras and the packages each installs (pyproject.toml's ``optional-dependencies`` names the same).
 EXTRAS = {
     "analysis": ("MDAnalysis", "scipy", "tqdm"),
     "studies": ("matplotlib", "tqdm", "pymbar", "scipy", "MDAnalysis"),
