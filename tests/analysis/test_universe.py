@@ -170,7 +170,7 @@ def test_reorientation_agrees_with_waterdynamics(plain_water, order):
             frames = ours[name][:(n_frames // dt) * dt:dt]
             c = reorientation.legendre_correlation(frames, order, max_lag=1).mean(axis=1)[1]
             assert c == pytest.approx(theirs[dt - 1], abs=2e-5), (name, dt)
-    full = Reorientation(u, vectors=("HH",), orders=(order,), stop=n_frames).run()
+    full = Reorientation(u, vectors=("HH",), orders=(order,)).run(stop=n_frames)  # the frames compared above
     # its lag dt averages n_frames / dt origins of 64 waters (25 at dt = 4): agreement within that noise
     np.testing.assert_allclose(full.results.C["HH"][f"C{order}"][1:dtmax + 1], hh, atol=0.05)
 
@@ -228,3 +228,17 @@ def test_unevenly_spaced_frames_are_refused(plain_water):
     r = Reorientation(u, vectors=("HH",), orders=(1,))
     with pytest.raises(ValueError, match="not evenly spaced"):
         r.run(frames=[0, 1, 2, 4, 5, 6, 7, 8, 9, 10, 11, 12])
+
+
+@pytest.mark.parametrize("cls", [SelfDiffusion, Reorientation, AngularVelocityCorrelation, RadialDistribution,
+                                 KineticTemperatures])
+def test_frame_range_and_misspelt_keywords_are_refused(plain_water, cls):
+    """MDAnalysis' AnalysisBase takes **kwargs and ignores them: stop= given to a constructor would analyse every
+    frame without a word.  The classes refuse what they do not take, and say where the frame range goes."""
+    u = _dcd(plain_water)
+    by = {"by": "residues"} if cls is KineticTemperatures else {}  # the PDB has no bonds
+    with pytest.raises(TypeError, match=r"unexpected keyword argument 'stop'.*frames to analyse.*\.run\(\)"):
+        cls(u, stop=10, **by)
+    with pytest.raises(TypeError, match=r"unexpected keyword argument 'n_block'.*it takes .*'verbose'"):
+        cls(u, n_block=3, **by)
+    assert cls(u, verbose=True, **by)._verbose is True

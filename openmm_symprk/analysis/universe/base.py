@@ -16,6 +16,8 @@ orthorhombic; without a box, positions are taken as continuous and molecules as 
 """
 from __future__ import annotations
 
+import inspect
+
 import numpy as np
 
 from ...conservation.analysis import group_masses
@@ -23,7 +25,7 @@ from ...support import require
 
 AnalysisBase = require("MDAnalysis.analysis.base", "analysis", "openmm_symprk.analysis.universe").AnalysisBase
 
-__all__ = ["Waters", "find_waters", "WaterFrames", "ANGSTROM_IN_NM"]
+__all__ = ["Waters", "find_waters", "WaterFrames", "ANGSTROM_IN_NM", "refuse_unknown_keywords"]
 
 #: 1 Angstrom (MDAnalysis' length unit) in nm.
 ANGSTROM_IN_NM = 0.1
@@ -95,16 +97,38 @@ def find_waters(atomgroup, masses=None) -> Waters:
     return Waters(atoms, molecules, all_masses[flat.ravel()], charges)
 
 
+#: The keywords of AnalysisBase.run() that choose the frames.
+RUN_KEYWORDS = ("start", "stop", "step", "frames")
+
+
+def refuse_unknown_keywords(analysis, kwargs: dict) -> None:
+    """TypeError naming ``kwargs`` (what the constructor of ``analysis`` received beyond its own parameters) and
+    what it takes.  MDAnalysis' AnalysisBase accepts any keyword and ignores it, so ``stop=10`` given to a
+    constructor would analyse every frame without a word; the frame range goes to ``.run()``."""
+    if not kwargs:
+        return
+    name = type(analysis).__name__
+    takes = [p for p in inspect.signature(type(analysis).__init__).parameters
+             if p not in ("self", "atomgroup", "kwargs", "verbose")] + ["verbose"]
+    where = (" (the frames to analyse, start/stop/step/frames, are chosen in .run(), as in MDAnalysis: "
+             f"{name}(...).run(stop=100))" if set(kwargs) & set(RUN_KEYWORDS) else "")
+    raise TypeError(f"{name}() got unexpected keyword argument{'s' if len(kwargs) > 1 else ''} "
+                    f"{', '.join(repr(k) for k in kwargs)}{where}; it takes {', '.join(repr(t) for t in takes)}")
+
+
 class WaterFrames(AnalysisBase):
     """Base of the water analyses: collects the waters' positions (and, with ``velocities=True``, velocities)
     at every analysed frame, then :meth:`_analyse` works on them in nm, ps.  ``atomgroup``: a Universe or an
-    AtomGroup holding the waters; ``masses``: see :func:`find_waters`."""
+    AtomGroup holding the waters; ``masses``: see :func:`find_waters`; ``verbose``: MDAnalysis' progress bar.
+    Keywords a class does not take are refused (:func:`refuse_unknown_keywords`): the frames to analyse go to
+    ``.run(start, stop, step, frames)``."""
 
     _needs_velocities = False
 
-    def __init__(self, atomgroup, masses=None, **kwargs):
+    def __init__(self, atomgroup, masses=None, verbose: bool = False, **kwargs):
+        refuse_unknown_keywords(self, kwargs)
         universe = getattr(atomgroup, "universe", atomgroup)
-        super().__init__(universe.trajectory, **kwargs)
+        super().__init__(universe.trajectory, verbose=verbose)
         self.waters = find_waters(atomgroup, masses)
 
     def _prepare(self):

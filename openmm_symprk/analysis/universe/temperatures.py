@@ -7,7 +7,7 @@ import numpy as np
 from ...conservation.analysis import group_masses, subgroups
 from ...physics.temperature import kinetic_temperatures
 from ...stats import block_stats, series_stats
-from .base import ANGSTROM_IN_NM, AnalysisBase
+from .base import ANGSTROM_IN_NM, AnalysisBase, refuse_unknown_keywords
 
 __all__ = ["KineticTemperatures"]
 
@@ -34,9 +34,10 @@ class KineticTemperatures(AnalysisBase):
     """
 
     def __init__(self, atomgroup, masses=None, by: str = "fragments", momentum_fixed: bool = True,
-                 constraints: int | None = None, n_blocks: int | None = 10, **kwargs):
+                 constraints: int | None = None, n_blocks: int | None = 10, verbose: bool = False, **kwargs):
+        refuse_unknown_keywords(self, kwargs)
         atomgroup = getattr(atomgroup, "atoms", atomgroup)
-        super().__init__(atomgroup.universe.trajectory, **kwargs)
+        super().__init__(atomgroup.universe.trajectory, verbose=verbose)
         self._ag = atomgroup
         self._m = group_masses(atomgroup, masses)
         if by not in ("residues", "fragments", "segments"):
