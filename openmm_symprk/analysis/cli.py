@@ -97,6 +97,7 @@ def observe(universe, *, window_ps=None, viscosity_mpas=None, temperature_k=None
     :data:`OBSERVED`), each analysis of :mod:`openmm_symprk.analysis.universe` run with its defaults."""
     from .universe import AngularVelocityCorrelation, KineticTemperatures, RadialDistribution, Reorientation
     from .universe import SelfDiffusion
+    from .universe.base import ANGSTROM_IN_NM
 
     obs, notes = {key: None for key, _, _ in OBSERVED}, {}
 
@@ -151,7 +152,7 @@ def observe(universe, *, window_ps=None, viscosity_mpas=None, temperature_k=None
         g = RadialDistribution(universe).run()
         if g.results.peak is None:
             raise ValueError(g.results.note)
-        obs["g_r"] = _pair(g.results.peak.r, g.results.peak.r_se)
+        obs["g_r"] = _pair(g.results.peak.r, g.results.peak.r_se, ANGSTROM_IN_NM)  # the table's nm
         obs["g_h"] = _pair(g.results.peak.height, g.results.peak.height_se)
 
     attempt(("D", "D_inf"), diffusion)

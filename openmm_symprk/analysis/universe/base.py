@@ -1,5 +1,6 @@
-"""What every trajectory analysis of water shares: finding the waters of a Universe, reading their frames in the
-package's units (nm, ps, Da, e), and the time between frames.
+"""What every trajectory analysis of water shares: finding the waters of a Universe, reading their frames (in
+MDAnalysis' units, Angstrom and ps, converted to the kernels' nm once), and the time between frames.  The
+analyses take and give Angstrom and ps, as MDAnalysis does.
 
 Waters (:func:`find_waters`): the residues of the atom group with exactly one oxygen and two hydrogens among
 their atoms of non-zero mass (the element, else the name's first letter: OW, OH2, O; HW1, H1, H), any

@@ -30,7 +30,7 @@ class KineticTemperatures(AnalysisBase):
 
     Results: ``translational``, ``rotational``, ``internal``, ``difference`` (rotational - translational), one
     value per frame; ``mean_translational`` ... their means and ``se_translational`` ... their standard errors
-    (nan with fewer than 4 frames); ``dof``.
+    (nan with fewer than 4 frames); ``dof``; ``units`` (K for all).
     """
 
     def __init__(self, atomgroup, masses=None, by: str = "fragments", momentum_fixed: bool = True,
@@ -81,3 +81,4 @@ class KineticTemperatures(AnalysisBase):
                 else:
                     se = block_stats(series, min(int(self._n_blocks), self.n_frames // 2), dt).se
             self.results[f"se_{key}"] = se
+        self.results.units = {key: "K" for key in self.results if key not in ("dof",)}
