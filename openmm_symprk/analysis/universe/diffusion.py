@@ -24,7 +24,9 @@ class SelfDiffusion(WaterFrames):
     analysed time T (:func:`~openmm_symprk.analysis.diffusion.self_diffusion`; ``error``: "molecules" or
     "blocks" with ``n_blocks``; ``max_lag``: the longest lag, frames).  With ``viscosity_mpas`` (mPa s) and
     ``temperature_k`` (K) the Yeh-Hummer finite-size correction of a cubic box is added to give
-    ``results.D_infinite``.
+    ``results.D_infinite``.  Without a box in the trajectory the positions must be continuous: centres of mass
+    that jump by about the system's width between frames (positions wrapped into a box the file does not
+    store) are refused (:func:`~openmm_symprk.analysis.universe.checks.wrapped_problem`).
 
     Results, in MDAnalysis' units (Angstrom, ps) and, where :class:`MDAnalysis.analysis.msd.EinsteinMSD` computes
     the same, its names: ``timeseries`` (Angstrom^2, the MSD averaged over molecules at lags ``lag_ps``),
@@ -41,6 +43,8 @@ class SelfDiffusion(WaterFrames):
             raise ValueError("the Yeh-Hummer correction needs both viscosity_mpas and temperature_k")
         self._options = dict(window_ps=window_ps, error=error, n_blocks=n_blocks, drift=drift, max_lag=max_lag)
         self._eta, self._temperature = viscosity_mpas, temperature_k
+
+    _needs_continuous = True
 
     def _analyse(self, x, v, box):
         w = self.waters
