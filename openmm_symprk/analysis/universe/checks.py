@@ -53,12 +53,17 @@ def describe_steps(times, irregular, frame_numbers=None) -> str:
     numbers = np.arange(len(t)) if frame_numbers is None else np.asarray(frame_numbers)
     k = int(irregular[0])
     step = t[k + 1] - t[k]
-    usual = float(np.median(np.diff(t)))
-    what = (f"time goes back by {-step:.4g} ps" if step < 0 else "no time passes" if step == 0 else
-            f"{step:.4g} ps pass")
+    regular = np.delete(np.diff(t), irregular)
+    usual = float(regular.mean()) if len(regular) else float("nan")
+    # to one decimal place beyond the usual step's first digit: 100002.9, not 100003 or 100002.8984
+    places = 1 + max(0, -int(np.floor(np.log10(abs(usual))))) if np.isfinite(usual) and usual != 0 else 3
+    fixed = (lambda value: f"{value:.{places}f}".rstrip("0").rstrip("."))
+    what = (f"time goes back by {fixed(-step)} ps" if step < 0 else "no time passes" if step == 0 else
+            f"{fixed(step)} ps pass")
     more = f" ({len(irregular)} such steps)" if len(irregular) > 1 else ""
-    return (f"the frames are not evenly spaced in time: between frame {numbers[k]} (t = {t[k]:.6g} ps) and frame "
-            f"{numbers[k + 1]} (t = {t[k + 1]:.6g} ps) {what} where the other frames are {usual:.4g} ps apart{more}")
+    return (f"the frames are not evenly spaced in time: between frame {numbers[k]} (t = {fixed(t[k])} ps) and "
+            f"frame {numbers[k + 1]} (t = {fixed(t[k + 1])} ps) {what} where the other frames are {fixed(usual)} ps "
+            f"apart{more}")
 
 
 def _whole(x, molecules, box):
