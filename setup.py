@@ -278,7 +278,9 @@ EXTRAS["all"] = sorted(set(EXTRAS["analysis"] + EXTRAS["studies"]))
 EXTRAS["docs"] = sorted(set(["sphinx>=8,<10", "myst-parser>=4", "furo>=2024.1"] + EXTRAS["all"]))
 #: The test-suite cross-checks the analyses against MDAnalysis' test files and the MDAKits that compute the same.
 CROSS_CHECKS = ["MDAnalysisTests>=2.7", "waterdynamics>=1.2", "transport-analysis>=0.1.2", "tidynamics>=1.1"]
-EXTRAS["test"] = sorted(set(["pytest>=7", "pyelftools>=0.29"] + EXTRAS["all"] + EXTRAS["cluster"] + CROSS_CHECKS))
+# PyYAML reads mdakit/metadata.yaml, the MDAKits registry's entry, in its test
+EXTRAS["test"] = sorted(set(["pytest>=7", "pyelftools>=0.29", "pyyaml>=6"] + EXTRAS["all"] + EXTRAS["cluster"]
+                            + CROSS_CHECKS))
 
 if __name__ == "__main__":
     setup(

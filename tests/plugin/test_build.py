@@ -140,4 +140,4 @@ def test_extras():
     assert names["docs"] == {"sphinx", "myst-parser", "furo"} | names["all"]
     # the suite cross-checks the analyses against MDAnalysis' test files and the MDAKits computing the same
     cross_checks = {"mdanalysistests", "waterdynamics", "transport-analysis", "tidynamics"}
-    assert names["test"] == {"pytest", "pyelftools"} | names["all"] | names["cluster"] | cross_checks
+    assert names["test"] == {"pytest", "pyelftools", "pyyaml"} | names["all"] | names["cluster"] | cross_checks
