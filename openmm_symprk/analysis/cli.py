@@ -20,6 +20,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import stat
 import sys
 
 import numpy as np
@@ -172,13 +173,19 @@ def build_parser():
     return ap
 
 
-def _json_target(path: str) -> str:
-    """``path`` as an absolute path, once a file can be created in its folder (checked by creating and removing
-    one); ValueError naming the path and why otherwise.  Run before the analysis, so that a bad path costs none."""
-    target = os.path.abspath(path)
-    folder = os.path.dirname(target)
-    if os.path.isdir(target):
+def _json_target(path: str) -> tuple:
+    """(the file to write, whether to write into it as a stream) for ``--json path``, checked before the analysis
+    so that a bad path costs none; ValueError naming the path and why it cannot be written.  A regular file (or
+    a new one) is replaced whole (:func:`_write_json`), through a symlink to the file it names; anything else
+    that exists (a device such as /dev/stdout or /dev/null, a FIFO) is written into, never replaced."""
+    if os.path.isdir(path):
         raise ValueError(f"--json {path} is a folder: give a file name (e.g. {os.path.join(path, 'observe.json')})")
+    if os.path.exists(path) and not stat.S_ISREG(os.stat(path).st_mode):
+        if not os.access(path, os.W_OK):
+            raise ValueError(f"--json {path} cannot be written (permission denied)")
+        return path, True
+    target = os.path.realpath(path)
+    folder = os.path.dirname(target)
     if not os.path.isdir(folder):
         raise ValueError(f"--json {path}: the folder {folder} does not exist")
     probe = os.path.join(folder, f".{os.path.basename(target)}.{os.getpid()}.probe")
@@ -188,20 +195,24 @@ def _json_target(path: str) -> str:
         os.remove(probe)
     except OSError as exc:
         raise ValueError(f"--json {path}: cannot write in {folder} ({exc.strerror or exc})") from None
-    return target
+    return target, False
 
 
-def _write_json(target: str, data: dict) -> None:
-    """``data`` as strict JSON (no NaN: missing numbers are null) in ``target``, written whole or not at all: a
-    file in the same folder, then os.replace."""
+def _write_json(target: str, stream: bool, data: dict) -> None:
+    """``data`` as strict JSON (no NaN: missing numbers are null) in ``target`` (from :func:`_json_target`): a
+    regular file is written whole or not at all (a file beside it, then os.replace), a stream is written into."""
     text = json.dumps(data, indent=2, allow_nan=False) + "\n"
     tmp = os.path.join(os.path.dirname(target), f".{os.path.basename(target)}.{os.getpid()}.tmp")
     try:
+        if stream:
+            with open(target, "w") as fh:
+                fh.write(text)
+            return
         with open(tmp, "x") as fh:
             fh.write(text)
         os.replace(tmp, target)
     except OSError as exc:
-        if os.path.exists(tmp):
+        if not stream and os.path.exists(tmp):
             os.remove(tmp)
         raise ValueError(f"cannot write --json {target}: {exc.strerror or exc}") from None
 
@@ -214,7 +225,7 @@ def main(argv=None) -> int:
         if args.dt is not None and not (np.isfinite(args.dt) and args.dt > 0):
             raise ValueError(f"--dt must be a positive number of ps (the time between the trajectory's frames), "
                              f"got {args.dt:g}")
-        target = _json_target(args.json) if args.json else None
+        target, stream = _json_target(args.json) if args.json else (None, False)
         require("MDAnalysis", "analysis", "symprk observe")
         from .universe.reading import open_universe, read_waters, stored_box
 
@@ -249,7 +260,7 @@ def main(argv=None) -> int:
                                 {"value": obs[key][0], "se": obs[key][1], "unit": units[key]} for key in obs},
                 "notes": notes}
         try:
-            _write_json(target, data)
+            _write_json(target, stream, data)
         except ValueError as exc:
             print(f"symprk observe: error: {exc}", file=sys.stderr)
             return 2

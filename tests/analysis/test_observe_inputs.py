@@ -5,8 +5,10 @@ and MDAnalysis' own traceback after the one-line error for an unreadable file.  
 the frames of OpenMM's own DCD (conftest's plain_water: 64 SPC/E waters, a frame every 10 fs)."""
 import json
 import os
+import stat
 import subprocess
 import sys
+import threading
 
 import numpy as np
 import pytest
@@ -91,7 +93,7 @@ def test_a_gap_in_time_between_files_is_refused_naming_it(files, capsys):
     assert "between frame 99 (t = 0.99 ps) and frame 100 (t = 1.5 ps) 0.51 ps pass where the other frames are " \
            "0.01 ps apart" in err and "--start 0 --stop 100" in err and "--dt" in err
     assert out == ""  # refused before anything was computed
-    assert main([files.pdb, str(files.a), str(files.b), "--stop", "100", "--json", os.devnull]) == 0
+    assert main([files.pdb, str(files.a), str(files.b), "--stop", "100", "--progress", "never"]) == 0
     assert "100 frames every 0.01 ps" in capsys.readouterr().out
     # a file whose clock starts again: time goes back
     assert main([files.pdb, files.dcd, files.dcd, "--progress", "never"]) == 2
@@ -200,6 +202,27 @@ def test_the_json_is_strict_and_written_whole(tmp_path, capsys):
     t = data["observables"]["T_trans"]
     assert t["se"] is None and 250 < t["value"] < 350  # 3 frames: no block error
     assert os.listdir(tmp_path) == ["obs.json"]
+
+
+def test_the_json_goes_through_a_symlink_and_into_a_fifo(tmp_path, capsys):
+    """The whole-file replacement (temp file + os.replace) is for regular files: a symlink keeps pointing at the
+    file it names, which is replaced; a FIFO (or a device: /dev/stdout, /dev/null) is written into, not replaced
+    by a regular file."""
+    real, link = tmp_path / "real.json", tmp_path / "link.json"
+    real.write_text("an older file\n")
+    link.symlink_to(real)
+    assert main([datafiles.PRM_NCBOX, datafiles.TRJ_NCBOX, "--json", str(link)]) == 0
+    assert link.is_symlink() and json.loads(real.read_text())["n_waters"] == 464
+    fifo = tmp_path / "pipe"
+    os.mkfifo(fifo)
+    got = []
+    reader = threading.Thread(target=lambda: got.append(open(fifo).read()), daemon=True)
+    reader.start()
+    assert main([datafiles.PRM_NCBOX, datafiles.TRJ_NCBOX, "--json", str(fifo)]) == 0
+    reader.join(60)
+    assert stat.S_ISFIFO(os.stat(fifo).st_mode) and json.loads(got[0])["n_waters"] == 464
+    assert sorted(os.listdir(tmp_path)) == ["link.json", "pipe", "real.json"]
+    capsys.readouterr()
 
 
 SCRIPT = "import sys; from openmm_symprk.cli import main; sys.exit(main(sys.argv[1:]))"
