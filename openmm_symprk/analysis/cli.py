@@ -7,11 +7,20 @@ reorientation times tau_1, tau_2 of the dipole, H-H and O-H vectors, and the O-O
 the angular-velocity autocorrelation and the translational and rotational temperatures need velocities too
 (TRR, NetCDF, H5MD; DCD and XTC store none).  An observable that cannot be computed from the trajectory (too
 short, too coarse, no velocities) is printed as missing with the reason.  ``--json FILE`` writes them all.
+
+Refused, in one line, before anything is computed: frames unevenly spaced in time (files of one run with a
+stretch not written between them: analyse one piece with --start/--stop), molecules that are not water in the
+first frame (a topology listing the atoms in another order than the trajectory), positions wrapped into a box
+the file does not store, a --json path that cannot be written, and files MDAnalysis cannot read.  Frames
+without a box take the first frame's, or the topology's (a multi-model PDB's one CRYST1); a format without
+times (PDB, GRO ...) is read as frames 1 ps apart unless --dt gives the interval.
 """
 from __future__ import annotations
 
 import argparse
 import json
+import os
+import stat
 import sys
 
 import numpy as np
@@ -43,52 +52,11 @@ OMEGA_MAX_INTERVAL_PS = 0.02
 PROGRESS_FRAMES = 200
 
 
-def read_waters(universe, select=None, start=None, stop=None, step=None, progress=None):
-    """An in-memory Universe of the waters of ``universe`` (``select``: an MDAnalysis selection to look in) at
-    frames ``start:stop:step``, and whether it has velocities.  ``progress``: show a tqdm bar (default: when
-    more than :data:`PROGRESS_FRAMES` frames are read)."""
-    mda = require("MDAnalysis", "analysis", "symprk observe")
-    MemoryReader = require("MDAnalysis.coordinates.memory", "analysis", "symprk observe").MemoryReader
-    tqdm = require("tqdm", "analysis", "symprk observe's progress bar").tqdm
-    from .universe import find_waters
-
-    group = universe.select_atoms(select) if select else universe.atoms
-    if select and group.n_atoms == 0:
-        raise ValueError(f"the selection {select!r} matches no atom")
-    waters = find_waters(group)
-    frames = range(*slice(start, stop, step).indices(universe.trajectory.n_frames))
-    if len(frames) < 2:
-        raise ValueError(f"{len(frames)} frame(s) selected: the observables need at least 2")
-    n = waters.atoms.n_atoms
-    x = np.empty((len(frames), n, 3), dtype=np.float32)
-    v = np.empty_like(x) if universe.trajectory.ts.has_velocities else None
-    dims = np.zeros((len(frames), 6), dtype=np.float32)
-    times = np.empty(len(frames))
-    show = len(frames) > PROGRESS_FRAMES if progress is None else progress
-    sliced = universe.trajectory[frames.start:frames.stop:frames.step]
-    for k, ts in enumerate(tqdm(sliced, total=len(frames), disable=not show, desc="reading frames",
-                                unit="frame", file=sys.stderr)):
-        x[k] = waters.atoms.positions
-        if v is not None:
-            if not ts.has_velocities:
-                v = None
-            else:
-                v[k] = waters.atoms.velocities
-        if ts.dimensions is not None:
-            dims[k] = ts.dimensions
-        times[k] = ts.time
-    memory = mda.Merge(waters.atoms)
-    steps = np.diff(times)
-    dt = float(np.median(steps)) if len(steps) else 1.0
-    memory.load_new(x, format=MemoryReader, velocities=v, dimensions=None if not dims[:, :3].all() else dims,
-                    dt=dt if dt > 0 else 1.0)
-    return memory, v is not None
-
-
 def _pair(value, se, scale=1.0):
+    """[value, se] scaled, or None for a missing value; a missing error is None (JSON null, never NaN)."""
     if value is None or not np.isfinite(value):
         return None
-    return [float(value) * scale, float(se) * scale if se is not None and np.isfinite(se) else float("nan")]
+    return [float(value) * scale, float(se) * scale if se is not None and np.isfinite(se) else None]
 
 
 def observe(universe, *, window_ps=None, viscosity_mpas=None, temperature_k=None, omega_lag_ps: float = 0.5,
@@ -97,6 +65,7 @@ def observe(universe, *, window_ps=None, viscosity_mpas=None, temperature_k=None
     :data:`OBSERVED`), each analysis of :mod:`openmm_symprk.analysis.universe` run with its defaults."""
     from .universe import AngularVelocityCorrelation, KineticTemperatures, RadialDistribution, Reorientation
     from .universe import SelfDiffusion
+    from .universe.base import ANGSTROM_IN_NM
 
     obs, notes = {key: None for key, _, _ in OBSERVED}, {}
 
@@ -151,7 +120,7 @@ def observe(universe, *, window_ps=None, viscosity_mpas=None, temperature_k=None
         g = RadialDistribution(universe).run()
         if g.results.peak is None:
             raise ValueError(g.results.note)
-        obs["g_r"] = _pair(g.results.peak.r, g.results.peak.r_se)
+        obs["g_r"] = _pair(g.results.peak.r, g.results.peak.r_se, ANGSTROM_IN_NM)  # the table's nm
         obs["g_h"] = _pair(g.results.peak.height, g.results.peak.height_se)
 
     attempt(("D", "D_inf"), diffusion)
@@ -171,7 +140,7 @@ def format_table(obs: dict, notes: dict) -> str:
     lines = [f"{'observable':40s} {'value':>22s}  unit"]
     for key, what, unit in OBSERVED:
         pair = obs.get(key)
-        text = "-" if pair is None else f"{pair[0]:.4g} ± {pair[1]:.2g}"
+        text = "-" if pair is None else f"{pair[0]:.4g} ± " + ("?" if pair[1] is None else f"{pair[1]:.2g}")
         lines.append(f"{what:40s} {text:>22s}  {unit}")
     missing = [key for key, _, _ in OBSERVED if obs.get(key) is None and key in notes]
     if missing:
@@ -190,6 +159,9 @@ def build_parser():
     ap.add_argument("--start", type=int, default=None)
     ap.add_argument("--stop", type=int, default=None)
     ap.add_argument("--step", type=int, default=None)
+    ap.add_argument("--dt", type=float, default=None, metavar="PS",
+                    help="time between the trajectory's frames, ps, for formats that store no times (PDB, GRO, XYZ: "
+                         "read as 1 ps apart otherwise); replaces the file's times")
     ap.add_argument("--window", type=float, nargs=2, metavar=("T_MIN", "T_MAX"), default=None,
                     help="diffusion fit window, ps (default: T/10 to T/2 of the analysed time T)")
     ap.add_argument("--viscosity", type=float, default=None, help="the model's shear viscosity, mPa s (Yeh-Hummer)")
@@ -201,44 +173,97 @@ def build_parser():
     return ap
 
 
+def _json_target(path: str) -> tuple:
+    """(the file to write, whether to write into it as a stream) for ``--json path``, checked before the analysis
+    so that a bad path costs none; ValueError naming the path and why it cannot be written.  A regular file (or
+    a new one) is replaced whole (:func:`_write_json`), through a symlink to the file it names; anything else
+    that exists (a device such as /dev/stdout or /dev/null, a FIFO) is written into, never replaced."""
+    if os.path.isdir(path):
+        raise ValueError(f"--json {path} is a folder: give a file name (e.g. {os.path.join(path, 'observe.json')})")
+    if os.path.exists(path) and not stat.S_ISREG(os.stat(path).st_mode):
+        if not os.access(path, os.W_OK):
+            raise ValueError(f"--json {path} cannot be written (permission denied)")
+        return path, True
+    target = os.path.realpath(path)
+    folder = os.path.dirname(target)
+    if not os.path.isdir(folder):
+        raise ValueError(f"--json {path}: the folder {folder} does not exist")
+    probe = os.path.join(folder, f".{os.path.basename(target)}.{os.getpid()}.probe")
+    try:
+        with open(probe, "x"):
+            pass
+        os.remove(probe)
+    except OSError as exc:
+        raise ValueError(f"--json {path}: cannot write in {folder} ({exc.strerror or exc})") from None
+    return target, False
+
+
+def _write_json(target: str, stream: bool, data: dict) -> None:
+    """``data`` as strict JSON (no NaN: missing numbers are null) in ``target`` (from :func:`_json_target`): a
+    regular file is written whole or not at all (a file beside it, then os.replace), a stream is written into."""
+    text = json.dumps(data, indent=2, allow_nan=False) + "\n"
+    tmp = os.path.join(os.path.dirname(target), f".{os.path.basename(target)}.{os.getpid()}.tmp")
+    try:
+        if stream:
+            with open(target, "w") as fh:
+                fh.write(text)
+            return
+        with open(tmp, "x") as fh:
+            fh.write(text)
+        os.replace(tmp, target)
+    except OSError as exc:
+        if not stream and os.path.exists(tmp):
+            os.remove(tmp)
+        raise ValueError(f"cannot write --json {target}: {exc.strerror or exc}") from None
+
+
 def main(argv=None) -> int:
     args = build_parser().parse_args(argv)
     try:
         if (args.viscosity is None) != (args.temperature is None):
             raise ValueError("the Yeh-Hummer correction needs both --viscosity and --temperature")
-        mda = require("MDAnalysis", "analysis", "symprk observe")
-        files = args.trajectory[0] if len(args.trajectory) == 1 else args.trajectory
-        try:
-            u = mda.Universe(args.topology, files)
-        except (OSError, ValueError, TypeError) as exc:
-            raise ValueError(f"MDAnalysis cannot read {args.topology} with {', '.join(args.trajectory)}: {exc}") \
-                from None
-        progress = {"auto": None, "always": True, "never": False}[args.progress]
-        memory, has_v = read_waters(u, args.select, args.start, args.stop, args.step, progress)
+        if args.dt is not None and not (np.isfinite(args.dt) and args.dt > 0):
+            raise ValueError(f"--dt must be a positive number of ps (the time between the trajectory's frames), "
+                             f"got {args.dt:g}")
+        target, stream = _json_target(args.json) if args.json else (None, False)
+        require("MDAnalysis", "analysis", "symprk observe")
+        from .universe.reading import open_universe, read_waters, stored_box
+
+        u = open_universe(args.topology, args.trajectory)
+        progress = {"auto": PROGRESS_FRAMES, "always": True, "never": False}[args.progress]
+        read = read_waters(u, args.select, args.start, args.stop, args.step, progress, dt=args.dt,
+                           fallback_box=lambda: stored_box(args.topology, args.trajectory))
+        memory, has_v = read.universe, read.has_velocities
         obs, notes = observe(memory, window_ps=args.window, viscosity_mpas=args.viscosity,
                              temperature_k=args.temperature, omega_lag_ps=args.omega_lag, has_velocities=has_v)
     except (ValueError, OSError) as exc:
         print(f"symprk observe: error: {exc}", file=sys.stderr)
         return 2
     n_waters = memory.residues.n_residues
-    dt = float(memory.trajectory.dt)
-    print(f"{n_waters} waters, {memory.trajectory.n_frames} frames every {dt:g} ps"
+    dt = read.dt
+    when = "" if read.dt_from == "the file's times" else f" ({read.dt_from})"
+    print(f"{n_waters} waters, {memory.trajectory.n_frames} frames every {dt:g} ps{when}"
           f"{'' if has_v else ' (positions only: no velocities)'}; errors are standard errors "
           f"(molecules' scatter, jackknife over molecules, or blocks of frames)")
+    if read.box_from:
+        print(f"box from {read.box_from}")
     print(format_table(obs, notes))
     if not has_v:
         print("\nThe omega ACF, T_trans and T_rot need velocities: write the trajectory with them (TRR, NetCDF, "
               "H5MD) to get them.")
-    if args.json:
+    if target:
         units = {key: unit for key, _, unit in OBSERVED}
         data = {"topology": args.topology, "trajectory": args.trajectory, "n_waters": n_waters,
-                "n_frames": memory.trajectory.n_frames, "dt_ps": dt, "velocities": has_v,
+                "n_frames": memory.trajectory.n_frames, "dt_ps": dt, "dt_from": read.dt_from,
+                "box_from": read.box_from, "velocities": has_v,
                 "observables": {key: None if obs[key] is None else
                                 {"value": obs[key][0], "se": obs[key][1], "unit": units[key]} for key in obs},
                 "notes": notes}
-        with open(args.json, "w") as fh:
-            json.dump(data, fh, indent=2, allow_nan=True)
-            fh.write("\n")
+        try:
+            _write_json(target, stream, data)
+        except ValueError as exc:
+            print(f"symprk observe: error: {exc}", file=sys.stderr)
+            return 2
         print(f"\nwrote {args.json}")
     return 0
 

@@ -99,7 +99,8 @@ def mean_squared_displacement(r, max_lag: int | None = None) -> np.ndarray:
 
 @dataclass
 class DiffusionFit:
-    """D and its standard error (1e-5 cm^2/s), the molecule-averaged MSD it was fitted to and the window."""
+    """D and its standard error (1e-5 cm^2/s), the molecule-averaged MSD it was fitted to, each molecule's MSD
+    and the window."""
 
     D: float
     se: float
@@ -108,6 +109,7 @@ class DiffusionFit:
     window_ps: tuple
     error: str  # "molecules" or "blocks"
     n_samples: int  # molecules or blocks the error came from
+    msds: np.ndarray | None = None  # (L, n) nm^2, each molecule's
 
     def __format__(self, spec):
         spec = spec or ".3f"
@@ -163,7 +165,7 @@ def self_diffusion(r, dt_ps: float, window_ps, *, error: str = "molecules", n_bl
         raise ValueError("the error needs at least 2 molecules (or blocks)")
     se = float(np.std(per, ddof=1) / np.sqrt(len(per)))
     return DiffusionFit(D, se, np.arange(msd.shape[0]) * dt_ps, mean_msd, (float(t[0]), float(t[-1])), error,
-                        len(per))
+                        len(per), msd)
 
 
 def yeh_hummer(box_nm: float, temperature_k: float, viscosity_mpas: float) -> float:

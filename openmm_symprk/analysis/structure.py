@@ -76,7 +76,8 @@ def radial_distribution(x, box, r_max: float, dr: float = 0.005, n_blocks: int =
 
 @dataclass
 class Peak:
-    """First peak of g(r): position (nm) and height, with standard errors from the blocks."""
+    """First peak of g(r): position (nm; Angstrom from :class:`openmm_symprk.analysis.universe.RadialDistribution`)
+    and height, with standard errors from the blocks."""
 
     r: float
     height: float
@@ -84,17 +85,17 @@ class Peak:
     height_se: float
 
 
-def _vertex(r, g, r_min, above):
+def _vertex(r, g, r_min, above, unit="nm"):
     """Parabola through the highest bin of the first run of bins beyond r_min with g > above, and its two
     neighbours: (position, height)."""
     over = (r > r_min) & (g > above)
     if not over.any():
-        raise ValueError(f"g(r) never exceeds {above} beyond r_min = {r_min} nm: no first peak")
+        raise ValueError(f"g(r) never exceeds {above} beyond r_min = {r_min:g} {unit}: no first peak")
     start = int(np.argmax(over))
     stop = start + (int(np.argmin(over[start:])) if not over[start:].all() else len(g) - start)
     k = start + int(np.argmax(g[start:stop]))
     if k == 0 or k == len(g) - 1:
-        raise ValueError(f"the first peak's highest bin is at the end of the range (r = {r[k]:.4g} nm): "
+        raise ValueError(f"the first peak's highest bin is at the end of the range (r = {r[k]:.4g} {unit}): "
                          f"no peak to refine (raise r_max or r_min)")
     g0, g1, g2 = g[k - 1], g[k], g[k + 1]
     curv = g0 - 2.0 * g1 + g2
@@ -105,13 +106,14 @@ def _vertex(r, g, r_min, above):
     return float(r[k] + shift * h), float(g1 - 0.25 * (g0 - g2) * shift)
 
 
-def first_peak(rdf: Rdf, r_min: float = 0.0, above: float = 1.0) -> Peak:
+def first_peak(rdf: Rdf, r_min: float = 0.0, above: float = 1.0, unit: str = "nm") -> Peak:
     """Position (nm) and height of the first peak of ``rdf``: the first run of bins beyond ``r_min`` nm where
     g > ``above`` (water's O-O: 0.26-0.33 nm), its highest bin refined by the parabola through it and its
-    two neighbours; standard errors from the same on each block's g."""
-    r, h = _vertex(rdf.r, rdf.g, r_min, above)
+    two neighbours; standard errors from the same on each block's g.  (``rdf.r`` in another unit gives the
+    position in it: ``unit`` names it in the errors.)"""
+    r, h = _vertex(rdf.r, rdf.g, r_min, above, unit)
     if len(rdf.blocks) > 1:
-        per = np.array([_vertex(rdf.r, b, r_min, above) for b in rdf.blocks])
+        per = np.array([_vertex(rdf.r, b, r_min, above, unit) for b in rdf.blocks])
         se = per.std(axis=0, ddof=1) / np.sqrt(len(per))
     else:
         se = (np.nan, np.nan)

@@ -60,7 +60,6 @@ def test_openmm_dcd_positions_only_with_a_progress_bar(plain_water, tmp_path, ca
     assert "reading frames" not in capsys.readouterr().err
 
 
-@pytest.mark.filterwarnings("ignore::pytest.PytestUnraisableExceptionWarning")  # MDAnalysis, on a missing file
 def test_no_water_unreadable_files_and_bad_options_are_one_line_errors(tmp_path, capsys):
     assert main([datafiles.PSF, datafiles.DCD]) == 2
     assert "no water in the selection" in capsys.readouterr().err

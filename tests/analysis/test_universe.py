@@ -68,9 +68,16 @@ def test_self_diffusion_from_the_wrapped_dcd_is_the_study_figure(plain_water, st
     d = SelfDiffusion(u, CFG["msd_window_ps"], masses=plain_water.masses).run()
     assert d.results.D == pytest.approx(obs["D"][0], rel=2e-4)
     assert d.results.se == pytest.approx(obs["D"][1], rel=1e-2)
-    np.testing.assert_allclose(d.results.msd, curves["msd"], rtol=1e-3, atol=1e-7)
+    # MDAnalysis' units and names: the MSD in Angstrom^2 (the study's is nm^2), lags in ps, D's unit stated
+    np.testing.assert_allclose(d.results.timeseries, 100.0 * curves["msd"], rtol=1e-3, atol=1e-5)
+    assert d.results.msds_by_particle.shape == (len(d.results.timeseries), 64)
+    np.testing.assert_allclose(d.results.msds_by_particle.mean(axis=1), d.results.timeseries, rtol=1e-12)
+    np.testing.assert_allclose(d.results.lag_ps, np.arange(len(d.results.timeseries)) * plain_water.dt, rtol=1e-6)
+    assert d.results.units == {"D": "1e-5 cm^2/s", "se": "1e-5 cm^2/s", "D_infinite": "1e-5 cm^2/s",
+                               "correction": "1e-5 cm^2/s", "timeseries": "Angstrom^2",
+                               "msds_by_particle": "Angstrom^2", "lag_ps": "ps", "window_ps": "ps"}
     # the molecules cross the box: without unwrapping the MSD would saturate
-    assert (plain_water.x[-1, plain_water.molecules[:, 0]] > plain_water.box).any() or d.results.msd[-1] > 0.02
+    assert (plain_water.x[-1, plain_water.molecules[:, 0]] > plain_water.box).any() or d.results.timeseries[-1] > 2
 
 
 def test_yeh_hummer_correction_is_added_for_a_cubic_box(plain_water):
@@ -122,15 +129,40 @@ def test_radial_distribution_is_the_study_figure_and_interrdf(plain_water, study
 
     obs, curves, _ = study
     u = _dcd(plain_water)
-    g = RadialDistribution(u, r_min=CFG["rdf_r_min_nm"]).run()
-    assert g.results.peak.r == pytest.approx(obs["g_r"][0], abs=1e-5)
+    g = RadialDistribution(u, peak_from=10 * CFG["rdf_r_min_nm"]).run()
+    # Angstrom (the study's nm); float32 moves pairs across bin edges, which moved the vertex by 1.5e-4 Angstrom
+    # in one run of the (not bitwise reproducible) simulation, where the peak's standard error was 7e-3
+    assert g.results.peak.r == pytest.approx(10 * obs["g_r"][0], abs=5e-4)
+    assert g.results.peak.r_se == pytest.approx(10 * obs["g_r"][1], rel=1e-2)
     assert g.results.peak.height == pytest.approx(obs["g_h"][0], rel=1e-3)  # float32 moves a few pairs
-    np.testing.assert_allclose(g.results.g, curves["g_oo"], atol=1e-3)  # a pair moved across a bin edge
+    np.testing.assert_allclose(g.results.rdf, curves["g_oo"], atol=1e-3)  # a pair moved across a bin edge
     oxygens = u.select_atoms("name O")
-    ref = InterRDF(oxygens, oxygens, nbins=len(g.results.r), range=(0, 10 * g.results.r[-1] + 0.025),
+    half = 5.0 * plain_water.box.min()  # the default range: half the shortest edge, Angstrom
+    ref = InterRDF(oxygens, oxygens, nbins=int(half / 0.05 + 1e-9), range=(0, int(half / 0.05 + 1e-9) * 0.05),
                    exclusion_block=(1, 1)).run()
-    np.testing.assert_allclose(g.results.g, ref.results.rdf, atol=1e-3)  # float32 in nm and in Angstrom
-    assert 0.26 < g.results.peak.r < 0.30 and 2.3 < g.results.peak.height < 3.6  # liquid water's first shell
+    np.testing.assert_allclose(g.results.bins, ref.results.bins, rtol=1e-6)  # InterRDF's names and units
+    np.testing.assert_allclose(g.results.edges, ref.results.edges, rtol=1e-6)
+    np.testing.assert_allclose(g.results.rdf, ref.results.rdf, atol=1e-3)  # float32 in nm and in Angstrom
+    assert g.results.units == {"bins": "Angstrom", "edges": "Angstrom", "rdf": "", "rdf_se": "", "peak.r": "Angstrom",
+                               "peak.height": ""}
+    assert 2.6 < g.results.peak.r < 3.0 and 2.3 < g.results.peak.height < 3.6  # liquid water's first shell
+
+
+def test_radial_distribution_takes_interrdf_range_and_nbins_in_angstrom(plain_water):
+    from MDAnalysis.analysis.rdf import InterRDF
+
+    u = _dcd(plain_water)
+    g = RadialDistribution(u, nbins=40, range=(0.0, 6.0), n_blocks=2).run(stop=20)
+    oxygens = u.select_atoms("name O")
+    ref = InterRDF(oxygens, oxygens, nbins=40, range=(0.0, 6.0), exclusion_block=(1, 1)).run(stop=20)
+    np.testing.assert_allclose(g.results.edges, ref.results.edges, rtol=1e-12)
+    np.testing.assert_allclose(g.results.rdf, ref.results.rdf, atol=1e-6)
+    with pytest.raises(ValueError, match=r"range must be \(0, r_max\) in Angstrom.*got \(1.0, 6.0\)"):
+        RadialDistribution(u, range=(1.0, 6.0))
+    with pytest.raises(ValueError, match="nbins must be a positive integer, got 0"):
+        RadialDistribution(u, nbins=0)
+    with pytest.raises(TypeError, match="unexpected keyword argument 'r_max'"):  # the former nm keyword, refused
+        RadialDistribution(u, r_max=0.6)
 
 
 def test_msd_agrees_with_einstein_msd_on_the_centres_of_mass(plain_water):
@@ -145,8 +177,9 @@ def test_msd_agrees_with_einstein_msd_on_the_centres_of_mass(plain_water):
     u = mda.Universe.empty(len(p.molecules), trajectory=False)
     u.load_new(com * 10.0, format=MemoryReader)
     ref = EinsteinMSD(u.atoms, msd_type="xyz", fft=True).run()
-    np.testing.assert_allclose(d.results.msd, ref.results.timeseries[:len(d.results.msd)] / 100.0, rtol=1e-3,
-                               atol=1e-7)
+    lags = len(d.results.timeseries)
+    np.testing.assert_allclose(d.results.timeseries, ref.results.timeseries[:lags], rtol=1e-3, atol=1e-5)
+    np.testing.assert_allclose(d.results.msds_by_particle, ref.results.msds_by_particle[:lags], rtol=1e-3, atol=1e-4)
 
 
 @pytest.mark.parametrize("order", [1, 2])
@@ -170,7 +203,7 @@ def test_reorientation_agrees_with_waterdynamics(plain_water, order):
             frames = ours[name][:(n_frames // dt) * dt:dt]
             c = reorientation.legendre_correlation(frames, order, max_lag=1).mean(axis=1)[1]
             assert c == pytest.approx(theirs[dt - 1], abs=2e-5), (name, dt)
-    full = Reorientation(u, vectors=("HH",), orders=(order,), stop=n_frames).run()
+    full = Reorientation(u, vectors=("HH",), orders=(order,)).run(stop=n_frames)  # the frames compared above
     # its lag dt averages n_frames / dt origins of 64 waters (25 at dt = 4): agreement within that noise
     np.testing.assert_allclose(full.results.C["HH"][f"C{order}"][1:dtmax + 1], hh, atol=0.05)
 
@@ -228,3 +261,17 @@ def test_unevenly_spaced_frames_are_refused(plain_water):
     r = Reorientation(u, vectors=("HH",), orders=(1,))
     with pytest.raises(ValueError, match="not evenly spaced"):
         r.run(frames=[0, 1, 2, 4, 5, 6, 7, 8, 9, 10, 11, 12])
+
+
+@pytest.mark.parametrize("cls", [SelfDiffusion, Reorientation, AngularVelocityCorrelation, RadialDistribution,
+                                 KineticTemperatures])
+def test_frame_range_and_misspelt_keywords_are_refused(plain_water, cls):
+    """MDAnalysis' AnalysisBase takes **kwargs and ignores them: stop= given to a constructor would analyse every
+    frame without a word.  The classes refuse what they do not take, and say where the frame range goes."""
+    u = _dcd(plain_water)
+    by = {"by": "residues"} if cls is KineticTemperatures else {}  # the PDB has no bonds
+    with pytest.raises(TypeError, match=r"unexpected keyword argument 'stop'.*frames to analyse.*\.run\(\)"):
+        cls(u, stop=10, **by)
+    with pytest.raises(TypeError, match=r"unexpected keyword argument 'n_block'.*it takes .*'verbose'"):
+        cls(u, n_block=3, **by)
+    assert cls(u, verbose=True, **by)._verbose is True

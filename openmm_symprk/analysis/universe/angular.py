@@ -18,7 +18,7 @@ class AngularVelocityCorrelation(WaterFrames):
     (default half the analysed frames).  The librations live within ~0.1 ps: store frames every few fs.
 
     Results: ``lag_ps``, ``acf`` (C(t)), ``summary`` (:class:`~openmm_symprk.analysis.angular.AcfSummary`, ps),
-    ``omega`` (F, n, 3) rad/ps.
+    ``omega`` (F, n, 3) rad/ps; ``units``.
     """
 
     _needs_velocities = True
@@ -38,3 +38,4 @@ class AngularVelocityCorrelation(WaterFrames):
         acf, summary = angular.omega_correlation(omega, dt, min(max_lag, len(omega) - 1), self._n_groups)
         r = self.results
         r.omega, r.acf, r.summary, r.lag_ps = omega, acf, summary, np.arange(len(acf)) * dt
+        r.units = {"lag_ps": "ps", "acf": "", "omega": "rad/ps", "summary.t_zero": "ps", "summary.integral": "ps"}

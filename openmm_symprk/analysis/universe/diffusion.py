@@ -5,24 +5,34 @@ import numpy as np
 
 from .. import diffusion
 from ..molecules import centre_of_mass_trajectory
-from .base import WaterFrames
+from .base import ANGSTROM_IN_NM, WaterFrames
 
 __all__ = ["SelfDiffusion"]
 
+#: D's unit: 1e-5 cm^2/s (= 1e-9 m^2/s = 0.1 Angstrom^2/ps), the literature's for water.
+D_UNIT = "1e-5 cm^2/s"
+
 
 class SelfDiffusion(WaterFrames):
-    """Self-diffusion coefficient of the waters' centres of mass, 1e-5 cm^2/s, with its standard error.
+    """Self-diffusion coefficient of the waters' centres of mass, in 1e-5 cm^2/s (the unit of water's literature;
+    0.1 Angstrom^2/ps), with its standard error.
 
     Each frame's molecules are made whole, their centres of mass unwrapped across the box
     (:func:`~openmm_symprk.analysis.diffusion.unwrap`: frames must be stored often enough that no molecule moves
     0.4 of an edge between them), the common centre's motion taken out (``drift``), the MSD computed by FFT over
     every time origin and D = slope / 6 fitted over ``window_ps`` (t_min, t_max) ps, default (T/10, T/2) of the
     analysed time T (:func:`~openmm_symprk.analysis.diffusion.self_diffusion`; ``error``: "molecules" or
-    "blocks" with ``n_blocks``).  With ``viscosity_mpas`` and ``temperature_k`` the Yeh-Hummer finite-size
-    correction of a cubic box is added to give ``results.D_infinite``.
+    "blocks" with ``n_blocks``; ``max_lag``: the longest lag, frames).  With ``viscosity_mpas`` (mPa s) and
+    ``temperature_k`` (K) the Yeh-Hummer finite-size correction of a cubic box is added to give
+    ``results.D_infinite``.  Without a box in the trajectory the positions must be continuous: centres of mass
+    that jump by about the system's width between frames (positions wrapped into a box the file does not
+    store) are refused (:func:`~openmm_symprk.analysis.universe.checks.wrapped_problem`).
 
-    Results: ``D``, ``se``, ``fit`` (:class:`~openmm_symprk.analysis.diffusion.DiffusionFit`), ``lag_ps``,
-    ``msd`` (nm^2, molecule average), ``window_ps``; ``correction``, ``D_infinite`` (nan without a viscosity).
+    Results, in MDAnalysis' units (Angstrom, ps) and, where :class:`MDAnalysis.analysis.msd.EinsteinMSD` computes
+    the same, its names: ``timeseries`` (Angstrom^2, the MSD averaged over molecules at lags ``lag_ps``),
+    ``msds_by_particle`` (Angstrom^2, (lags, molecules)); ``D``, ``se``, ``correction``, ``D_infinite`` (nan
+    without a viscosity), all in 1e-5 cm^2/s; ``window_ps`` (the lags fitted, ps), ``error`` and ``n_samples``
+    (the molecules or blocks the error came from); ``units`` names each result's unit.
     """
 
     def __init__(self, atomgroup, window_ps=None, *, error: str = "molecules", n_blocks: int = 5,
@@ -33,6 +43,8 @@ class SelfDiffusion(WaterFrames):
             raise ValueError("the Yeh-Hummer correction needs both viscosity_mpas and temperature_k")
         self._options = dict(window_ps=window_ps, error=error, n_blocks=n_blocks, drift=drift, max_lag=max_lag)
         self._eta, self._temperature = viscosity_mpas, temperature_k
+
+    _needs_continuous = True
 
     def _analyse(self, x, v, box):
         w = self.waters
@@ -50,14 +62,18 @@ class SelfDiffusion(WaterFrames):
         fit = diffusion.self_diffusion(com, dt, window, error=o["error"], n_blocks=o["n_blocks"],
                                        max_lag=o["max_lag"], drift=o["drift"], weights=mol_mass)
         r = self.results
-        r.fit, r.D, r.se, r.lag_ps, r.msd, r.window_ps = fit, fit.D, fit.se, fit.lag_ps, fit.msd, fit.window_ps
+        nm2 = 1.0 / ANGSTROM_IN_NM**2
+        r.D, r.se, r.window_ps, r.error, r.n_samples = fit.D, fit.se, fit.window_ps, fit.error, fit.n_samples
+        r.lag_ps, r.timeseries, r.msds_by_particle = fit.lag_ps, fit.msd * nm2, fit.msds * nm2
         r.correction = r.D_infinite = float("nan")
+        r.units = {"D": D_UNIT, "se": D_UNIT, "D_infinite": D_UNIT, "correction": D_UNIT,
+                   "timeseries": "Angstrom^2", "msds_by_particle": "Angstrom^2", "lag_ps": "ps", "window_ps": "ps"}
         if self._eta is not None:
             if box is None:
                 raise ValueError("the Yeh-Hummer correction needs the box: the trajectory has none")
             edge = box.mean(axis=0)
             if np.ptp(edge) > 0.01 * edge.mean():
                 raise ValueError(f"the Yeh-Hummer correction here is for a cubic box; the mean edges are "
-                                 f"{np.round(edge, 4).tolist()} nm")
+                                 f"{np.round(edge / ANGSTROM_IN_NM, 3).tolist()} Angstrom")
             r.correction = diffusion.yeh_hummer(float(edge.mean()), self._temperature, self._eta)
             r.D_infinite = fit.D + r.correction

@@ -26,7 +26,7 @@ class Reorientation(WaterFrames):
     Results: ``lag_ps``; ``C[vector]["C1"]`` ... the curves (molecule average); ``tau[vector]["tau1"]``
     (:class:`~openmm_symprk.analysis.reorientation.CorrelationTime`, ps, or None); ``notes[vector]["tau1"]``
     says why a time is missing (a curve that does not decay to ``c_cut`` within the lags); ``dipole_from``:
-    "charges" or "bisector".
+    "charges" or "bisector"; ``units``.
     """
 
     def __init__(self, atomgroup, vectors=VECTORS, orders=(1, 2), *, max_lag: int | None = None,
@@ -71,3 +71,4 @@ class Reorientation(WaterFrames):
                     r.notes[name][f"tau{order}"] = str(exc)
                 r.tau[name][f"tau{order}"] = tau
         r.lag_ps = np.arange(len(next(iter(r.C.values()))[f"C{self._orders[0]}"])) * dt
+        r.units = {"lag_ps": "ps", "C": "", "tau": "ps"}

@@ -7,7 +7,7 @@ import numpy as np
 from ...conservation.analysis import group_masses, subgroups
 from ...physics.temperature import kinetic_temperatures
 from ...stats import block_stats, series_stats
-from .base import ANGSTROM_IN_NM, AnalysisBase
+from .base import ANGSTROM_IN_NM, AnalysisBase, refuse_unknown_keywords
 
 __all__ = ["KineticTemperatures"]
 
@@ -30,13 +30,14 @@ class KineticTemperatures(AnalysisBase):
 
     Results: ``translational``, ``rotational``, ``internal``, ``difference`` (rotational - translational), one
     value per frame; ``mean_translational`` ... their means and ``se_translational`` ... their standard errors
-    (nan with fewer than 4 frames); ``dof``.
+    (nan with fewer than 4 frames); ``dof``; ``units`` (K for all).
     """
 
     def __init__(self, atomgroup, masses=None, by: str = "fragments", momentum_fixed: bool = True,
-                 constraints: int | None = None, n_blocks: int | None = 10, **kwargs):
+                 constraints: int | None = None, n_blocks: int | None = 10, verbose: bool = False, **kwargs):
+        refuse_unknown_keywords(self, kwargs)
         atomgroup = getattr(atomgroup, "atoms", atomgroup)
-        super().__init__(atomgroup.universe.trajectory, **kwargs)
+        super().__init__(atomgroup.universe.trajectory, verbose=verbose)
         self._ag = atomgroup
         self._m = group_masses(atomgroup, masses)
         if by not in ("residues", "fragments", "segments"):
@@ -80,3 +81,4 @@ class KineticTemperatures(AnalysisBase):
                 else:
                     se = block_stats(series, min(int(self._n_blocks), self.n_frames // 2), dt).se
             self.results[f"se_{key}"] = se
+        self.results.units = {key: "K" for key in self.results if key not in ("dof",)}
