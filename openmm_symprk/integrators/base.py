@@ -15,18 +15,19 @@ program of :mod:`.custom_backend` or the plugin's SymPRKIntegrator of :mod:`.nat
 * copies: ``pickle``, ``copy.copy`` and ``copy.deepcopy`` go through OpenMM's XML serialization (as for
   OpenMM's own integrators) and give back the same Python class with its conveniences.
 
-* the thermostat's accessors (``temperature=`` of :func:`.thermostat.thermostat_settings`), in OpenMM's idiom:
-  ``getTemperature``/``setTemperature``, ``getCollisionTime``/``setCollisionTime``, ``getThermostatInterval``,
-  ``setRandomNumberSeed`` (checked), ``computeHeatBathEnergy``, ``thermostat_kinetic_energy`` (the kinetic energy
-  at the thermostat point), ``thermostat_position``, ``thermostat_dof`` /
-  ``getThermostatDegreesOfFreedom``; ``thermostat`` holds the :class:`.thermostat.ThermostatSettings` (None:
-  NVE).
+* the thermostat's settings, held once: ``thermostat`` is a read-only view of one frozen
+  :class:`.thermostat.ThermostatSettings` (None: NVE), which the setters replace through one method
+  (:meth:`IntegratorBase._set_thermostat`, which gives the backend's program or plugin the new value); and its
+  accessors in OpenMM's idiom: ``getTemperature``/``setTemperature``, ``getCollisionTime``/``setCollisionTime``,
+  ``getThermostatInterval``, ``setRandomNumberSeed`` (checked), ``computeHeatBathEnergy``,
+  ``thermostat_kinetic_energy`` (the kinetic energy at the thermostat point), ``computeSystemTemperature``,
+  ``thermostat_position``, ``thermostat_dof`` / ``getThermostatDegreesOfFreedom``.
 
 Backends implement the hooks ``_blowup_step()``, ``_clear_blowup()``, ``_raw_steps_taken()`` and may
-override ``_before_step()`` / ``_after_step()``; with a thermostat, ``_heat_bath_energy()`` (kJ/mol) and
-``_apply_thermostat(settings)`` (give the running program a new temperature or collision time),
-``_thermostat_kinetic_energy()`` (kJ/mol, after the last event), and may
-override ``_thermostat_values()`` where the program holds them (a checkpoint may bring back older ones).
+override ``_before_step()`` / ``_after_step()``; with a thermostat, ``_heat_bath_energy()`` (kJ/mol),
+``_apply_thermostat(settings)`` (give the program or the plugin these settings: the temperature and collision time,
+and the seed a Context takes when it is created), ``_thermostat_kinetic_energy()`` and
+``_thermostat_peculiar_kinetic_energy()`` (kJ/mol, after the last event).
 """
 from __future__ import annotations
 
@@ -83,7 +84,7 @@ class IntegratorBase:
     resolved = None  # the ResolvedMethod it runs (openmm_symprk.methods.resolved)
     options = None  # the IntegratorOptions it was built with (.options)
     program_info = None  # the ProgramInfo of its compiled program (.program)
-    thermostat = None  # ThermostatSettings as the program runs them now, None without a thermostat (NVE)
+    _thermostat = None  # the one holder of the thermostat's settings (ThermostatSettings; None: NVE)
     #: attributes a copy does not carry (the C++ object, per-Context handles)
     _transient: tuple = ("this", "thisown", "_context_ref")
 
@@ -188,20 +189,28 @@ class IntegratorBase:
 
     # -- the thermostat ---------------------------------------------------------------------------------
     @property
+    def thermostat(self):
+        """The thermostat's settings as the next step runs them (a frozen
+        :class:`~openmm_symprk.integrators.thermostat.ThermostatSettings`), None without a thermostat (NVE).  Read-only:
+        ``setTemperature``, ``setCollisionTime`` and ``setRandomNumberSeed`` change it."""
+        return self._thermostat
+
+    def _set_thermostat(self, settings):
+        """Replace the thermostat's settings: the one way they change (the backend's program or plugin is given them)."""
+        self._apply_thermostat(settings)
+        self._thermostat = settings
+
+    @property
     def has_thermostat(self) -> bool:
-        return self.thermostat is not None
+        return self._thermostat is not None
 
     def _require_thermostat(self, what: str):
         self._sync_run_state()
-        if self.thermostat is None:
+        if self._thermostat is None:
             raise ValueError(f"{type(self).__name__}({self.method_name}).{what}: this integrator was created without "
                              f"temperature=, so it runs NVE and has no thermostat; create it with e.g. "
                              f"temperature=300*unit.kelvin (and system=) for NVT")
-        return self._thermostat_values()
-
-    def _thermostat_values(self):
-        """The settings the program runs now (a backend whose program holds them reads them there)."""
-        return self.thermostat
+        return self._thermostat
 
     @property
     def thermostat_dof(self) -> int | None:
@@ -218,9 +227,7 @@ class IntegratorBase:
 
     def setTemperature(self, temperature):
         """Set the target temperature (a Quantity or a number of K); allowed while the integrator runs."""
-        settings = self._require_thermostat("setTemperature()").with_temperature(temperature)
-        self._apply_thermostat(settings)
-        self.thermostat = settings
+        self._set_thermostat(self._require_thermostat("setTemperature()").with_temperature(temperature))
 
     def getCollisionTime(self):
         """The thermostat's collision time tau (a Quantity in ps)."""
@@ -229,9 +236,7 @@ class IntegratorBase:
     def setCollisionTime(self, collision_time):
         """Set the collision time tau (a time Quantity or a number of ps): while the integrator runs on the custom
         backend; on the native backend only before its Context exists (tau is part of the checkpoint signature)."""
-        settings = self._require_thermostat("setCollisionTime()").with_collision_time(collision_time)
-        self._apply_thermostat(settings)
-        self.thermostat = settings
+        self._set_thermostat(self._require_thermostat("setCollisionTime()").with_collision_time(collision_time))
 
     def getThermostatInterval(self) -> int:
         """The thermostat acts every this many steps."""
@@ -241,10 +246,9 @@ class IntegratorBase:
         """OpenMM's setRandomNumberSeed, checked (an int from 0 to 2**31 - 1; 0: a fresh seed each time a Context
         is created).  As in OpenMM it takes effect when the next Context is created."""
         seed = check_seed(seed)
-        result = super().setRandomNumberSeed(seed)
-        if self.thermostat is not None:
-            self.thermostat = self.thermostat.with_seed(seed)
-        return result
+        if self._thermostat is None:
+            return super().setRandomNumberSeed(seed)
+        self._set_thermostat(self._thermostat.with_seed(seed))  # (which gives the program or the plugin the seed)
 
     def computeHeatBathEnergy(self):
         """The heat-bath energy (a Quantity in kJ/mol): minus the energy the thermostat gave the system, so that

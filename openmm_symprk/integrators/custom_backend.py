@@ -28,7 +28,7 @@ from . import program, thermostat_program
 from .backend import resolve_for_system
 from .base import CheckpointMismatchError, ConvergenceWarning, IntegratorBase, SystemMismatchError
 from .metadata import add_metadata, metadata
-from .options import OPTIONS, IntegratorOptions
+from .options import DEFAULT_MAX_ITERATIONS, DEFAULT_TOLERANCE, OPTIONS, IntegratorOptions, check_option_names
 from .projection import set_masses
 from .symplectic import SymplecticIntegrator
 
@@ -80,9 +80,19 @@ class PRKIntegrator(IntegratorBase, mm.CustomIntegrator):
 
     backend = "custom"
 
-    def __init__(self, stepSize, tableau, system: mm.System | None = None, name: str | None = None, **options):
-        self._compile(tableau, system, IntegratorOptions.build(type(self).__name__, stepSize, system, OPTIONS,
-                                                                ("name",), **options), name)
+    def __init__(self, stepSize, tableau, system: mm.System | None = None, name: str | None = None, *,
+                 exact_momentum=False, check_finite=True, max_speed=None, groups=None, inner_method=None,
+                 temperature=None, collision_time=None, thermostat_interval=None, random_seed=None,
+                 thermostat_position=None, constraints=None, allow_nonsymplectic=False, tolerance=DEFAULT_TOLERANCE,
+                 max_iterations=DEFAULT_MAX_ITERATIONS, **unknown):
+        check_option_names(unknown, OPTIONS | {"name"}, type(self).__name__)
+        options = IntegratorOptions.build(
+            type(self).__name__, stepSize, system, exact_momentum=exact_momentum, check_finite=check_finite,
+            max_speed=max_speed, groups=groups, inner_method=inner_method, temperature=temperature,
+            collision_time=collision_time, thermostat_interval=thermostat_interval, random_seed=random_seed,
+            thermostat_position=thermostat_position, constraints=constraints, allow_nonsymplectic=allow_nonsymplectic,
+            tolerance=tolerance, max_iterations=max_iterations)
+        self._compile(tableau, system, options, name)
 
     def _compile(self, method, system, options: IntegratorOptions, name: str | None = None):
         """Resolve ``method`` for ``system``, compile its program with ``options`` and record its metadata."""
@@ -92,9 +102,8 @@ class PRKIntegrator(IntegratorBase, mm.CustomIntegrator):
         mm.CustomIntegrator.__init__(self, options.step_size)
         self._set_program(r, options, program.compile_program(self, r, options, has_sites))
         self._masses = masses(system) if options.exact_momentum or options.thermostat is not None else None
-        self.thermostat = options.thermostat
         if options.thermostat is not None:
-            mm.CustomIntegrator.setRandomNumberSeed(self, options.thermostat.seed)
+            self._set_thermostat(options.thermostat)
         self._reset_binding()
         add_metadata(self, metadata(type(self).__name__, method, r, options))
 
@@ -225,27 +234,21 @@ class PRKIntegrator(IntegratorBase, mm.CustomIntegrator):
         self.setPerDofVariableByName(thermostat_program.MASK_VAR,
                                      thermostat_program.mask_values(m, self.thermostat.dof))
 
-    def _program_thermostat_values(self):
-        """The settings with the temperature and collision time the program's variables hold (an integrator read from
-        XML: as they were last set) and the seed OpenMM will use."""
-        if self.thermostat is None:
-            return None
+    def program_thermostat_settings(self, settings):
+        """``settings`` with the temperature, collision time and seed this program holds (an integrator read from XML:
+        as they were last set, where its metadata has them as created)."""
         get = self.getGlobalVariableByName
-        return replace(self.thermostat, temperature=get(thermostat_program.TEMPERATURE_VAR),
+        return replace(settings, temperature=get(thermostat_program.TEMPERATURE_VAR),
                        collision_time=get(thermostat_program.COLLISION_TIME_VAR),
                        seed=int(mm.CustomIntegrator.getRandomNumberSeed(self)))
 
-    def _thermostat_values(self):
-        """The integrator's settings (the ones the next step runs: a checkpoint or a State that brought back the program's
-        older temperature or collision time is overruled before it, :meth:`_keep_thermostat_settings`, as on the native
-        backend) with the seed OpenMM will use."""
-        if self.thermostat is None:
-            return None
-        return replace(self.thermostat, seed=int(mm.CustomIntegrator.getRandomNumberSeed(self)))
-
     def _apply_thermostat(self, settings):
+        """The program's variables (temperature, collision time) and OpenMM's seed for the next Context.  (A checkpoint
+        or a State may bring back the program's older values: :meth:`_keep_thermostat_settings` overrules them before
+        the next step, as the native backend, whose plugin is not in the checkpoint, does.)"""
         self.setGlobalVariableByName(thermostat_program.TEMPERATURE_VAR, settings.temperature)
         self.setGlobalVariableByName(thermostat_program.COLLISION_TIME_VAR, settings.collision_time)
+        mm.CustomIntegrator.setRandomNumberSeed(self, int(settings.seed))
 
     def _heat_bath_energy(self) -> float:
         return self.getGlobalVariableByName(thermostat_program.HEAT_BATH_VAR)
@@ -349,7 +352,7 @@ class PRKIntegrator(IntegratorBase, mm.CustomIntegrator):
         if r.is_mts:
             lines.append("  " + r.describe_levels())
         if self.thermostat is not None:
-            lines.append("  " + self._thermostat_values().describe(r.thermostat_position))
+            lines.append("  " + self.thermostat.describe(r.thermostat_position))
         return "\n".join(lines)
 
 
@@ -358,8 +361,6 @@ class CustomSymplecticIntegrator(SymplecticIntegrator, PRKIntegrator, backend="c
     builds, and what ``backend="auto"`` builds for implicit and general tableaux.  Parameters: those of
     :class:`~openmm_symprk.integrators.symplectic.SymplecticIntegrator` and :class:`PRKIntegrator`."""
 
-    def __init__(self, stepSize, method="verlet", system: mm.System | None = None, backend: str = "custom",
-                 **options):
+    def __init__(self, stepSize, method="verlet", system: mm.System | None = None, backend: str = "custom", **options):
         self._check_backend(backend)
-        self._compile(method, system, IntegratorOptions.build(type(self).__name__, stepSize, system, OPTIONS,
-                                                               **options))
+        PRKIntegrator.__init__(self, stepSize, method, system, **options)

@@ -29,10 +29,10 @@ from .. import plugin
 from ..methods.resolved import Substep, SubstepKind
 from .backend import resolve_for_system
 from .base import IntegratorBase
-from .options import NATIVE_OPTIONS, IntegratorOptions
+from .options import NATIVE_OPTIONS, IntegratorOptions, check_option_names
+from .thermostat import ThermostatSettings
 from .program import ProgramInfo
 from .symplectic import SymplecticIntegrator
-from .thermostat import ThermostatSettings
 
 __all__ = ["NativeSymplecticIntegrator", "native_available"]
 
@@ -60,9 +60,16 @@ class NativeSymplecticIntegrator(SymplecticIntegrator, _PluginIntegrator, backen
     Raises NativeUnavailableError (with the reason and the fix) when the plugin is unavailable and NativeMethodError
     for implicit and general tableaux, which only the CustomIntegrator backend runs."""
 
-    def __init__(self, stepSize, method="verlet", system=None, backend="native", **options):
+    def __init__(self, stepSize, method="verlet", system=None, backend="native", *, exact_momentum=False,
+                 check_finite=True, max_speed=None, groups=None, inner_method=None, temperature=None,
+                 collision_time=None, thermostat_interval=None, random_seed=None, thermostat_position=None, **unknown):
         self._check_backend(backend)
-        opts = IntegratorOptions.build(type(self).__name__, stepSize, system, NATIVE_OPTIONS, ("backend",), **options)
+        check_option_names(unknown, NATIVE_OPTIONS | {"backend"}, type(self).__name__)
+        opts = IntegratorOptions.build(
+            type(self).__name__, stepSize, system, exact_momentum=exact_momentum, check_finite=check_finite,
+            max_speed=max_speed, groups=groups, inner_method=inner_method, temperature=temperature,
+            collision_time=collision_time, thermostat_interval=thermostat_interval, random_seed=random_seed,
+            thermostat_position=thermostat_position)
         if _swig is None:
             raise plugin.NativeUnavailableError(f"the native backend is unavailable: {plugin.unavailable_reason()}. "
                                                 f"To fix it, {plugin.fix_hint()}.")
@@ -80,7 +87,7 @@ class NativeSymplecticIntegrator(SymplecticIntegrator, _PluginIntegrator, backen
         if opts.system is not None:
             self.setExpectedSystem(opts.system.n_particles, r.constraints)
         if opts.thermostat is not None:
-            self.thermostat = opts.thermostat  # the property below hands it to the plugin
+            self._set_thermostat(opts.thermostat)
         self._set_program(r, opts)
 
     def _set_program(self, r, options, notes=()):
@@ -108,39 +115,28 @@ class NativeSymplecticIntegrator(SymplecticIntegrator, _PluginIntegrator, backen
         self.this = typed.this
         self.thisown = own
 
-    # -- the thermostat: the plugin holds its settings -------------------------------------------------------
-    @property
-    def thermostat(self):
-        """The thermostat's settings (:class:`~openmm_symprk.integrators.thermostat.ThermostatSettings`), read from
-        the plugin; None without a thermostat."""
+    # -- the thermostat: the plugin is given the settings the integrator holds ----------------------------------------
+    def plugin_thermostat_settings(self, position: str):
+        """The thermostat's settings as the plugin holds them (an integrator read from XML), with its placement
+        ``position`` (None without a thermostat)."""
         if not self.hasThermostat():
             return None
-        asked = self.options.thermostat if self.options is not None and self.options.thermostat is not None else None
-        middle = any(self.getSubstepKind(i) == SubstepKind.THERMOSTAT for i in range(self.getNumSubsteps()))
-        position = asked.position if asked is not None else ("middle" if middle else "ends")
-        return ThermostatSettings(float(self.getThermostatTemperature()), float(_PluginIntegrator.getCollisionTime(self)),
-                                  int(_PluginIntegrator.getThermostatInterval(self)), int(self.getRandomNumberSeed()),
-                                  int(self.getThermostatDof()), bool(self.getThermostatKeepsRotation()), position)
-
-    @thermostat.setter
-    def thermostat(self, settings):
-        if settings is None:
-            if self.hasThermostat():
-                raise ValueError("the thermostat of a NativeSymplecticIntegrator cannot be removed: create an integrator "
-                                 "without temperature= for an NVE run")
-            return
-        self._apply_thermostat(settings)
-        _PluginIntegrator.setRandomNumberSeed(self, int(settings.seed))
+        return ThermostatSettings(temperature=float(self.getThermostatTemperature()),
+                                  collision_time=float(_PluginIntegrator.getCollisionTime(self)),
+                                  interval=int(_PluginIntegrator.getThermostatInterval(self)),
+                                  seed=int(_PluginIntegrator.getRandomNumberSeed(self)), dof=int(self.getThermostatDof()),
+                                  keep_rotation=bool(self.getThermostatKeepsRotation()), position=position)
 
     def _apply_thermostat(self, settings):
-        current = self.thermostat
-        if current is not None and current.temperature != settings.temperature:
-            self.setThermostatTemperature(float(settings.temperature))  # allowed while bound
+        """Give the plugin ``settings``: the temperature at any time, the seed for the next Context, the rest before the
+        Context exists (its checkpoints and program signature carry the collision time, interval and degrees of
+        freedom)."""
+        current = self._thermostat
         if current is None or (current.collision_time, current.interval, current.dof, current.keep_rotation) != \
                 (settings.collision_time, settings.interval, settings.dof, settings.keep_rotation):
             try:
-                self.setThermostat(float(settings.temperature), float(settings.collision_time), int(settings.interval),
-                                   int(settings.dof), bool(settings.keep_rotation))
+                self.setThermostat(settings.temperature, settings.collision_time, settings.interval, settings.dof,
+                                   settings.keep_rotation)
             except mm.OpenMMException as exc:
                 if "bound" not in str(exc):
                     raise
@@ -148,6 +144,9 @@ class NativeSymplecticIntegrator(SymplecticIntegrator, _PluginIntegrator, backen
                                  f"{current.collision_time:g} ps to {settings.collision_time:g} ps) once the integrator "
                                  f"runs a Context: its checkpoints and program signature carry it. Set it before "
                                  f"creating the Context, or create a new integrator") from None
+        elif current.temperature != settings.temperature:
+            self.setThermostatTemperature(settings.temperature)  # allowed while bound
+        _PluginIntegrator.setRandomNumberSeed(self, int(settings.seed))
 
     def _heat_bath_energy(self) -> float:
         return float(self.getHeatBathEnergy())

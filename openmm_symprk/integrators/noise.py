@@ -69,7 +69,8 @@ def _native(dof: int, count: int, platform: str, seed: int, properties) -> tuple
     swig = plugin.swig_module()
     if swig is None:
         raise plugin.NativeUnavailableError(f"the native backend is unavailable: {plugin.unavailable_reason()}")
-    integrator = swig.SymPRKIntegrator(0.001, [0, 1, 0], [0.5, 1.0, 0.5], [-1, -1, -1], [0, 0, 0])
+    # velocity Verlet between the ends placement's two half events (thermostat, kick, drift, kick, thermostat)
+    integrator = swig.SymPRKIntegrator(0.001, [2, 0, 1, 0, 2], [0.5, 0.5, 1.0, 0.5, 0.5], [-1] * 5, [4, 2, 0, 0, 8])
     integrator.setThermostat(300.0, 0.1, 1, int(dof), False)
     integrator.setRandomNumberSeed(int(seed))
     context = _context(_system(max(2, math.ceil(dof / 3))), integrator, platform, properties)

@@ -106,27 +106,30 @@ class IntegratorOptions:
     max_iterations: int = DEFAULT_MAX_ITERATIONS
 
     @classmethod
-    def build(cls, where: str, step_size, system=None, accepted=OPTIONS, keywords=(), **options) -> IntegratorOptions:
-        """The checked options of ``where`` (the class name, for messages): ``options`` must be names of
-        ``accepted``; ``keywords`` are the class's other keyword arguments, named in the unknown-option message."""
-        check_option_names(options, set(accepted) | set(keywords), where)
+    def build(cls, where: str, step_size, system=None, *, exact_momentum=False, check_finite=True, max_speed=None,
+              groups=None, inner_method=None, temperature=None, collision_time=None, thermostat_interval=None,
+              random_seed=None, thermostat_position=None, constraints=None, allow_nonsymplectic=False,
+              tolerance=DEFAULT_TOLERANCE, max_iterations=DEFAULT_MAX_ITERATIONS) -> IntegratorOptions:
+        """The checked options of ``where`` (the class name, for messages), each by its name (the module docstring
+        lists them).  A class refuses the names it does not take before it calls this (:func:`check_option_names`)."""
         dt = step_size_in_ps(step_size)
-        max_speed = check_max_speed(options.get("max_speed"))
-        constraints = options.get("constraints")
+        max_speed = check_max_speed(max_speed)
         if constraints is not None and not isinstance(constraints, bool):
             raise TypeError(f"constraints must be True, False or None (from system=), got {constraints!r}")
-        tolerance = _check_tolerance(options.get("tolerance", DEFAULT_TOLERANCE))
-        max_iterations = _check_max_iterations(options.get("max_iterations", DEFAULT_MAX_ITERATIONS))
-        exact_momentum = bool(options.get("exact_momentum", False))
+        tolerance = _check_tolerance(tolerance)
+        max_iterations = _check_max_iterations(max_iterations)
+        exact_momentum = bool(exact_momentum)
         if exact_momentum and system is None:
             raise ValueError("exact_momentum=True needs system= (the System the integrator will run): the "
                              "projection is only right for an isolated System, which is checked, and it uses the "
                              "System's masses")
         if system is not None:
             check_system_type(system)
-        thermostat = thermostat_settings(system, *(options.get(k) for k in THERMOSTAT_OPTIONS))
-        groups = options.get("groups")
-        return cls(dt, signature(system) if system is not None else None, exact_momentum,
-                   bool(options.get("check_finite", True)), max_speed,
-                   mts_groups(groups) if groups is not None else None, options.get("inner_method"), thermostat,
-                   constraints, bool(options.get("allow_nonsymplectic", False)), tolerance, max_iterations)
+        thermostat = thermostat_settings(system, temperature=temperature, collision_time=collision_time,
+                                         thermostat_interval=thermostat_interval, random_seed=random_seed,
+                                         thermostat_position=thermostat_position)
+        return cls(step_size=dt, system=signature(system) if system is not None else None,
+                   exact_momentum=exact_momentum, check_finite=bool(check_finite), max_speed=max_speed,
+                   groups=mts_groups(groups) if groups is not None else None, inner_method=inner_method,
+                   thermostat=thermostat, constraints=constraints, allow_nonsymplectic=bool(allow_nonsymplectic),
+                   tolerance=tolerance, max_iterations=max_iterations)

@@ -25,12 +25,10 @@ One compiler for everything (docs/openmm_notes.md explains each rule):
 * The blow-up check: the first step at which some velocity is NaN or infinite (or faster than a given
   speed) is kept in a global variable.
 * Optional thermostat (:mod:`.thermostat_program`, only with ``thermostat=`` settings: without them not one
-  computation or variable differs from the NVE program): a half velocity-rescaling event after the header,
-  before the first sub-step of every ``interval`` steps, and one after the end-of-step velocity projection
-  of the ``interval``-th step (Trotter splitting; ``if`` blocks on the step counter when interval > 1).  With
-  multiple time stepping the events wrap the outer step, which is the whole program.  The middle placement
-  (a method resolved with ``thermostat_position="middle"``) has no end events: one whole event at the method's
-  THERMOSTAT sub-step, the centre of the (outer) step, in step i where i mod n = (n - 1) // 2.
+  computation or variable differs from the NVE program): each THERMOSTAT sub-step of the resolved method is an
+  event over its fraction of the interval, in an ``if`` block on the step counter for the step of the interval its
+  phase names when the interval n > 1.  Where the events sit is the resolved method's (resolve with
+  ``thermostat_position``); the program runs its sub-steps in order.
 """
 from __future__ import annotations
 
@@ -40,7 +38,7 @@ from dataclasses import dataclass
 import numpy as np
 import openmm as mm
 
-from ..methods.resolved import ResolvedMethod, SubstepKind
+from ..methods.resolved import EventPhase, ResolvedMethod, SubstepKind
 from .options import IntegratorOptions
 
 #: Global variables every compiled program has, in this order (read by the integrator classes).
@@ -95,13 +93,11 @@ def _num(c) -> str:
 class _Emitter:
     """Appends computations to a CustomIntegrator, with the shared header, kick and drift rules."""
 
-    def __init__(self, integrator: mm.CustomIntegrator, constraints: bool, exact_momentum: bool, thermostat=None,
-                 thermostat_ends: bool = True):
+    def __init__(self, integrator: mm.CustomIntegrator, constraints: bool, exact_momentum: bool, thermostat=None):
         if integrator.getNumComputations() or integrator.getNumGlobalVariables() or integrator.getNumPerDofVariables():
             raise ValueError("compile into an empty CustomIntegrator: this one already has a program")
         self.ig = integrator
         self.thermostat = thermostat
-        self.thermostat_ends = thermostat is not None and thermostat_ends
         self.constraints = constraints
         self.exact_momentum = exact_momentum
         self._vars: set = set()
@@ -118,32 +114,22 @@ class _Emitter:
             add_variables(integrator, thermostat)
         integrator.addUpdateContextState()
         self._probe()
-        self._thermostat_event(STEP_VAR)
 
-    def middle_thermostat_event(self, fraction):
-        """The thermostat event of a THERMOSTAT sub-step (the middle placement), over ``fraction`` of the step: in
-        step i (counted from 0) where i mod n = (n - 1) // 2 for interval n, with c = exp(-fraction n dt/tau), so that
-        the event sits at the centre of its n steps."""
+    def thermostat_event(self, sub, name: str):
+        """A THERMOSTAT sub-step: its velocity projection where flagged (every step), then the event over its
+        fraction of the interval, in an ``if`` block for the step of the interval its phase names when the
+        thermostat acts every n > 1 steps (the step counter counts from 0 and is advanced at the end of the step)."""
         from .thermostat_program import emit_event
 
+        if self.thermostat is None:
+            raise ValueError(f"{name}: the method was resolved with thermostat events, but the options have no "
+                             f"thermostat (temperature=)")
+        if sub.project_before:
+            self.project_velocities()
         n = int(self.thermostat.interval)
         if n > 1:
-            self.ig.beginIfBlock(f"abs({STEP_VAR} - {n}*floor({STEP_VAR}/{n}) - {(n - 1) // 2}) < 0.5")
-        emit_event(self.ig, self.thermostat, float(fraction))
-        if n > 1:
-            self.ig.endBlock()
-
-    def _thermostat_event(self, counter: str):
-        """A half thermostat event of the ends placement, in an ``if`` block on ``counter`` (a multiple of the
-        interval) when the thermostat acts every n > 1 steps."""
-        if not self.thermostat_ends:
-            return
-        from .thermostat_program import emit_half_event
-
-        n = int(self.thermostat.interval)
-        if n > 1:
-            self.ig.beginIfBlock(f"{counter} - {n}*floor(({counter})/{n}) < 0.5")
-        emit_half_event(self.ig, self.thermostat)
+            self.ig.beginIfBlock(_in_step_of_interval(sub.phase, n))
+        emit_event(self.ig, self.thermostat, float(sub.coefficient))
         if n > 1:
             self.ig.endBlock()
 
@@ -216,15 +202,17 @@ class _Emitter:
 
                 emit_drift_restoration(self.ig, "symprk_xu", f"{_num(c)}*dt")
 
-    def finish(self, check_finite: bool, max_speed: float = 0.0) -> int:
-        """End the step (velocity projection, counter, blow-up check); set and return the signature."""
+    def close_rattle(self):
+        """RATTLE's closing velocity projection, after the last kick or drift (constraints only)."""
         if self.constraints and self.exact_momentum:
             from .projection import emit_constrain_velocities
 
             emit_constrain_velocities(self.ig)
         elif self.constraints:
             self.ig.addConstrainVelocities()
-        self._thermostat_event(f"{STEP_VAR} + 1")
+
+    def finish(self, check_finite: bool, max_speed: float = 0.0) -> int:
+        """End the step (counter, blow-up check); set and return the signature."""
         self.ig.addComputeGlobal(STEP_VAR, f"{STEP_VAR} + 1")
         if check_finite:
             # Count the degrees of freedom whose speed is NaN (every comparison with NaN is false, so
@@ -244,24 +232,31 @@ def _compile_splitting(integrator, method: ResolvedMethod, constraints: bool, op
     """Emit the program of a resolved kick/drift method: its sub-steps as they run, with a velocity projection
     before every drift flagged for one.  ``constraints``: emit the RATTLE steps (the System has constraints, or
     virtual sites that only ConstrainPositions places on the Common platforms)."""
-    em = _Emitter(integrator, constraints, options.exact_momentum, options.thermostat,
-                  thermostat_ends=method.thermostat_position != "middle")
-    for sub in method.substeps:
+    em = _Emitter(integrator, constraints, options.exact_momentum, options.thermostat)
+    last = max(i for i, sub in enumerate(method.substeps) if sub.is_kick_or_drift)
+    for i, sub in enumerate(method.substeps):
         c = float(sub.coefficient)
         if sub.kind == SubstepKind.THERMOSTAT:
-            if options.thermostat is None:
-                raise ValueError(f"{method.name}: the method was resolved with a thermostat sub-step, but the options "
-                                 f"have no thermostat (temperature=)")
-            if sub.project_before:
-                em.project_velocities()
-            em.middle_thermostat_event(c)
+            em.thermostat_event(sub, method.name)
         elif sub.kind == SubstepKind.DRIFT:
             if sub.project_before:
                 em.project_velocities()
             em.drift(c)
         else:
             em.kick(c, sub.groups)
+        if i == last:
+            em.close_rattle()
     return ProgramInfo(method, constraints, em.finish(options.check_finite, options.max_speed))
+
+
+def _in_step_of_interval(phase: EventPhase, n: int) -> str:
+    """The condition (on the step counter, which counts steps from 0) that holds in the step of every interval of
+    ``n`` steps that ``phase`` names (:meth:`EventPhase.step_in`)."""
+    if phase is EventPhase.FIRST:
+        return f"{STEP_VAR} - {n}*floor(({STEP_VAR})/{n}) < 0.5"
+    if phase is EventPhase.LAST:  # the counter is advanced after the event: this step's number is counter + 1
+        return f"{STEP_VAR} + 1 - {n}*floor(({STEP_VAR} + 1)/{n}) < 0.5"
+    return f"abs({STEP_VAR} - {n}*floor({STEP_VAR}/{n}) - {phase.step_in(n)}) < 0.5"
 
 
 def _lincomb(base: str, coeffs, names) -> str:
@@ -279,6 +274,10 @@ def _compile_tableau(integrator, method: ResolvedMethod, options: IntegratorOpti
     symprk_p<i> (stage velocities P_i), symprk_q<i> (implicit stage positions).  ``place_virtual_sites``
     ends the step with a ConstrainPositions (which only places virtual sites in an unconstrained System)."""
     em = _Emitter(integrator, False, options.exact_momentum, options.thermostat)
+    # the thermostat's events around the stages: those of the first step of its interval before them, the rest after
+    before = [sub for sub in method.substeps if sub.phase is EventPhase.FIRST]
+    for sub in before:
+        em.thermostat_event(sub, method.name)
     tab = method.tableau
     tolerance, max_iterations = options.tolerance, options.max_iterations
     s = tab.stages
@@ -350,6 +349,8 @@ def _compile_tableau(integrator, method: ResolvedMethod, options: IntegratorOpti
     integrator.addComputePerDof("v", _lincomb("symprk_v0", bh, k))
     if place_virtual_sites:
         integrator.addConstrainPositions()
+    for sub in method.substeps[len(before):]:
+        em.thermostat_event(sub, method.name)
     return ProgramInfo(method, False, em.finish(options.check_finite, options.max_speed), tuple(notes))
 
 

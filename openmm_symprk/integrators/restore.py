@@ -21,7 +21,7 @@ import openmm.unit as unit
 from .. import plugin
 from ..methods.catalogue import methods as catalogue_methods
 from ..methods.placement import THERMOSTAT
-from ..methods.resolved import SubstepKind, resolve
+from ..methods.resolved import SubstepFlag, SubstepKind, resolve
 from ..methods.splitting import Splitting
 from . import program
 from .backend import resolve_for_system
@@ -75,9 +75,10 @@ def _restore_custom(integrator: mm.CustomIntegrator):
     obj = object.__new__(cls)
     obj._adopt(integrator)
     obj._set_program(resolved, options, replace(info, notes=(*info.notes, "restored from XML")))
-    obj.__dict__.update(_masses=None, thermostat=options.thermostat)
+    obj.__dict__.update(_masses=None)
     # the program holds the temperature and collision time as they were last set (the metadata: as created)
-    obj.thermostat = obj._program_thermostat_values()
+    if options.thermostat is not None:
+        obj._thermostat = obj.program_thermostat_settings(options.thermostat)
     obj._reset_binding()
     obj._forget_run_state()
     return obj
@@ -104,8 +105,10 @@ def _restore_native(integrator):
     constraints = bool(obj.getExpectedConstraints()) if expected >= 0 else True
     plugin_steps = [(obj.getSubstepKind(i), obj.getSubstepCoefficient(i), obj.getSubstepForceGroups(i),
                      obj.getSubstepFlags(i)) for i in range(obj.getNumSubsteps())]
-    # the thermostat's placement: a THERMOSTAT sub-step is the middle one (resolve puts it back at the centre)
-    middle = any(kind == SubstepKind.THERMOSTAT for kind, *_ in plugin_steps)
+    # the thermostat's placement: an event in the centre step of the interval is the middle one (resolve puts it back
+    # at the centre), events in the first and last steps are the ends'
+    edges = SubstepFlag.FIRST_OF_INTERVAL | SubstepFlag.LAST_OF_INTERVAL
+    middle = any(kind == SubstepKind.THERMOSTAT and not flags & edges for kind, _, _, flags in plugin_steps)
     position = "middle" if middle else ("ends" if obj.hasThermostat() else None)
 
     def runs_as_plugin(r):
@@ -126,9 +129,11 @@ def _restore_native(integrator):
             resolved = replace(resolved, entry=entry, order=entry.order, constrained_order=entry.constrained_order,
                                stability=entry.stability)
     # the plugin holds these options; check_finite is Python's (True), system= is held as the expected particle count
+    settings = obj.plugin_thermostat_settings(position)
     options = IntegratorOptions(float(obj.getStepSize().value_in_unit(unit.picosecond)),
                                 exact_momentum=bool(obj.getExactMomentum()), max_speed=float(obj.getMaxSpeed()),
-                                thermostat=obj.thermostat)
+                                thermostat=settings)
+    obj._thermostat = settings
     obj._set_program(resolved, options, notes=("restored from XML",))
     obj._reset_binding()
     return obj

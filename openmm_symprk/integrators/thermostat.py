@@ -16,7 +16,7 @@ import numpy as np
 import openmm as mm
 import openmm.unit as unit
 
-from ..methods.placement import POSITIONS
+from ..methods.placement import check_position
 from ..physics.temperature import R_KJ
 from ..physics.velocity_rescaling import peculiar_kinetic_energy, relaxation_factor
 from ..systems.checks import EXACT_MOMENTUM_FORBIDDEN, check_system_type, conservation_issues
@@ -70,15 +70,6 @@ def check_interval(interval) -> int:
         raise ValueError(f"thermostat_interval must be at most {MAX_INTERVAL} (the native plugin holds it in a 32-bit "
                          f"integer; an interval that long is an NVE run: drop temperature= for one), got {n}")
     return n
-
-
-def check_position(position) -> str:
-    """``thermostat_position``: "ends" (half an event before and after the step), "middle" (one event at the exact
-    centre of the step) or "auto" (the one :func:`openmm_symprk.methods.placement.best_position` picks for the
-    method: "middle" for verlet, "ends" for omelyan-2 and the higher-order methods)."""
-    if not isinstance(position, str) or position not in POSITIONS:
-        raise ValueError(f"thermostat_position must be one of {', '.join(map(repr, POSITIONS))}, got {position!r}")
-    return position
 
 
 def check_seed(seed) -> int:
@@ -170,7 +161,7 @@ class ThermostatSettings:
                 f"freedom, {kept}, seed {self.seed if self.seed else 'fresh per Context'}")
 
 
-def thermostat_settings(system, temperature=None, collision_time=None, thermostat_interval=None,
+def thermostat_settings(system, *, temperature=None, collision_time=None, thermostat_interval=None,
                         random_seed=None, thermostat_position=None) -> ThermostatSettings | None:
     """The checked thermostat settings of an integrator's options, or None without ``temperature``.
 

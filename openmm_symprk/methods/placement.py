@@ -20,7 +20,7 @@ from fractions import Fraction
 
 import numpy as np
 
-__all__ = ["THERMOSTAT", "POSITIONS", "centre", "with_thermostat", "harmonic_sampling", "placement_errors",
+__all__ = ["THERMOSTAT", "POSITIONS", "check_position", "centre", "with_thermostat", "harmonic_sampling", "placement_errors",
            "best_position", "H_OMEGA_GRID"]
 
 #: The label of a thermostat event in a step sequence.
@@ -30,6 +30,16 @@ POSITIONS = ("ends", "middle", "auto")
 #: The h*omega values over which "auto" compares the placements: water's librations at 1-4 fs span about
 #: 0.13-0.5, an O-H stretch at 1 fs about 0.9.
 H_OMEGA_GRID = (0.25, 0.5, 0.75, 1.0)
+
+
+def check_position(position) -> str:
+    """``position`` if it is one of :data:`POSITIONS` ("ends": half an event before and after the step; "middle": one
+    event at the exact centre of the step; "auto": the one :func:`best_position` picks for the method); ValueError
+    naming the accepted values otherwise.  The one check of a placement, for the integrators' option and
+    :func:`openmm_symprk.methods.resolved.resolve` alike."""
+    if not isinstance(position, str) or position not in POSITIONS:
+        raise ValueError(f"thermostat_position must be one of {', '.join(map(repr, POSITIONS))}, got {position!r}")
+    return position
 
 
 def centre(steps) -> int:

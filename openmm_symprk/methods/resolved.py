@@ -16,9 +16,16 @@ numbers as the plugin's ``SymPRKIntegrator::SubstepKind``), its velocity project
 (:class:`SubstepFlag`, the plugin's ``SymPRKIntegrator::SubstepFlag``), the force evaluations per step, and
 the catalogue's order, constrained order and stability interval.  The result is frozen and hashable.
 
-The projection rule (:func:`projected_drifts`) and the cached-force rule
-(:attr:`~.splitting.Splitting.evaluating_kicks`) are written here and in :mod:`.splitting` only: the
-CustomIntegrator compiler and the native kernels are sent the flags and do not derive them again.
+``substeps`` is the whole step, in the order it runs: the kicks and drifts and the thermostat's events where they
+sit, each event with the fraction of the step it relaxes over and the step of the thermostat's interval it runs in
+(:class:`EventPhase`).  Under constraints the kicks and drifts are RATTLE's, whose last part is a velocity projection
+right after the last kick or drift (before an ends placement's closing event).  (A general PRK pair's stages are its
+``tableau``; its sub-steps are only the thermostat's events around them.)
+
+The projection rule (:func:`projected_drifts`), the cached-force rule
+(:attr:`~.splitting.Splitting.evaluating_kicks`) and the thermostat's schedule (:func:`resolve` with
+``thermostat_position``) are written here and in :mod:`.splitting` only: the CustomIntegrator compiler and the native
+kernels are sent the sub-steps with their flags and execute them; neither decides anything about the step.
 """
 from __future__ import annotations
 
@@ -29,13 +36,13 @@ from fractions import Fraction
 import numpy as np
 
 from .catalogue import Method, get_method
-from .placement import POSITIONS, THERMOSTAT, best_position, centre
+from .placement import THERMOSTAT, best_position, centre, check_position
 from .respa import MTSError, evaluations_per_step, label_groups, levels, mts_groups, respa
 from .splitting import DRIFT, KICK, Splitting
 from .tableau import PRKTableau, TableauError
 
-__all__ = ["resolve", "thermostat_position_for", "ResolvedMethod", "Substep", "SubstepKind", "SubstepFlag", "ConstraintSupportError",
-           "projected_drifts", "FORMS"]
+__all__ = ["resolve", "thermostat_position_for", "ResolvedMethod", "Substep", "SubstepKind", "SubstepFlag", "EventPhase",
+           "ConstraintSupportError", "projected_drifts", "FORMS"]
 
 #: The form of a step, which decides how it runs: a kick/drift sequence (any splitting or composition, multiple time
 #: stepping included), an explicit general PRK pair, or an implicit one (stages solved by fixed-point iteration).
@@ -49,7 +56,7 @@ class SubstepKind(IntEnum):
 
     KICK = 0  # v += c*dt*F/m
     DRIFT = 1  # x += c*dt*v (RATTLE under constraints)
-    THERMOSTAT = 2  # a thermostat event over the fraction c of the step (c = 1: one whole event, the middle placement)
+    THERMOSTAT = 2  # a thermostat event over the fraction c of the step's interval (1/2 at the ends, 1 in the middle)
 
 
 class SubstepFlag(IntFlag):
@@ -58,6 +65,23 @@ class SubstepFlag(IntFlag):
     NONE = 0
     PROJECT_BEFORE = 1  # a drift or a thermostat event: project the velocities onto the constraints first
     FORCES_CACHED = 2  # a kick: its force groups' forces are still those of the current positions
+    FIRST_OF_INTERVAL = 4  # a thermostat event: runs in the first step of every thermostat interval
+    LAST_OF_INTERVAL = 8  # a thermostat event: runs in the last step (neither: in the centre step, (n - 1) // 2)
+
+
+class EventPhase(IntEnum):
+    """In which step of the thermostat's interval of n steps an event runs: the first (the ends placement's half event
+    before the step), the centre one, (n - 1) // 2 counted from 0 (the middle placement's event, at the centre of its n
+    steps), or the last (the ends placement's half event after the step)."""
+
+    FIRST = 0
+    CENTRE = 1
+    LAST = 2
+
+    def step_in(self, interval: int) -> int:
+        """The step, counted from 0 within an interval of ``interval`` steps, in which such an event runs."""
+        n = int(interval)
+        return 0 if self is EventPhase.FIRST else (n - 1 if self is EventPhase.LAST else (n - 1) // 2)
 
 
 class ConstraintSupportError(ValueError):
@@ -73,10 +97,11 @@ class Substep:
     groups: tuple | None = None  # kicks: the force groups (None: all the integrator's forces)
     project_before: bool = False  # drifts and thermostat events: project the velocities first
     forces_cached: bool = False  # kicks: no force evaluation (no drift since the last kick of these groups)
+    phase: EventPhase | None = None  # thermostat events: the step of the thermostat's interval it runs in
 
     @property
     def label(self) -> str:
-        """"drift", "kick", or "kick:<groups>" (the labels of :class:`~.splitting.Splitting`)."""
+        """"drift", "kick", or "kick:<groups>" (the labels of :class:`~.splitting.Splitting`), or "thermostat"."""
         if self.kind == SubstepKind.DRIFT:
             return DRIFT
         if self.kind == SubstepKind.THERMOSTAT:
@@ -84,9 +109,15 @@ class Substep:
         return KICK if self.groups is None else KICK + ":" + ",".join(map(str, self.groups))
 
     @property
+    def is_kick_or_drift(self) -> bool:
+        return self.kind in (SubstepKind.KICK, SubstepKind.DRIFT)
+
+    @property
     def flags(self) -> SubstepFlag:
         return ((SubstepFlag.PROJECT_BEFORE if self.project_before else SubstepFlag.NONE)
-                | (SubstepFlag.FORCES_CACHED if self.forces_cached else SubstepFlag.NONE))
+                | (SubstepFlag.FORCES_CACHED if self.forces_cached else SubstepFlag.NONE)
+                | (SubstepFlag.FIRST_OF_INTERVAL if self.phase is EventPhase.FIRST else SubstepFlag.NONE)
+                | (SubstepFlag.LAST_OF_INTERVAL if self.phase is EventPhase.LAST else SubstepFlag.NONE))
 
     @property
     def group_mask(self) -> int:
@@ -226,11 +257,11 @@ def _form(splitting, tableau) -> str:
 
 
 def _with_middle_thermostat(substeps: tuple, constrained: bool) -> tuple:
-    """``substeps`` with one whole thermostat event at the step's centre: the central sub-step (a drift, or a kick of
-    BABAB schemes and of multiple time stepping with an even number of inner steps) split in two equal halves
-    around it.  The first half keeps the sub-step's flags; the second half of a kick finds its forces cached (no
-    drift between), that of a drift needs no projection (the same coefficient as the drift before it, see
-    :func:`projected_drifts`).
+    """``substeps`` with one whole thermostat event at the step's centre (in the centre step of the thermostat's
+    interval): the central kick or drift (a drift, or a kick of BABAB schemes and of multiple time stepping with an
+    even number of inner steps) split in two equal halves around it.  The first half keeps the sub-step's flags; the
+    second half of a kick finds its forces cached (no drift between), that of a drift needs no projection (the same
+    coefficient as the drift before it, see :func:`projected_drifts`).
 
     Under constraints an event that follows a kick projects the velocities first: a kick leaves each constraint's
     share of the force in the velocities (RATTLE removes it only before the next drift), a kinetic energy along the
@@ -242,17 +273,24 @@ def _with_middle_thermostat(substeps: tuple, constrained: bool) -> tuple:
     half = sub.coefficient / 2
     first = Substep(sub.kind, half, sub.groups, sub.project_before, sub.forces_cached)
     second = Substep(sub.kind, half, sub.groups, False, sub.kind == SubstepKind.KICK)
-    event = Substep(SubstepKind.THERMOSTAT, Fraction(1), project_before=constrained and sub.kind == SubstepKind.KICK)
+    event = Substep(SubstepKind.THERMOSTAT, Fraction(1), project_before=constrained and sub.kind == SubstepKind.KICK,
+                    phase=EventPhase.CENTRE)
     return (*substeps[:i], first, event, second, *substeps[i + 1:])
 
 
+def _with_end_events(substeps: tuple) -> tuple:
+    """``substeps`` with the ends placement's two half events: one before them, in the first step of the thermostat's
+    interval, and one after them (after RATTLE's closing velocity projection under constraints), in its last step."""
+    half = Fraction(1, 2)
+    return (Substep(SubstepKind.THERMOSTAT, half, phase=EventPhase.FIRST), *substeps,
+            Substep(SubstepKind.THERMOSTAT, half, phase=EventPhase.LAST))
+
+
 def thermostat_position_for(resolved: ResolvedMethod, position: str) -> str:
-    """"ends" or "middle": ``position`` as given ("ends", "middle" or "auto"), "auto" being
+    """"ends" or "middle": ``position`` as given (:func:`.placement.check_position`), "auto" being
     :func:`.placement.best_position` of the method's kick/drift sequence (on multiple time stepping: the inner,
     fastest level's kicks carry the oscillator's force); a general PRK pair has no centre sub-step: "ends"."""
-    if position not in POSITIONS:
-        raise ValueError(f"thermostat_position must be one of {', '.join(map(repr, POSITIONS))}, got {position!r}")
-    if position != "auto":
+    if check_position(position) != "auto":
         return position
     if not resolved.is_splitting:
         return "ends"
@@ -277,14 +315,15 @@ def resolve(method, constraints: bool | None = False, groups=None, inner_method=
 
     ``thermostat_position``: None (no thermostat), "ends", "middle" or "auto" (:func:`thermostat_position_for`).
     With "middle" the sub-steps get one :attr:`SubstepKind.THERMOSTAT` event at the exact centre of the step (of the
-    outer step with multiple time stepping), splitting the central drift or kick in two halves; ValueError for a
-    general PRK pair or a sequence that is not symmetric (no one centre).  With "ends" the sub-steps are those of
-    the method alone (both backends put half an event before and after the step themselves)."""
+    outer step with multiple time stepping), splitting the central drift or kick in two halves, in the centre step of
+    the thermostat's interval; ValueError for a general PRK pair or a sequence that is not symmetric (no one centre).
+    With "ends" they get a half event before the first sub-step (in the first step of the interval) and one after the
+    last (in its last step): :class:`EventPhase`."""
     if thermostat_position is not None:
         plain = resolve(method, constraints, groups, inner_method, name)
         where = thermostat_position_for(plain, thermostat_position)
         if where == "ends":
-            return replace(plain, thermostat_position="ends")
+            return replace(plain, substeps=_with_end_events(plain.substeps), thermostat_position="ends")
         if not plain.is_splitting:
             raise ValueError(f"thermostat_position='middle' needs a kick/drift method, whose step has a centre "
                              f"sub-step; {plain.name!r} is a general ({plain.family or plain.form}) PRK tableau: use "

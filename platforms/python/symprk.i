@@ -78,7 +78,9 @@ public:
     };
     enum SubstepFlag {
         ProjectVelocitiesBefore = 1,
-        ForcesCached = 2
+        ForcesCached = 2,
+        FirstOfInterval = 4,
+        LastOfInterval = 8
     };
     explicit SymPRKIntegrator(double stepSize);
     SymPRKIntegrator(double stepSize, const std::vector<int>& kinds, const std::vector<double>& coefficients,

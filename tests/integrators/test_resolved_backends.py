@@ -80,8 +80,11 @@ def test_plugin_checks_the_flags_it_is_sent():
     for kinds, coefficients, groups, flags, match in [
             ([K, D], [0.5, 1.0], [-1, -1], [P, 0], "is a kick flagged ProjectVelocitiesBefore"),
             ([K, D], [0.5, 1.0], [-1, -1], [0, C], "is a drift flagged ForcesCached"),
-            ([K, D], [0.5, 1.0], [-1, -1], [0, 8], "has flags 8"),
-            ([K, cls.Thermostat], [0.5, 1.0], [-1, -1], [0, C], "thermostat event .* takes -1 and flags 0 or 1"),
+            ([K, D], [0.5, 1.0], [-1, -1], [0, 16], "has flags 16"),
+            ([K, D], [0.5, 1.0], [-1, -1], [0, cls.LastOfInterval], "is a drift flagged 8; FirstOfInterval and "
+                                                                     "LastOfInterval name the step of a thermostat event"),
+            ([K, cls.Thermostat], [0.5, 1.0], [-1, -1], [0, C], "thermostat event .* takes -1 and flags of 1"),
+            ([K, cls.Thermostat], [0.5, 1.0], [-1, -1], [0, 12], "thermostat event .* flags 12; .* one of 4 .first step of the interval. or 8"),
             ([K, 3], [0.5, 1.0], [-1, -1], [0, 0], "has kind 3; expected 0 .kick., 1 .drift. or 2 .thermostat event."),
             ([K, D], [0.0, 1.0], [-1, -1], [0, 0], "finite non-zero"),
             ([K, D], [0.5, 1.0], [-1, 3], [0, 0], "a drift takes -1"),

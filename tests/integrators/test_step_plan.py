@@ -9,11 +9,12 @@ r-RESPA sequence of two force groups, and the thermostat every step and every th
 and in its middle (``thermostat_position="middle"``: a THERMOSTAT sub-step; with multiple time stepping the middle
 of the outer step):
 
-* the plan states the sequence the integrator was given: a kick per kick sub-step with its groups (-1 resolved
-  to the integration force groups), a projection before each drift flagged for one and one at the end of the
-  step where the System has constraints, the thermostat's half events before the first and after the last step
-  of each interval (ends), or one event at its THERMOSTAT sub-step in the middle step of each interval (phase
-  (n - 1) // 2) and none at the ends (middle), the blow-up check after the last velocity-changing operation;
+* the plan is the resolved method's sub-steps (``integrator.resolved.substeps``, the whole step: resolve decides it,
+  the plugin only executes it): a kick per kick sub-step with its groups (-1 resolved to the integration force
+  groups), a projection before each drift or event flagged for one and RATTLE's after the last kick or drift where
+  the System has constraints, an event per THERMOSTAT sub-step in the step of each interval its phase names (ends:
+  half events in the first and the last step; middle: one in the centre step, (n - 1) // 2), the blow-up check
+  after the last velocity-changing operation;
 * every step runs the plan's operations in order, the thermostat events only in the steps of their phase;
 * forces are evaluated only by kicks, for their own groups, and a step costs getForceEvaluationsPerStep()
   evaluations in steady state (per group with multiple time stepping);
@@ -24,7 +25,8 @@ import openmm as mm
 import openmm.unit as unit
 import pytest
 
-from openmm_symprk import SymplecticIntegrator, plugin
+from openmm_symprk import SymplecticIntegrator, catalogue, plugin
+from openmm_symprk.methods.resolved import EventPhase, SubstepKind, resolve
 from openmm_symprk.systems.forcegroups import split_forces
 
 pytestmark = pytest.mark.skipif(not plugin.available(), reason=f"native plugin unavailable: {plugin.unavailable_reason()}")
@@ -84,31 +86,37 @@ def _run(case, platform, props, request):
 
 
 def _expected_plan(ig, constrained):
-    """The plan's lines as the sequence and settings say they must be (kind, substep, groups, reuse, phase)."""
+    """The plan's lines as the resolved sub-steps say they must be (kind, substep, groups, reuse, phase): the plugin
+    executes ``ig.resolved.substeps`` and decides nothing of its own."""
     out = []
     interval = ig.getThermostatInterval() if ig.hasThermostat() else 1
-    middle = any(ig.getSubstepKind(s) == ig.Thermostat for s in range(ig.getNumSubsteps()))
-    ends = ig.hasThermostat() and not middle
-    if ends:
-        out.append(("thermostat", None, None, None, 0))
-    for s in range(ig.getNumSubsteps()):
-        flags = ig.getSubstepFlags(s)
-        if ig.getSubstepKind(s) == ig.Thermostat:  # after a kick, under constraints: velocities projected first
-            if constrained and flags & ig.ProjectVelocitiesBefore:
+    subs = ig.resolved.substeps
+    last = max(i for i, sub in enumerate(subs) if sub.is_kick_or_drift)
+    for s, sub in enumerate(subs):
+        if sub.kind == SubstepKind.THERMOSTAT:  # after a kick, under constraints: velocities projected first
+            if constrained and sub.project_before:
                 out.append(("project", s, None, None, None))
-            out.append(("thermostat", s, None, None, (interval - 1) // 2))
-        elif ig.getSubstepKind(s) == ig.Kick:
-            mask = ig.getSubstepForceGroups(s)
-            out.append(("kick", s, ig.getIntegrationForceGroups() if mask == -1 else mask, bool(flags & ig.ForcesCached), None))
+            out.append(("thermostat", s, None, None, sub.phase.step_in(interval)))
+        elif sub.kind == SubstepKind.KICK:
+            out.append(("kick", s, ig.getIntegrationForceGroups() if sub.group_mask == -1 else sub.group_mask,
+                        sub.forces_cached, None))
         else:
-            if constrained and flags & ig.ProjectVelocitiesBefore:
+            if constrained and sub.project_before:
                 out.append(("project", s, None, None, None))
             out.append(("drift", s, None, None, None))
-    if constrained:
-        out.append(("project", None, None, None, None))
-    if ends:
-        out.append(("thermostat", None, None, None, interval - 1))
+        if s == last and constrained:  # RATTLE's closing projection
+            out.append(("project", None, None, None, None))
     return out, interval
+
+
+def _trace_of(plan_lines, trace, steps):
+    """{step: [resolved sub-step index, or "project" for the closing projection, of every operation run]}."""
+    operations = [parse(line) for line in plan_lines]
+    out = {}
+    for step in range(1, steps + 1):
+        out[step] = [int(operations[op][1]["substep"]) if "substep" in operations[op][1] else "project"
+                     for op in trace[trace[:, 0] == step][:, 1]]
+    return out
 
 
 @pytest.mark.parametrize("platform,props", PLATFORMS)
@@ -128,10 +136,10 @@ def test_each_kernel_runs_the_plan(case, platform, props, request):
                     int(facts["phase"].split("/")[0]) if kind == "thermostat" else None))
     assert got == expected, "\n".join(plan)
     for (kind, facts, _), (_, s, *_) in zip(parsed, expected):
-        if kind in ("kick", "drift") or (kind == "thermostat" and s is not None):
-            assert float(facts["c"]) == pytest.approx(ig.getSubstepCoefficient(s), rel=1e-5)
+        if kind in ("kick", "drift", "thermostat"):
+            assert float(facts["c"]) == pytest.approx(float(ig.resolved.substeps[s].coefficient), rel=1e-5)
         if kind == "thermostat":
-            assert float(facts["c"]) == (1.0 if s is not None else 0.5) and facts["phase"].endswith(f"/{interval}")
+            assert float(facts["c"]) in (0.5, 1.0) and facts["phase"].endswith(f"/{interval}")
     changes = [i for i, (kind, _, _) in enumerate(parsed) if kind == "kick" or (kind == "drift" and constrained)]
     assert [i for i, (_, _, words) in enumerate(parsed) if "check" in words] == changes[-1:]
     mts = len({g for k, _, g, _, _ in expected if k == "kick"}) > 1
@@ -150,7 +158,8 @@ def test_each_kernel_runs_the_plan(case, platform, props, request):
         assert all(evaluated != 0 for op, evaluated in ran[:, 1:] if expected[op][0] == "kick" and not expected[op][3])
         if step > 1:  # steady state: the cached forces of the last step's closing kick serve the opening one
             assert np.count_nonzero(ran[:, 2]) == ig.getForceEvaluationsPerStep(), (step, ran.tolist())
-    middle = [i for i, e in enumerate(expected) if e[0] == "thermostat" and e[1] is not None]
+    middle = [i for i, e in enumerate(expected)
+              if e[0] == "thermostat" and ig.resolved.substeps[e[1]].phase is EventPhase.CENTRE]
     if middle:  # one event, at the centre of the (outer) step: as many sub-steps before it as after it
         n = ig.getNumSubsteps()
         assert len(middle) == 1 and n % 2 == 1 and expected[middle[0]][1] == n // 2
@@ -209,3 +218,58 @@ def test_the_plan_follows_the_integration_force_groups(morse):
     assert [parse(line)[1]["groups"] for line in ig.getStepPlan() if line.startswith("kick")] == ["0x2"] * 2
     evaluated = set(np.asarray(ig.getExecutionTrace()).reshape(-1, 3)[:, 2].tolist()) - {0}
     assert evaluated == {1 << 1}
+
+
+#: every catalogue splitting and composition (what the native backend runs)
+SPLITTINGS = sorted({m.name for m in catalogue.values() if m.splitting is not None})
+
+
+def _placements(name):
+    out = ["ends"]
+    try:
+        resolve(name, constraints=True, thermostat_position="middle")
+        out.append("middle")
+    except ValueError:
+        pass  # not symmetric: no centre
+    return out
+
+
+@pytest.mark.parametrize("interval", [1, 3])
+@pytest.mark.parametrize("name", SPLITTINGS + ["mts"])
+def test_the_plugin_runs_the_resolved_substeps(name, interval, water8, morse):
+    """For every catalogue splitting, both placements (where the method has a centre), multiple time stepping and a
+    thermostat every step and every third: each step runs exactly the resolved sub-steps (the events only in the step
+    of the interval their phase names; a projection flagged before an event in every step), in order, RATTLE's
+    projection right after the last kick or drift."""
+    scene = water8 if name != "mts" else morse
+    system, options = scene.system, {}
+    if name == "mts":
+        system = mm.XmlSerializer.clone(system)
+        options["groups"] = split_forces(system, slow=["CustomAngleForce", 2], substeps=2)
+    constrained = system.getNumConstraints() > 0
+    for position in _placements("verlet" if name == "mts" else name):
+        ig = SymplecticIntegrator(0.5 * unit.femtoseconds, "verlet" if name == "mts" else name, system=system,
+                                  backend="native", temperature=300, thermostat_interval=interval, random_seed=3,
+                                  thermostat_position=position, **options)
+        ctx = mm.Context(system, ig, mm.Platform.getPlatformByName("Reference"))
+        ctx.setPositions(scene.positions)
+        ctx.setVelocities(scene.velocities)
+        ig.setExecutionTraceEnabled(True)
+        steps = 2 * interval
+        ig.step(steps)
+        ran = _trace_of(ig.getStepPlan(), np.asarray(ig.getExecutionTrace()).reshape(-1, 3), steps)
+        subs = ig.resolved.substeps
+        last = max(i for i, sub in enumerate(subs) if sub.is_kick_or_drift)
+        for step in range(1, steps + 1):
+            expected = []
+            for i, sub in enumerate(subs):
+                if constrained and sub.project_before:
+                    expected.append(i)  # its projection (every step), named by the sub-step it precedes
+                if sub.kind == SubstepKind.THERMOSTAT and (step - 1) % interval != sub.phase.step_in(interval):
+                    continue
+                expected.append(i)
+                if i == last and constrained:
+                    expected.append("project")
+            assert ran[step] == expected, (name, position, step)
+        assert ig.resolved.thermostat_position == position
+        del ctx

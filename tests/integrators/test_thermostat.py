@@ -85,10 +85,10 @@ def peculiar_kinetic(x, v, m, keep_rotation):
 def test_degrees_of_freedom_exclude_kept_motion_constraints_and_massless(cluster, box):
     n = cluster.system.getNumParticles()
     assert thermostat_degrees_of_freedom(cluster.system, True) == 3 * n - n - 6  # 3 SETTLE constraints per water
-    assert thermostat_settings(cluster.system, 300).dof == 3 * n - n - 6  # isolated: rotation kept too
-    assert thermostat_settings(cluster.system, 300).keep_rotation
+    assert thermostat_settings(cluster.system, temperature=300).dof == 3 * n - n - 6  # isolated: rotation kept too
+    assert thermostat_settings(cluster.system, temperature=300).keep_rotation
     system, _ = box
-    s = thermostat_settings(system, 300)
+    s = thermostat_settings(system, temperature=300)
     assert (s.dof, s.keep_rotation) == (3 * 192 - 192 - 3, False)  # periodic: only the centre of mass kept
     # a virtual site and a frozen (massless) particle count for nothing; a frozen particle makes it not isolated
     sys2 = mm.System()
@@ -98,7 +98,7 @@ def test_degrees_of_freedom_exclude_kept_motion_constraints_and_massless(cluster
     sys2.addConstraint(0, 1, 0.1)
     sys2.addConstraint(1, 4, 0.1)  # to a frozen particle: still removes one degree of freedom
     assert thermostat_degrees_of_freedom(sys2, False) == 9 - 2 - 3
-    assert thermostat_settings(sys2, 300).dof == 4 and not thermostat_settings(sys2, 300).keep_rotation
+    assert thermostat_settings(sys2, temperature=300).dof == 4 and not thermostat_settings(sys2, temperature=300).keep_rotation
 
 
 # -- bad input -------------------------------------------------------------------------------------------------

@@ -21,7 +21,7 @@ from openmm_symprk import SymplecticIntegrator, plugin
 from openmm_symprk.integrators import deserialize
 from openmm_symprk.integrators.thermostat import MAX_INTERVAL
 from openmm_symprk.methods import placement
-from openmm_symprk.methods.resolved import SubstepKind, resolve
+from openmm_symprk.methods.resolved import EventPhase, SubstepKind, resolve
 from openmm_symprk.physics.temperature import R_KJ
 from openmm_symprk.stats import drift
 from openmm_symprk.systems.prepare import equilibrate, maxwell_boltzmann
@@ -63,9 +63,17 @@ def test_middle_splits_the_central_drift_or_kick():
     seq = _seq(mts)
     i = seq.index(("thermostat", 1.0))
     assert seq[:i][::-1] == seq[i + 1:] and seq[i - 1] == ("drift", 1 / 6)
-    # ends: the method's own sub-steps (the backends add the two half events)
-    assert _seq(resolve("verlet", thermostat_position="ends")) == _seq(resolve("verlet"))
-    assert resolve("verlet", thermostat_position="ends").thermostat_position == "ends"
+    # ends: the method's own sub-steps between two half events, in the first and the last step of the interval
+    ends = resolve("verlet", thermostat_position="ends")
+    assert _seq(ends) == [("thermostat", 0.5), *_seq(resolve("verlet")), ("thermostat", 0.5)]
+    assert [s.phase for s in ends.substeps if s.kind == SubstepKind.THERMOSTAT] == [EventPhase.FIRST, EventPhase.LAST]
+    assert [s.phase for s in mts.substeps if s.kind == SubstepKind.THERMOSTAT] == [EventPhase.CENTRE]
+    assert ends.thermostat_position == "ends" and ends.force_evals == resolve("verlet").force_evals
+    # the phases name the step of an interval of n steps: first, centre (n - 1) // 2, last
+    assert [EventPhase.FIRST.step_in(3), EventPhase.CENTRE.step_in(3), EventPhase.LAST.step_in(3)] == [0, 1, 2]
+    assert [p.step_in(1) for p in EventPhase] == [0, 0, 0] and EventPhase.CENTRE.step_in(4) == 1
+    # a general PRK pair: the two half events around its stages
+    assert _seq(resolve("gauss-2", thermostat_position="ends")) == [("thermostat", 0.5), ("thermostat", 0.5)]
 
 
 def test_auto_follows_the_harmonic_measurement():

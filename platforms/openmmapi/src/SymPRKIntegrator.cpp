@@ -68,16 +68,22 @@ void SymPRKIntegrator::setSubsteps(const vector<int>& newKinds, const vector<dou
         else if (newKinds[i] == Thermostat && !(newCoefficients[i] > 0 && std::isfinite(newCoefficients[i])))
             msg << " is a thermostat event with the coefficient " << newCoefficients[i] << "; expected a finite fraction > 0 "
                    "of the thermostat's interval (1: one whole event)";
-        else if (newKinds[i] == Thermostat && (newGroups[i] != -1 || (newFlags[i] & ~ProjectVelocitiesBefore) != 0))
+        else if (newKinds[i] == Thermostat && (newGroups[i] != -1 || (newFlags[i] & ~(ProjectVelocitiesBefore | FirstOfInterval | LastOfInterval)) != 0
+                 || (newFlags[i] & (FirstOfInterval | LastOfInterval)) == (FirstOfInterval | LastOfInterval)))
             msg << " is a thermostat event with force-group mask " << newGroups[i] << " and flags " << newFlags[i]
-                << "; a thermostat event takes -1 and flags 0 or " << ProjectVelocitiesBefore << " (project velocities first)";
+                << "; a thermostat event takes -1 and flags of " << ProjectVelocitiesBefore << " (project velocities first) and "
+                << "one of " << FirstOfInterval << " (first step of the interval) or " << LastOfInterval << " (last step; "
+                << "neither: the centre step)";
+        else if (newKinds[i] != Thermostat && (newFlags[i] & (FirstOfInterval | LastOfInterval)) != 0)
+            msg << " is a " << (newKinds[i] == Kick ? "kick" : "drift") << " flagged " << newFlags[i] << "; FirstOfInterval and "
+                   "LastOfInterval name the step of a thermostat event";
         else if (!std::isfinite(newCoefficients[i]) || newCoefficients[i] == 0.0)
             msg << " has the coefficient " << newCoefficients[i] << "; expected a finite non-zero number (leave a zero sub-step out)";
         else if (newKinds[i] == Kick && (newGroups[i] == 0 || newGroups[i] < -1))
             msg << " has force-group mask " << newGroups[i] << "; expected a non-zero bit mask or -1";
         else if (newKinds[i] == Drift && newGroups[i] != -1)
             msg << " is a drift with force-group mask " << newGroups[i] << "; a drift takes -1";
-        else if ((newFlags[i] & ~(ProjectVelocitiesBefore | ForcesCached)) != 0)
+        else if ((newFlags[i] & ~(ProjectVelocitiesBefore | ForcesCached | FirstOfInterval | LastOfInterval)) != 0)
             msg << " has flags " << newFlags[i] << "; expected a combination of " << ProjectVelocitiesBefore
                 << " (project velocities before a drift or a thermostat event) and " << ForcesCached << " (a kick on cached forces)";
         else if (newKinds[i] == Kick && (newFlags[i] & ProjectVelocitiesBefore) != 0)
@@ -260,7 +266,12 @@ long long SymPRKIntegrator::getProgramSignature() const {
             hash *= 1099511628211ULL;
         }
     };
+    // The ends placement's events (FirstOfInterval, LastOfInterval) are left out: their place follows from the
+    // thermostat's settings hashed below, and so a checkpoint written before they were sub-steps (format 4, an ends
+    // placement run without them in the sequence) keeps its signature.
     for (size_t i = 0; i < kinds.size(); i++) {
+        if (kinds[i] == Thermostat && (flags[i] & (FirstOfInterval | LastOfInterval)) != 0)
+            continue;
         int32_t kind = kinds[i], group = groups[i], flag = flags[i];
         mix(&kind, sizeof(kind));
         mix(&coefficients[i], sizeof(double));

@@ -44,25 +44,24 @@ SymPRKStepPlan::SymPRKStepPlan(const SymPRKIntegrator& integrator, bool hasConst
         if (integrator.getSubstepKind(s) == SymPRKIntegrator::Kick)
             masks.insert(integrator.getSubstepForceGroups(s) == -1 ? integrationForceGroups : integrator.getSubstepForceGroups(s));
     const bool multipleGroups = (masks.size() > 1);
-    // The thermostat.  Middle placement: the sequence's Thermostat sub-steps, each an event in the middle step
-    // (phase (interval-1)/2) of every interval.  Ends placement (no Thermostat sub-step): a half event before the
-    // first step of every interval (after the Context's state updates, a barostat's move included) and one after
-    // its last step (after the end-of-step projection).
-    bool middle = false;
-    for (int s = 0; s < n; s++)
-        if (integrator.getSubstepKind(s) == SymPRKIntegrator::Thermostat) {
-            middle = true;
-            if (!integrator.hasThermostat())
-                throw OpenMM::OpenMMException("SymPRKIntegrator: sub-step "+to_string(s)+" is a thermostat event, but the integrator "
-                                      "has no thermostat (setThermostat gives it one)");
-        }
-    const bool ends = integrator.hasThermostat() && !middle;
+    // The thermostat's events are sub-steps (where they sit is the sequence's): each runs in the step of every interval
+    // its flags name.  With constraints, RATTLE's velocity projection follows the last kick or drift.
     const int interval = integrator.getThermostatInterval();
     const double tau = integrator.getCollisionTime();
-    if (ends) {
-        operations.push_back(operation(ThermostatEvent, -1, 0.5, interval, tau));
-        operations.back().phase = 0;
+    int lastKickOrDrift = -1, events = 0;
+    for (int s = 0; s < n; s++) {
+        if (integrator.getSubstepKind(s) != SymPRKIntegrator::Thermostat)
+            lastKickOrDrift = s;
+        else
+            events++;
     }
+    if (events > 0 && !integrator.hasThermostat())
+        throw OpenMM::OpenMMException("SymPRKIntegrator: the sequence has thermostat events, but the integrator has no "
+                                      "thermostat (setThermostat gives it one)");
+    if (events == 0 && integrator.hasThermostat())
+        throw OpenMM::OpenMMException("SymPRKIntegrator: the integrator has a thermostat, but its sequence has no thermostat "
+                                      "event: add Thermostat sub-steps where the events go (ends: a half event flagged "
+                                      "FirstOfInterval before the kicks and drifts and one flagged LastOfInterval after them)");
     for (int s = 0; s < n; s++) {
         const double c = integrator.getSubstepCoefficient(s);
         const int flags = integrator.getSubstepFlags(s);
@@ -70,7 +69,8 @@ SymPRKStepPlan::SymPRKStepPlan(const SymPRKIntegrator& integrator, bool hasConst
             if (constraints && (flags & SymPRKIntegrator::ProjectVelocitiesBefore) != 0)
                 operations.push_back(operation(ProjectVelocities, s, 0.0));
             operations.push_back(operation(ThermostatEvent, s, c, interval, tau));
-            operations.back().phase = (interval-1)/2;
+            operations.back().phase = ((flags & SymPRKIntegrator::FirstOfInterval) != 0 ? 0 :
+                                       (flags & SymPRKIntegrator::LastOfInterval) != 0 ? interval-1 : (interval-1)/2);
         }
         else if (integrator.getSubstepKind(s) == SymPRKIntegrator::Kick) {
             Operation op = operation(Kick, s, c);
@@ -84,12 +84,8 @@ SymPRKStepPlan::SymPRKStepPlan(const SymPRKIntegrator& integrator, bool hasConst
                 operations.push_back(operation(ProjectVelocities, s, 0.0));
             operations.push_back(operation(Drift, s, c));
         }
-    }
-    if (constraints)
-        operations.push_back(operation(ProjectVelocities, -1, 0.0));
-    if (ends) {
-        operations.push_back(operation(ThermostatEvent, -1, 0.5, interval, tau));
-        operations.back().phase = interval-1;
+        if (s == lastKickOrDrift && constraints)
+            operations.push_back(operation(ProjectVelocities, -1, 0.0));
     }
     // The blow-up check follows the last operation that changes the velocities in every step.
     int last = -1;

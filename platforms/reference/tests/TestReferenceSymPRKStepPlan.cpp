@@ -55,10 +55,12 @@ int main() {
         well->setForceGroup(0);
         system.addForce(well);
 
-        const int K = SymPRKIntegrator::Kick, D = SymPRKIntegrator::Drift;
+        const int K = SymPRKIntegrator::Kick, D = SymPRKIntegrator::Drift, T = SymPRKIntegrator::Thermostat;
         const int cached = SymPRKIntegrator::ForcesCached, project = SymPRKIntegrator::ProjectVelocitiesBefore;
-        SymPRKIntegrator integrator(0.001, {K, K, D, K, D, K, K}, {0.5, 0.25, 0.5, 0.5, 0.5, 0.25, 0.5}, {2, 1, -1, 1, -1, 1, 2},
-                                    {cached, cached, 0, 0, project, 0, 0});
+        const int first = SymPRKIntegrator::FirstOfInterval, last = SymPRKIntegrator::LastOfInterval;
+        // the ends placement: a half event before the sequence (first step of every interval) and one after it (last)
+        SymPRKIntegrator integrator(0.001, {T, K, K, D, K, D, K, K, T}, {0.5, 0.5, 0.25, 0.5, 0.5, 0.5, 0.25, 0.5, 0.5},
+                                    {-1, 2, 1, -1, 1, -1, 1, 2, -1}, {first, cached, cached, 0, 0, project, 0, 0, last});
         integrator.setThermostat(300.0, 0.1, 3, 3*3-1-3, false);
         integrator.setRandomNumberSeed(5);
         Context context(system, integrator, Platform::getPlatformByName("Reference"));
@@ -66,17 +68,17 @@ int main() {
         context.setVelocities({Vec3(0.1, 0.2, -0.1), Vec3(-0.3, 0.1, 0.2), Vec3(0.05, -0.2, 0.1)});
 
         const vector<string> expected = {
-            "thermostat c=0.5 phase=0/3",
-            "kick substep=0 c=0.5 groups=0x2 reuse copy",
-            "kick substep=1 c=0.25 groups=0x1 reuse copy",
-            "drift substep=2 c=0.5",
-            "kick substep=3 c=0.5 groups=0x1 copy",
-            "project substep=4",
-            "drift substep=4 c=0.5",
-            "kick substep=5 c=0.25 groups=0x1 copy",
-            "kick substep=6 c=0.5 groups=0x2 copy check",
+            "thermostat substep=0 c=0.5 phase=0/3",
+            "kick substep=1 c=0.5 groups=0x2 reuse copy",
+            "kick substep=2 c=0.25 groups=0x1 reuse copy",
+            "drift substep=3 c=0.5",
+            "kick substep=4 c=0.5 groups=0x1 copy",
+            "project substep=5",
+            "drift substep=5 c=0.5",
+            "kick substep=6 c=0.25 groups=0x1 copy",
+            "kick substep=7 c=0.5 groups=0x2 copy check",
             "project",
-            "thermostat c=0.5 phase=2/3"};
+            "thermostat substep=8 c=0.5 phase=2/3"};
         const vector<string> plan = integrator.getStepPlan();
         expect(plan == expected, "the plan of the r-RESPA sequence");
         if (plan != expected)
@@ -122,7 +124,6 @@ int main() {
 
         // the middle placement: the Thermostat sub-step between the drift's halves is the only event, in the middle
         // step of each interval of 3 (phase 1), with c = exp(-1*3*dt/tau); no ends events
-        const int T = SymPRKIntegrator::Thermostat;
         SymPRKIntegrator middle(0.001, {K, D, T, D, K}, {0.5, 0.5, 1.0, 0.5, 0.5}, {-1, -1, -1, -1, -1}, {cached, 0, 0, 0, 0});
         middle.setThermostat(300.0, 0.1, 3, 3*3-1-3, false);
         Context context3(system, middle, Platform::getPlatformByName("Reference"));
@@ -149,9 +150,21 @@ int main() {
             Context context4(system, bare, Platform::getPlatformByName("Reference"));
         }
         catch (const OpenMMException& e) {
-            refused = (string(e.what()).find("sub-step 2 is a thermostat event, but the integrator has no thermostat") != string::npos);
+            refused = (string(e.what()).find("the sequence has thermostat events, but the integrator has no thermostat") != string::npos);
         }
         expect(refused, "a Thermostat sub-step without a thermostat is refused when the Context is created");
+
+        // a thermostat without events in the sequence: refused, saying where the ends placement's events go
+        SymPRKIntegrator eventless(0.001);
+        eventless.setThermostat(300.0, 0.1, 1, 3*3-1-3, false);
+        refused = false;
+        try {
+            Context context5(system, eventless, Platform::getPlatformByName("Reference"));
+        }
+        catch (const OpenMMException& e) {
+            refused = (string(e.what()).find("its sequence has no thermostat event") != string::npos);
+        }
+        expect(refused, "a thermostat without Thermostat sub-steps is refused when the Context is created");
     }
     catch (const exception& e) {
         cerr << "exception: " << e.what() << endl;

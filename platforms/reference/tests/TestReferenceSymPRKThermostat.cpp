@@ -124,7 +124,11 @@ int main() {
         System system;
         for (double m : MASS)
             system.addParticle(m);
-        SymPRKIntegrator integrator(DT);  // velocity Verlet
+        // velocity Verlet with the ends placement's events: half an event before and after the kicks and drift
+        const int T = SymPRKIntegrator::Thermostat, K = SymPRKIntegrator::Kick, D = SymPRKIntegrator::Drift;
+        SymPRKIntegrator integrator(DT, {T, K, D, K, T}, {0.5, 0.5, 1.0, 0.5, 0.5}, {-1, -1, -1, -1, -1},
+                                    {SymPRKIntegrator::FirstOfInterval, SymPRKIntegrator::ForcesCached, 0, 0,
+                                     SymPRKIntegrator::LastOfInterval});
         integrator.setThermostat(TEMPERATURE, TAU, INTERVAL, DOF, true);
         integrator.setRandomNumberSeed(SEED);
         Context context(system, integrator, Platform::getPlatformByName("Reference"));

@@ -17,7 +17,9 @@ SymPRKIntegratorProxy::SymPRKIntegratorProxy() : SerializationProxy("SymPRKInteg
 
 void SymPRKIntegratorProxy::serialize(const void* object, SerializationNode& node) const {
     const SymPRKIntegrator& integrator = *reinterpret_cast<const SymPRKIntegrator*>(object);
-    node.setIntProperty("version", 3);  // 2: every sub-step carries its flags; 3: the thermostat (and the seed)
+    // 2: every sub-step carries its flags; 3: the thermostat (and the seed), and its events among the sub-steps
+    // (read back from an older version 3 that has a thermostat and no events: the ends placement's are added)
+    node.setIntProperty("version", 3);
     node.setDoubleProperty("stepSize", integrator.getStepSize());
     node.setDoubleProperty("constraintTolerance", integrator.getConstraintTolerance());
     node.setIntProperty("integrationForceGroups", integrator.getIntegrationForceGroups());
@@ -70,6 +72,23 @@ void* SymPRKIntegratorProxy::deserialize(const SerializationNode& node) const {
         coefficients.push_back(s.getDoubleProperty("c"));
         groups.push_back(s.getIntProperty("groups", -1));
         flags.push_back(s.getIntProperty("flags"));
+    }
+    // An integrator with a thermostat written before the thermostat's events were sub-steps holds none (its events
+    // were the ends placement's, implied): give it those, a half event before the sequence and one after it.
+    bool thermostat = false, events = false;
+    for (const SerializationNode& child : node.getChildren())
+        thermostat = thermostat || (child.getName() == "Thermostat");
+    for (int kind : kinds)
+        events = events || (kind == SymPRKIntegrator::Thermostat);
+    if (thermostat && !events) {
+        kinds.insert(kinds.begin(), SymPRKIntegrator::Thermostat);
+        coefficients.insert(coefficients.begin(), 0.5);
+        groups.insert(groups.begin(), -1);
+        flags.insert(flags.begin(), SymPRKIntegrator::FirstOfInterval);
+        kinds.push_back(SymPRKIntegrator::Thermostat);
+        coefficients.push_back(0.5);
+        groups.push_back(-1);
+        flags.push_back(SymPRKIntegrator::LastOfInterval);
     }
     SymPRKIntegrator* integrator = new SymPRKIntegrator(node.getDoubleProperty("stepSize"), kinds, coefficients, groups, flags);
     integrator->setConstraintTolerance(node.getDoubleProperty("constraintTolerance"));

@@ -30,7 +30,18 @@ int main() {
         vector<double> coefficients = {0.1931833275037836, 0.5, 0.6136333449924328, 0.5, 0.1931833275037836};
         vector<int> groups = {-1, -1, 2, -1, -1};
         vector<int> flags = {SymPRKIntegrator::ForcesCached, 0, 0, SymPRKIntegrator::ProjectVelocitiesBefore, 0};
-        SymPRKIntegrator original(0.0015, kinds, coefficients, groups, flags);
+        // with the ends placement's thermostat events around it
+        vector<int> nvtKinds = kinds, nvtGroups = groups, nvtFlags = flags;
+        vector<double> nvtCoefficients = coefficients;
+        nvtKinds.insert(nvtKinds.begin(), SymPRKIntegrator::Thermostat);
+        nvtKinds.push_back(SymPRKIntegrator::Thermostat);
+        nvtCoefficients.insert(nvtCoefficients.begin(), 0.5);
+        nvtCoefficients.push_back(0.5);
+        nvtGroups.insert(nvtGroups.begin(), -1);
+        nvtGroups.push_back(-1);
+        nvtFlags.insert(nvtFlags.begin(), SymPRKIntegrator::FirstOfInterval);
+        nvtFlags.push_back(SymPRKIntegrator::LastOfInterval);
+        SymPRKIntegrator original(0.0015, nvtKinds, nvtCoefficients, nvtGroups, nvtFlags);
         original.setConstraintTolerance(3e-7);
         original.setIntegrationForceGroups(5);
         original.setExactMomentum(true);
@@ -65,8 +76,9 @@ int main() {
             CHECK_EQUAL(original.getSubstepForceGroups(i), restored->getSubstepForceGroups(i));
             CHECK_EQUAL(original.getSubstepFlags(i), restored->getSubstepFlags(i));
         }
-        CHECK_EQUAL(5, restored->getNumSubsteps());
-        CHECK_EQUAL(2, restored->getSubstepForceGroups(2));
+        CHECK_EQUAL(7, restored->getNumSubsteps());
+        CHECK_EQUAL(2, restored->getSubstepForceGroups(3));
+        CHECK_EQUAL((int) SymPRKIntegrator::LastOfInterval, restored->getSubstepFlags(6));
         CHECK_EQUAL(true, restored->hasThermostat());
         CHECK_EQUAL(original.getThermostatTemperature(), restored->getThermostatTemperature());
         CHECK_EQUAL(original.getCollisionTime(), restored->getCollisionTime());
@@ -88,6 +100,21 @@ int main() {
         CHECK_EQUAL(original.getProgramSignature(), warmer.getProgramSignature());
         warmer.setThermostatTemperature(250.0);
         CHECK_EQUAL(250.0, warmer.getThermostatTemperature());
+
+        // XML written before the thermostat's events were sub-steps (a thermostat, no events: the ends placement was
+        // implied) comes back with the ends placement's events, and the same program signature (checkpoints load)
+        stringstream olderXml;
+        XmlSerializer::serialize<Integrator>(&warmer, "Integrator", olderXml);
+        unique_ptr<Integrator> older(XmlSerializer::deserialize<Integrator>(olderXml));
+        SymPRKIntegrator* olderRestored = dynamic_cast<SymPRKIntegrator*>(older.get());
+        CHECK_EQUAL(7, olderRestored->getNumSubsteps());
+        for (int i = 0; i < 7; i++) {
+            CHECK_EQUAL(nvtKinds[i], olderRestored->getSubstepKind(i));
+            CHECK_EQUAL(nvtCoefficients[i], olderRestored->getSubstepCoefficient(i));
+            CHECK_EQUAL(nvtGroups[i], olderRestored->getSubstepForceGroups(i));
+            CHECK_EQUAL(nvtFlags[i], olderRestored->getSubstepFlags(i));
+        }
+        CHECK_EQUAL(warmer.getProgramSignature(), olderRestored->getProgramSignature());
 
         // XML of serialization version 2 (before the thermostat: no seed, no Thermostat node) still loads.
         stringstream plainXml;

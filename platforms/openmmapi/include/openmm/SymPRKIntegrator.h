@@ -22,12 +22,13 @@
  * without the per-degree-of-freedom interpreter.
  *
  * An optional thermostat (setThermostat) samples the canonical ensemble by stochastic velocity rescaling of
- * the peculiar velocities (Bussi, Donadio and Parrinello 2007).  Where it sits in the step:
- *   ends   (no Thermostat sub-step in the sequence): a half event before the first of every `interval` steps and
- *          one after the last, each with c = exp(-interval*dt/(2 tau));
- *   middle (Thermostat sub-steps in the sequence, e.g. one between the two halves of Verlet's drift): each such
- *          sub-step of coefficient f is an event with c = exp(-f*interval*dt/tau), run in the steps whose 0-based
- *          index i has i mod interval == (interval-1)/2 (the middle step of each block); no ends events then.
+ * the peculiar velocities (Bussi, Donadio and Parrinello 2007).  Its events are sub-steps of the sequence like the
+ * kicks and drifts (openmm_symprk.methods.resolved decides where they sit): a Thermostat sub-step of coefficient f is
+ * an event with c = exp(-f*interval*dt/tau), run in one step of every `interval` steps, the one its flags name:
+ * FirstOfInterval (0-based index i with i mod interval == 0), LastOfInterval (== interval-1) or neither (the centre
+ * step, == (interval-1)/2).  The ends placement is a half event (f = 1/2, FirstOfInterval) before the kicks and drifts
+ * and one (LastOfInterval) after them; the middle placement one whole event at the sequence's centre.  With
+ * constraints, RATTLE's velocity projection follows the last kick or drift (before a closing event).
  * The centre-of-mass velocity is kept (and the rigid rotation about the centre of mass when keepRotation), so
  * total momentum (and angular momentum) is unchanged; one scalar factor leaves the velocity constraints
  * satisfied.  Where the peculiar kinetic energy is at most 1e-10 of the total (a System at rest or moving as a
@@ -57,7 +58,7 @@ public:
     enum SubstepKind {
         Kick = 0,
         Drift = 1,
-        /** A thermostat event over the fraction `coefficient` of interval*dt (the middle placement; needs setThermostat). */
+        /** A thermostat event over the fraction `coefficient` of interval*dt (needs setThermostat; flags: which step). */
         Thermostat = 2
     };
     /** Bits of a sub-step's flags (openmm_symprk.methods.resolved.SubstepFlag has the same numbers). */
@@ -69,7 +70,11 @@ public:
          */
         ProjectVelocitiesBefore = 1,
         /** A kick: no drift since the previous kick of its force groups; its forces are reused when still valid. */
-        ForcesCached = 2
+        ForcesCached = 2,
+        /** A thermostat event: it runs in the first step of every thermostat interval. */
+        FirstOfInterval = 4,
+        /** A thermostat event: it runs in the last step of every thermostat interval (neither bit: the centre step). */
+        LastOfInterval = 8
     };
     /**
      * Create an integrator running velocity Verlet (kick 1/2, drift 1, kick 1/2; the first kick on cached forces).

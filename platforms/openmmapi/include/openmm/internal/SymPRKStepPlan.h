@@ -38,8 +38,7 @@ public:
     };
     struct Operation {
         OperationKind kind;
-        /** The sub-step it comes from; -1 for the thermostat's ends events and the end-of-step projection (a Thermostat
-         *  sub-step's event names its sub-step). */
+        /** The sub-step it comes from; -1 for RATTLE's velocity projection after the last kick or drift. */
         int substep;
         /** Kick, Drift: the fraction of the step size.  ThermostatEvent: the fraction f of interval*dt/tau. */
         double coefficient;
@@ -86,8 +85,8 @@ public:
     std::vector<int> getKickGroups() const;
     /**
      * One line for operation index: its kind and its facts as key=value tokens, e.g.
-     * "kick substep=0 c=0.5 groups=0xffffffff reuse", "drift substep=1 c=1", "project",
-     * "thermostat c=0.5 phase=0/3" (ends) or "thermostat substep=2 c=1 phase=1/3" (a Thermostat sub-step); a trailing
+     * "kick substep=1 c=0.5 groups=0xffffffff reuse", "drift substep=2 c=1", "project" (RATTLE's, after the last kick
+     * or drift), "thermostat substep=0 c=0.5 phase=0/3" (an ends event) or "thermostat substep=2 c=1 phase=1/3"; a trailing
      * " check" marks the blow-up check.  (Tests and messages.)
      */
     std::string describe(int index) const;
