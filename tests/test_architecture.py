@@ -142,3 +142,44 @@ def test_pure_numerics_do_not_import_openmm(package):
 def test_few_modules_at_the_package_root():
     root = sorted(f for f in os.listdir(ROOT) if f.endswith(".py"))
     assert root == ["__init__.py", "cli.py"], root
+
+
+#: The modules that build or run the step: they execute the resolved method's sub-steps, thermostat events included,
+#: and decide nothing of where the events go (openmm_symprk.methods.resolved does).
+STEP_RUNNERS = ("integrators.program", "integrators.thermostat_program", "integrators.custom_backend",
+                "integrators.native_backend", "integrators.backend", "integrators.base")
+
+
+def _schedule_decisions(tree) -> list:
+    """(line, what) of every place in ``tree`` that decides a thermostat schedule: a comparison with a placement's
+    name ("ends", "middle"), a sub-step built (``Substep(...)``), a placement sequence made (``with_thermostat``,
+    ``centre``, ``best_position``), or the centre step of an interval worked out (a floor division by 2)."""
+    from openmm_symprk.methods.placement import POSITIONS
+
+    found = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Compare):
+            names = [c.value for c in [node.left, *node.comparators] if isinstance(c, ast.Constant)]
+            if any(n in POSITIONS for n in names):
+                found.append((node.lineno, f"compares with the placement {names}"))
+        elif isinstance(node, ast.Call):
+            name = getattr(node.func, "id", getattr(node.func, "attr", None))
+            if name in ("Substep", "with_thermostat", "centre", "best_position"):
+                found.append((node.lineno, f"calls {name}"))
+        elif isinstance(node, ast.BinOp) and isinstance(node.op, ast.FloorDiv) and \
+                isinstance(node.right, ast.Constant) and node.right.value == 2:
+            found.append((node.lineno, "works out a centre step (// 2)"))
+    return found
+
+
+def test_nothing_under_integrators_decides_a_thermostat_schedule():
+    """Where the thermostat's events sit, their fractions and their steps of the interval are resolve's
+    (methods/resolved.py); the CustomIntegrator compiler and the backends only execute the sub-steps."""
+    wrong = []
+    for short in STEP_RUNNERS:
+        name = "openmm_symprk." + short
+        for line, what in _schedule_decisions(ast.parse(open(MODULES[name]).read())):
+            wrong.append(f"{MODULES[name]}:{line}: {what}")
+    assert not wrong, "\n".join(wrong)
+    # and the rule sees a decision where there is one
+    assert _schedule_decisions(ast.parse("if position == 'middle': k = (n - 1) // 2"))

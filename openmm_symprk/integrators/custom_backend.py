@@ -343,7 +343,7 @@ class PRKIntegrator(IntegratorBase, mm.CustomIntegrator):
 
     def describe(self) -> str:
         info, r = self.program_info, self.resolved
-        size = f"{len(r.substeps)} kicks and drifts" if r.is_splitting else f"{r.stages} stages"
+        size = f"{sum(s.is_kick_or_drift for s in r.substeps)} kicks and drifts" if r.is_splitting else f"{r.stages} stages"
         lines = [f"{type(self).__name__}: {self.method_name}, step {self.getStepSize()}, CustomIntegrator backend",
                  f"  program: {r.form}, {size}, constraints={'RATTLE' if info.rattle else 'none'}, force evaluations "
                  f"per step: {r.force_evals}, exact momentum: {self.options.exact_momentum}",
@@ -352,7 +352,7 @@ class PRKIntegrator(IntegratorBase, mm.CustomIntegrator):
         if r.is_mts:
             lines.append("  " + r.describe_levels())
         if self.thermostat is not None:
-            lines.append("  " + self.thermostat.describe(r.thermostat_position))
+            lines.append("  " + self.thermostat.describe(r.thermostat_position, outer=r.is_mts))
         return "\n".join(lines)
 
 

@@ -26,7 +26,7 @@ from __future__ import annotations
 import openmm as mm
 
 from .. import plugin
-from ..methods.resolved import Substep, SubstepKind
+from ..methods.resolved import substep_label
 from .backend import resolve_for_system
 from .base import IntegratorBase
 from .options import NATIVE_OPTIONS, IntegratorOptions, check_option_names
@@ -176,13 +176,13 @@ class NativeSymplecticIntegrator(SymplecticIntegrator, _PluginIntegrator, backen
         for i in range(self.getNumSubsteps()):
             mask, c = self.getSubstepForceGroups(i), self.getSubstepCoefficient(i)
             groups = None if mask == -1 else tuple(g for g in range(32) if mask >> g & 1)
-            out.append((Substep(SubstepKind(self.getSubstepKind(i)), c, groups).label, c))
+            out.append((substep_label(self.getSubstepKind(i), groups), c))
         return out
 
     def describe(self) -> str:
         return (f"NativeSymplecticIntegrator: {self.method_name}, step {self.getStepSize()}, native backend "
                 f"(platforms: {', '.join(plugin.platforms())})\n"
-                f"  program: splitting, {self.getNumSubsteps()} kicks and drifts, constraints="
+                f"  program: splitting, {sum(s.is_kick_or_drift for s in self.resolved.substeps)} kicks and drifts, constraints="
                 f"{'RATTLE' if self.program_info.rattle else 'none'}, force evaluations per step: "
                 f"{self.force_evals}, exact momentum: {self.getExactMomentum()}"
                 + (f"\n  {self.resolved.describe_levels()}" if self.resolved.is_mts else "")
@@ -192,8 +192,7 @@ class NativeSymplecticIntegrator(SymplecticIntegrator, _PluginIntegrator, backen
         settings = self.thermostat
         if settings is None:
             return ""
-        where = ", around the outer step" if self.resolved.is_mts and self.thermostat_position == "ends" else ""
-        return f"\n  {settings.describe(self.thermostat_position)}{where}"
+        return f"\n  {settings.describe(self.thermostat_position, outer=self.resolved.is_mts)}"
 
 
 # IntegratorBase.step must come before the plugin's own step in the method resolution order.

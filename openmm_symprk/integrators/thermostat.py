@@ -16,7 +16,7 @@ import numpy as np
 import openmm as mm
 import openmm.unit as unit
 
-from ..methods.placement import check_position
+from ..methods.placement import PLACEMENT_TEXT, check_position
 from ..physics.temperature import R_KJ
 from ..physics.velocity_rescaling import peculiar_kinetic_energy, relaxation_factor
 from ..systems.checks import EXACT_MOMENTUM_FORBIDDEN, check_system_type, conservation_issues
@@ -148,11 +148,10 @@ class ThermostatSettings:
             out["position"] = self.position
         return out
 
-    def describe(self, position: str | None = None) -> str:
-        """One line; ``position``: the placement the method resolved "auto" to."""
-        where = position or self.position
-        placed = "half events around the step" if where == "ends" else (
-            "one event at the centre of the step" if where == "middle" else "placement: auto")
+    def describe(self, position: str | None = None, outer: bool = False) -> str:
+        """One line; ``position``: the placement the method resolved "auto" to; ``outer``: the step is the outer one of
+        multiple time stepping."""
+        placed = PLACEMENT_TEXT[position or self.position] + (" (the outer step)" if outer else "")
         kept = "centre-of-mass velocity and rigid rotation kept" if self.keep_rotation else \
             "centre-of-mass velocity kept"
         every = "every step" if self.interval == 1 else f"every {self.interval} steps"

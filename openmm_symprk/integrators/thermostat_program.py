@@ -1,6 +1,6 @@
 """The velocity-rescaling thermostat as CustomIntegrator computations (the CustomIntegrator backend).
 
-One half event (:func:`emit_half_event`) computes, with ``addComputeSum`` over the degrees of freedom,
+One event (:func:`emit_event`, over the fraction of the thermostat's interval its sub-step gives) computes, with ``addComputeSum`` over the degrees of freedom,
 
     M = sum m,  P = sum m v,  K = sum m v.v / 2
     and, when the rotation is kept (isolated System): sum m x, then, about the centre of mass R = sum m x / M, the
@@ -30,7 +30,7 @@ from .projection import emit_inertia, emit_rigid_solve
 from .thermostat import ThermostatSettings
 
 __all__ = ["PREFIX", "LOST_MASK_VAR", "TEMPERATURE_VAR", "COLLISION_TIME_VAR", "HEAT_BATH_VAR", "MASK_VAR", "ALPHA_VAR",
-           "KINETIC_VAR", "NEW_KINETIC_VAR", "add_variables", "emit_half_event", "emit_event", "mask_values",
+           "KINETIC_VAR", "NEW_KINETIC_VAR", "add_variables", "emit_event", "mask_values",
            "TOTAL_KINETIC_VAR", "SKIPPED_VAR", "event_kinetic_energy", "emit_noise", "R1_VAR", "CHI2_VAR"]
 
 PREFIX = "symprk_ts_"
@@ -166,14 +166,9 @@ def _emit_rotation(ig):
         ig.addComputeGlobal(v(f"w{a}"), f"select({linear}, select({tr}, 2*{v(f'Lc{a}')}/{tr}, 0), {v(f'w{a}')})")
 
 
-def emit_half_event(integrator: mm.CustomIntegrator, settings: ThermostatSettings) -> None:
-    """Append one half thermostat event (relaxation factor c = exp(-(n dt/2)/tau)): the ends placement."""
-    emit_event(integrator, settings, 0.5)
-
-
 def emit_event(integrator: mm.CustomIntegrator, settings: ThermostatSettings, fraction: float) -> None:
-    """Append one thermostat event over ``fraction`` of the step (c = exp(-fraction n dt/tau)): 0.5 at each end of
-    the step, 1 for the one event of the middle placement."""
+    """Append one thermostat event over ``fraction`` of the thermostat's interval of n steps (c = exp(-fraction n
+    dt/tau)): the coefficient of its THERMOSTAT sub-step (:mod:`openmm_symprk.methods.resolved`)."""
     ig = integrator
     v = _v
     rot = settings.keep_rotation

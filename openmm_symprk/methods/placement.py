@@ -20,13 +20,16 @@ from fractions import Fraction
 
 import numpy as np
 
-__all__ = ["THERMOSTAT", "POSITIONS", "check_position", "centre", "with_thermostat", "harmonic_sampling", "placement_errors",
+__all__ = ["THERMOSTAT", "POSITIONS", "PLACEMENT_TEXT", "check_position", "centre", "with_thermostat", "harmonic_sampling", "placement_errors",
            "best_position", "H_OMEGA_GRID"]
 
 #: The label of a thermostat event in a step sequence.
 THERMOSTAT = "thermostat"
 #: The placements a user can ask for ("auto": the one :func:`best_position` picks for the method).
 POSITIONS = ("ends", "middle", "auto")
+#: How each placement reads in an integrator's description (of the outer step with multiple time stepping).
+PLACEMENT_TEXT = {"ends": "half events around the step", "middle": "one event at the centre of the step",
+                  "auto": "placement: auto"}
 #: The h*omega values over which "auto" compares the placements: water's librations at 1-4 fs span about
 #: 0.13-0.5, an O-H stretch at 1 fs about 0.9.
 H_OMEGA_GRID = (0.25, 0.5, 0.75, 1.0)

@@ -41,7 +41,7 @@ from .respa import MTSError, evaluations_per_step, label_groups, levels, mts_gro
 from .splitting import DRIFT, KICK, Splitting
 from .tableau import PRKTableau, TableauError
 
-__all__ = ["resolve", "thermostat_position_for", "ResolvedMethod", "Substep", "SubstepKind", "SubstepFlag", "EventPhase",
+__all__ = ["resolve", "thermostat_position_for", "ResolvedMethod", "Substep", "substep_label", "SubstepKind", "SubstepFlag", "EventPhase",
            "ConstraintSupportError", "projected_drifts", "FORMS"]
 
 #: The form of a step, which decides how it runs: a kick/drift sequence (any splitting or composition, multiple time
@@ -102,11 +102,7 @@ class Substep:
     @property
     def label(self) -> str:
         """"drift", "kick", or "kick:<groups>" (the labels of :class:`~.splitting.Splitting`), or "thermostat"."""
-        if self.kind == SubstepKind.DRIFT:
-            return DRIFT
-        if self.kind == SubstepKind.THERMOSTAT:
-            return THERMOSTAT
-        return KICK if self.groups is None else KICK + ":" + ",".join(map(str, self.groups))
+        return substep_label(self.kind, self.groups)
 
     @property
     def is_kick_or_drift(self) -> bool:
@@ -123,6 +119,17 @@ class Substep:
     def group_mask(self) -> int:
         """The force groups as a bit mask, -1 for drifts and for kicks of all forces."""
         return -1 if self.groups is None else sum(1 << g for g in self.groups)
+
+
+def substep_label(kind, groups=None) -> str:
+    """The label of a sub-step of ``kind`` (a :class:`SubstepKind` or its number) and, for a kick, its force ``groups``
+    (None: all): "drift", "thermostat", "kick" or "kick:<groups>"."""
+    kind = SubstepKind(kind)
+    if kind == SubstepKind.DRIFT:
+        return DRIFT
+    if kind == SubstepKind.THERMOSTAT:
+        return THERMOSTAT
+    return KICK if groups is None else KICK + ":" + ",".join(map(str, groups))
 
 
 def projected_drifts(splitting: Splitting) -> list:

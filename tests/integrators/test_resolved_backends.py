@@ -120,6 +120,36 @@ def test_xml_carries_the_flags_and_refuses_the_old_format(water8):
 
 
 @needs_native
+@pytest.mark.parametrize("interval", [1, 3])
+def test_xml_written_before_the_events_were_substeps_still_loads(water8, interval):
+    """Native XML of an ends-placement integrator from before the thermostat's events were sub-steps has a Thermostat
+    node and no thermostat Substep: it is read back with the ends placement's two events (the plugin's proxy adds
+    them), resolved as the method with thermostat_position="ends", with the same program signature (its checkpoints
+    load), and it runs the same trajectory bit for bit."""
+    import re
+
+    def make():
+        return NativeSymplecticIntegrator(0.002, "omelyan-2", system=water8.system, temperature=300, random_seed=3,
+                                          thermostat_interval=interval, thermostat_position="ends")
+
+    ig = make()
+    xml = mm.XmlSerializer.serialize(ig)
+    old = re.sub(r'\s*<Substep c="\.5" flags="(4|8)" kind="thermostat"/>', "", xml)
+    assert old.count('kind="thermostat"') == 0 and xml.count('kind="thermostat"') == 2
+    back = deserialize(old)
+    assert back.resolved == ig.resolved and back.thermostat == ig.thermostat
+    assert back.getProgramSignature() == ig.getProgramSignature()
+    runs = []
+    for integrator in (ig, back):
+        ctx = water8.context(integrator)
+        integrator.step(7)
+        runs.append((ctx.getState(getVelocities=True).getVelocities(asNumpy=True)._value.tobytes(),
+                     integrator.computeHeatBathEnergy()))
+        del ctx
+    assert runs[0] == runs[1]
+
+
+@needs_native
 def test_checkpoint_of_the_old_format_is_refused(water8):
     ig = NativeSymplecticIntegrator(0.001, "verlet", system=water8.system)
     ctx = water8.context(ig)

@@ -412,7 +412,7 @@ def test_mts_thermostat_wraps_the_outer_step(water8):
     system = mm.XmlSerializer.clone(water8.system)
     groups = split_forces(system, slow="nonbonded", substeps=2)
     ig = N(2 * unit.femtoseconds, "verlet", system=system, groups=groups, temperature=300, random_seed=2, thermostat_position="ends")
-    assert "around the outer step" in ig.describe()
+    assert "half events around the step (the outer step)" in ig.describe()
     ctx = mm.Context(system, ig, _platform("Reference"))
     ctx.setPositions(water8.positions)
     ctx.setVelocities(water8.velocities)
