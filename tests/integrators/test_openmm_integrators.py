@@ -92,7 +92,7 @@ def test_rk4_loses_angular_momentum(morse):
 
 
 ORDER_CASES = ["verlet", "position-verlet", "yoshida-4", "mclachlan-atela-4", "mclachlan-atela-5", "kahan-li-6",
-               "gauss-2", "lobatto-iiia-iiib-3", "rk4"]
+               "gauss-2", "lobatto-iiia-iiib-3", "rk4", "bcss-2", "bcss-3", "predescu-3"]
 
 
 @pytest.mark.parametrize("name", ORDER_CASES)
@@ -106,7 +106,8 @@ def test_measured_order_on_openmm(name, morse):
 
 
 CONSTRAINED_CASES = ["verlet", "position-verlet", "yoshida-4", "forest-ruth-4-position", "suzuki-4",
-                     "yoshida-6", "kahan-li-6", "pefrl", "blanes-moan-srkn6b-4", "omelyan-2"]
+                     "yoshida-6", "kahan-li-6", "pefrl", "blanes-moan-srkn6b-4", "omelyan-2", "bcss-2", "bcss-3",
+                     "predescu-3"]
 
 
 @pytest.mark.parametrize("name", CONSTRAINED_CASES)

@@ -86,7 +86,7 @@ def test_methods_and_info(capsys):
     rc, out, _ = _run(["methods", "pefrl"], capsys)
     assert rc == 0 and "pefrl" in out and "sequence (applied left to right)" in out
     rc, out, _ = _run(["info"], capsys)
-    assert rc == 0 and "platform Reference" in out and "catalogue: 28 methods" in out
+    assert rc == 0 and "platform Reference" in out and "catalogue: 31 methods" in out
     if "Reference" in plugin.thermostat_platforms():
         assert "NVT thermostat (temperature=): native" in out
     rc, _, err = _run(["info", "--require-native", "Nosuch"], capsys)
