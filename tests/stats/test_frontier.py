@@ -1,0 +1,86 @@
+"""The frontier's arithmetic (openmm_symprk.stats.frontier) on synthetic families whose biases are known exactly:
+b(h) = c h^p plus replica noise, paired with a reference replica by replica."""
+import numpy as np
+import pytest
+
+from openmm_symprk.stats.frontier import Family, bootstrap, compare, equal_accuracy_step, fit_c, frontier
+
+
+def _family(name, c, steps, n=12, noise=0.01, order=2, seed=0, cost=1.0, shared=None, cap=None):
+    """Biases c h^p + noise; ``shared`` (n,): a replica-to-replica term common to every row (the reference's own
+    noise, which pairing carries into every row's bias)."""
+    rng = np.random.default_rng(seed)
+    steps = np.asarray(steps, dtype=float)
+    b = c * steps[:, None] ** order + rng.normal(0, noise, (len(steps), n))
+    if shared is not None:
+        b = b + shared[None, :]
+    return Family(name, tuple(steps), {"pe": b}, order=order, cost_per_step=cost, cap=cap)
+
+
+def test_fit_recovers_c_and_weights_the_rows():
+    f = _family("v", 0.01, [1, 2, 3], noise=1e-6)
+    assert fit_c(f.steps, f.bias["pe"], 2) == pytest.approx(0.01, rel=1e-4)
+    # weights: a noisy row counts for little (its SE is 100x larger)
+    b = np.array(f.bias["pe"])
+    b[2] = 0.5 + np.random.default_rng(3).normal(0, 1e-2, 12)  # a wild row at h = 3, but very noisy
+    b[2] += 100 * (b[2] - b[2].mean())
+    assert fit_c(f.steps, b, 2) == pytest.approx(0.01, rel=0.05)
+
+
+def test_equal_accuracy_step_is_the_smallest_over_observables_and_capped():
+    h = equal_accuracy_step({"pe": 0.01, "d": 0.04}, {"pe": 0.04, "d": 0.04}, 2, cap=10.0)
+    assert h == pytest.approx(1.0)  # d binds: (0.04/0.04)^(1/2)
+    assert equal_accuracy_step({"pe": 0.0}, {"pe": 0.04}, 2, cap=3.0) == 3.0  # no bias: the largest step
+    assert equal_accuracy_step({"pe": -0.01}, {"pe": 0.04}, 2, cap=10.0) == pytest.approx(2.0)  # |c|
+
+
+def test_two_families_compare_by_the_closed_form():
+    """cost_B/cost_A = (s_B/s_A)(c_B/c_A)^(1/p) whatever the tolerance (THEORY section 7's arithmetic: Verlet c 0.0099,
+    omelyan-2 c 0.0007 at two evaluations a step: 1.9x fewer evaluations)."""
+    verlet = _family("verlet", 0.0099, [0.5, 1, 2], noise=1e-7, cost=1.0, cap=100)
+    omelyan = _family("omelyan-2", 0.0007, [4, 5, 6, 7], noise=1e-7, cost=2.0, seed=1, cap=100)
+    boot = bootstrap([verlet, omelyan], ["pe"], n_boot=200)
+    for eps in (0.01, 0.03, 0.1):
+        a = frontier(omelyan, {"pe": eps}, boot["omelyan-2"])
+        b = frontier(verlet, {"pe": eps}, boot["verlet"])
+        ratio, low, high = compare(a, b, 2.0, 1.0)
+        assert ratio == pytest.approx((1.0 / 2.0) * (0.0099 / 0.0007) ** 0.5, rel=1e-3)  # 1.88
+        assert low <= ratio <= high and high / low < 1.01  # noise-free: a tight interval
+        assert a.limited_by == b.limited_by == "pe"
+
+
+def test_a_family_without_measurable_bias_is_held_to_its_largest_step():
+    flat = _family("flat", 0.0, [4, 6], noise=0.001)
+    boot = bootstrap([flat], ["pe"], n_boot=200)
+    point = frontier(flat, {"pe": 1.0}, boot["flat"])
+    assert point.step == 6.0 and point.limited_by == "largest step" and point.safe_step == 6.0
+
+
+def test_the_interval_covers_the_truth_about_as_often_as_it_says():
+    """Calibration: 120 synthetic studies (12 replicas, noise comparable to the bias at the smaller steps, the
+    reference's own noise shared by both families through the pairing); the 95 % interval of the ratio contains the
+    true ratio in 85-100 % of them, and the 95 % safe step is below the true equal-accuracy step in >= 85 %."""
+    p, eps = 2, 0.02
+    true_ratio = (1.0 / 1.0) * (0.01 / 0.002) ** 0.5
+    covered, safe_ok = 0, 0
+    runs = 120
+    for k in range(runs):
+        shared = np.random.default_rng(1000 + k).normal(0, 0.01, 12)
+        a = _family("a", 0.002, [2, 3, 4], noise=0.01, seed=2 * k, shared=shared, cap=50)
+        b = _family("b", 0.01, [1, 1.5, 2], noise=0.01, seed=2 * k + 1, shared=shared, cap=50)
+        boot = bootstrap([a, b], ["pe"], n_boot=300, seed=k)
+        fa, fb = frontier(a, {"pe": eps}, boot["a"]), frontier(b, {"pe": eps}, boot["b"])
+        _, low, high = compare(fa, fb, 1.0, 1.0)
+        covered += low <= true_ratio <= high
+        safe_ok += fa.safe_step <= (eps / 0.002) ** (1 / p)
+    assert 0.85 * runs <= covered <= runs, covered
+    assert safe_ok >= 0.85 * runs, safe_ok
+
+
+def test_bad_families_are_refused():
+    with pytest.raises(ValueError, match="steps must be a non-empty list of positive steps"):
+        Family("x", (), {"pe": np.zeros((0, 3))})
+    with pytest.raises(ValueError, match="pe has 2 rows of biases for 3 steps"):
+        Family("x", (1, 2, 3), {"pe": np.zeros((2, 3))})
+    with pytest.raises(ValueError, match="at least two replicas"):
+        fit_c([1, 2], np.full((2, 1), 0.1), 2)
