@@ -169,3 +169,27 @@ def test_rotational_energy_from_omega_is_the_temperature_modules():
     inertia = trajectory_frames(x, v, m, mols).inertia[0]
     k_rot = 0.5 * np.einsum("ni,nij,nj->n", w, inertia, w)
     np.testing.assert_allclose(k_rot, molecule_kinetics(x[0], v[0], m, mols).rotational, rtol=1e-10)
+
+
+# -- grid-free features: the same curve read on a fine and a coarse grid ----------------------------------------------
+def _libration_acf(t_fs):
+    """A normalised angular-velocity ACF shaped like rigid water's (first zero near 15 fs, first minimum near -0.47
+    at 27 fs): a damped cosine plus a slow positive tail."""
+    t = np.asarray(t_fs, dtype=float)
+    return 0.95 * np.exp(-t / 45.0) * np.cos(np.pi * t / 28.8) + 0.05 * np.exp(-t / 300.0)
+
+
+@pytest.mark.parametrize("grid_fs", [4.0, 6.0, 7.0])
+def test_features_do_not_hang_on_the_sample_grid(grid_fs):
+    """The curve sampled every 0.5 fs and every 4, 6 or 7 fs (the frame grids of rows at those steps): the first zero
+    within 0.01 fs, the first minimum within 0.05 fs and 3e-4 in value of the 0.5-fs reading, where the lowest sample
+    of the 6-fs grid is 0.027 above the minimum (90 times the interpolation's error)."""
+    fine = acf_summary(_libration_acf(np.arange(0, 500.5, 0.5)), 0.5e-3)  # (times in ps)
+    coarse_c = _libration_acf(np.arange(0, 500.5, grid_fs))
+    coarse = acf_summary(coarse_c, grid_fs * 1e-3)
+    assert abs(coarse.t_zero - fine.t_zero) < 0.01e-3  # ps
+    assert abs(coarse.t_min - fine.t_min) < 0.05e-3 and abs(coarse.c_min - fine.c_min) < 3e-4
+    grid_min = coarse_c[np.argmin(coarse_c[:20])]
+    if grid_fs == 6.0:
+        assert grid_min - fine.c_min > 0.02  # what reading the grid gave
+    assert 14e-3 < fine.t_zero < 16e-3 and -0.5 < fine.c_min < -0.43
