@@ -15,11 +15,13 @@ Fixed seeds; every bound is 3 standard errors (4 for the secondary moments: twel
 also asserts the resolution it claims."""
 import math
 
+import numpy as np
 import openmm as mm
+import openmm.unit as unit
 import pytest
 
 from helpers import native_skip_reason
-from openmm_symprk import plugin
+from openmm_symprk import SymplecticIntegrator, plugin
 from openmm_symprk.integrators.noise import sample_thermostat_noise
 from openmm_symprk.studies.nvt.known import OSCILLATORS, exact_temperatures, noise_draws, stationary_temperatures
 
@@ -132,3 +134,26 @@ def test_native_samples_what_custom_samples(stationary, backend, platform, posit
         se = math.hypot(native.se, custom.se)
         assert se < resolution, se
         assert abs(native.mean - custom.mean) < 3 * se, (native.mean, custom.mean, se)
+
+
+# -- common random numbers: rows on one event grid draw the same numbers ---------------------------------------------
+@pytest.mark.parametrize("backend, platform", [_case("native", "Reference"), _case("native", "OpenCL")])
+def test_runs_on_one_event_grid_draw_the_same_numbers(backend, platform, water8):
+    """Two runs with events at the same simulated times (2 fs steps every 6 steps, 4 fs steps every 3: every 12 fs)
+    and the same seed consume the thermostat's stream event for event: after the same simulated time the next draws
+    coincide bit for bit, although the runs took different steps and scaled different kinetic energies (the draws
+    do not depend on the state).  This pairs an NVT row with the NVT reference replica by replica, as NVE rows are."""
+    props = DOUBLE if platform == "OpenCL" else {}
+    next_draws = []
+    for step_fs, interval in ((2.0, 6), (4.0, 3)):
+        ig = SymplecticIntegrator(step_fs * 1e-3, "omelyan-2", system=water8.system, backend=backend, temperature=300,
+                                  collision_time=0.1, thermostat_interval=interval, random_seed=77,
+                                  thermostat_position="ends")
+        ctx = mm.Context(water8.system, ig, mm.Platform.getPlatformByName(platform), props)
+        ctx.setPositions(water8.positions)
+        ctx.setVelocities(water8.velocities)
+        ig.step(int(round(48 / step_fs)))  # 48 fs: 4 intervals, 8 events
+        assert ig.computeHeatBathEnergy().value_in_unit(unit.kilojoule_per_mole) != 0
+        next_draws.append(np.asarray(ig.sampleThermostatNoise(4)))
+        del ctx
+    assert next_draws[0].tobytes() == next_draws[1].tobytes()
