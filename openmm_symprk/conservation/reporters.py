@@ -39,7 +39,7 @@ import openmm.app as app
 import openmm.unit as unit
 
 from ..physics import momenta
-from ..physics.temperature import R_KJ, kinetic_temperatures
+from ..physics.temperature import kinetic_temperatures
 from ..support import require
 from ..stats.slope import RunningLine
 from ..systems.checks import conservation_issues, integrator_issues, warn_conservation, warn_once
