@@ -1,8 +1,7 @@
 """Conservation study: platform x method x exact-momentum projection, as a markdown table.
 
-    python -m openmm_symprk.studies.conservation_table            # full table (a few minutes)
-    python -m openmm_symprk.studies.conservation_table --quick    # 8 waters, 500 steps, verlet
-    symprk conservation [options]                         # same, through the CLI
+    symprk conservation            # full table (a few minutes)
+    symprk conservation --quick    # 8 waters, 500 steps, verlet
 
 For every scene, platform and method, two integrators run side by side from the same state: the
 method as compiled without projection ("off") and the complete exact-momentum program ("on":
@@ -147,8 +146,8 @@ def failure_table(rows) -> str:
     return "\n".join(lines)
 
 
-def build_parser():
-    p = argparse.ArgumentParser(prog="symprk conservation", description=__doc__.split("\n\n")[0],
+def build_parser(prog: str = "symprk conservation"):
+    p = argparse.ArgumentParser(prog=prog, description=__doc__.split("\n\n")[0],
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--steps", type=int, default=2000, help="steps per run (default 2000)")
     p.add_argument("--platforms", default=",".join(DEFAULT_PLATFORMS),
@@ -166,8 +165,7 @@ def build_parser():
     return p
 
 
-def main(argv=None) -> int:
-    args = build_parser().parse_args(argv)
+def run(args):
     if args.quick:
         args.steps, args.waters, args.methods, args.scenes = 500, 8, "verlet", "water"
     warnings.simplefilter("ignore")  # conservation warnings are the subject here, not news
@@ -183,8 +181,7 @@ def main(argv=None) -> int:
                 rows.append(r)
                 print(f"  {scene.name} {spec} {method}: dL/L off {_fmt(r['dL_off'])} on {_fmt(r['dL_on'])}, "
                       f"cost x{r['ratio']:.2f}", file=sys.stderr, flush=True)
-    cmd = "symprk conservation " + " ".join(argv if argv is not None else sys.argv[1:])
-    parts = [f"Command: `{cmd.strip()}` ({args.steps} steps of {args.step_size * 1000:g} fs; OpenMM "
+    parts = [f"Command: `{' '.join([args.prog, *args.argv])}` ({args.steps} steps of {args.step_size * 1000:g} fs; OpenMM "
              f"{mm.Platform.getOpenMMVersion()})", "", table(rows)]
     if missing:
         parts += ["", f"Platforms not available here: {', '.join(missing)}"]
@@ -194,8 +191,3 @@ def main(argv=None) -> int:
     print(text)
     if args.out:
         write_text(args.out, text + "\n")
-    return 0
-
-
-if __name__ == "__main__":
-    sys.exit(main())

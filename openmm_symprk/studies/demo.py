@@ -11,6 +11,7 @@ ratio to OpenMM's VerletIntegrator measured in the same run (the integrators tak
 """
 from __future__ import annotations
 
+import argparse
 from dataclasses import dataclass
 
 import numpy as np
@@ -21,10 +22,12 @@ from ..conservation.diagnostics import angular_momentum, linear_momentum
 from ..integrators.thermostat import DEFAULT_COLLISION_TIME
 from ..systems.properties import degrees_of_freedom
 from ..systems.scenes import water_cluster
+from .core import platforms
+from .core.options import positive
 from .core.rows import Row
 from .timing import interleaved
 
-__all__ = ["ROWS", "DemoRow", "run_demo", "default_platform"]
+__all__ = ["ROWS", "DemoRow", "run_demo", "default_platform", "build_parser", "run"]
 
 #: The demo's rows, in order: (name printed, row label without its step; :class:`~.core.rows.Row`).  The first row is
 #: the timing reference.  The thermostatted rows run at 300 K: ours with the package's default collision time, OpenMM's
@@ -55,8 +58,7 @@ class DemoRow:
 def default_platform(names=None) -> tuple[str, str]:
     """(platform, note): CPU where this installation has it (``names``: the platform names, default OpenMM's),
     else Reference with a note saying why."""
-    if names is None:
-        names = [mm.Platform.getPlatform(i).getName() for i in range(mm.Platform.getNumPlatforms())]
+    names = platforms.names() if names is None else names
     if "CPU" in names:
         return "CPU", ""
     return "Reference", f"OpenMM's CPU platform is not available here (platforms: {', '.join(names)}); " \
@@ -153,3 +155,21 @@ def run_demo(methods=None, n_waters: int = 64, steps: int = 2000, step_fs: float
             "1/ps) has no heat-bath energy (-).  Our thermostat rescales the velocities relative to the\n"
             "cluster's rigid motion, so P and L stay; Langevin's random forces change both.")
     return rows
+
+
+def build_parser(prog: str = "symprk demo"):
+    p = argparse.ArgumentParser(prog=prog, description="spinning rigid-water cluster: conservation vs OpenMM's "
+                                                       "Verlet and Langevin")
+    p.add_argument("--method", nargs="+", default=None,
+                   help="catalogue names, each an NVE row beside OpenMM's Verlet (default: the demo's rows)")
+    p.add_argument("--waters", type=positive(int), default=64)
+    p.add_argument("--steps", type=positive(int), default=2000)
+    p.add_argument("--step-fs", type=positive(float), default=2.0)
+    p.add_argument("--platform", default=None, help="default: CPU (Reference where CPU is missing)")
+    p.add_argument("--backend", default="auto", choices=("auto", "native", "custom"))
+    return p
+
+
+def run(args):
+    run_demo(methods=args.method, n_waters=args.waters, steps=args.steps, step_fs=args.step_fs,
+             platform=None if args.platform is None else platforms.check(args.platform), backend=args.backend)

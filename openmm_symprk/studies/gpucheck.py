@@ -1,7 +1,7 @@
 """The GPU check: the native backend on OpenMM's CUDA platform, in one command.
 
-    python -m openmm_symprk.studies.gpucheck          # = symprk gpucheck
-    python -m openmm_symprk.studies.gpucheck --quick  # fewer steps, the PME box only
+    symprk gpucheck          # mixed and double precision
+    symprk gpucheck --quick  # fewer steps, the PME box only
 
 Needs OpenMM's CUDA platform (``pip install "openmm_symprk[cuda12]"`` and an NVIDIA GPU with its driver).
 For mixed and double precision it prints, as markdown tables:
@@ -14,12 +14,11 @@ For mixed and double precision it prints, as markdown tables:
    force evaluation, integrators taking turns) on a periodic rigid TIP3P box with PME and on villin solvated
    to about 23,000 atoms (PME, HBonds, rigid water).
 
-Without a CUDA platform it says why and exits with status 1.  Not a test: nothing is asserted.
+Without a CUDA platform it says why in one line and exits with status 2.  Not a test: nothing is asserted.
 """
 from __future__ import annotations
 
 import argparse
-import sys
 import warnings
 
 import numpy as np
@@ -144,15 +143,19 @@ def speed(boxes, precisions, steps, rounds):
     return "\n".join(rows)
 
 
-def main(argv=None) -> int:
-    p = argparse.ArgumentParser(prog="symprk gpucheck", description=__doc__.split("\n\n")[0])
+def build_parser(prog: str = "symprk gpucheck"):
+    p = argparse.ArgumentParser(prog=prog, description=__doc__.split("\n\n")[0])
     p.add_argument("--quick", action="store_true", help="fewer steps; the PME box only for speed")
     p.add_argument("--precisions", default="mixed,double")
-    args = p.parse_args(argv)
+    return p
+
+
+def run(args):
+    from ..plugin import NativeUnavailableError
+
     reason = cuda_unavailable_reason()
     if reason:
-        print(f"symprk gpucheck: {reason}", file=sys.stderr)
-        return 1
+        raise NativeUnavailableError(reason)
     warnings.simplefilter("ignore")
     from ..studies.native_speed import water_box_system
     from ..systems.scenes import protein_vacuum, water_cluster
@@ -171,8 +174,3 @@ def main(argv=None) -> int:
         boxes["villin in water, PME"] = _solvated_villin(23000)
     print("\nSpeed (fastest of the blocks, integrators taking turns):\n")
     print(speed(boxes, precisions, 50 if args.quick else 300, 2 if args.quick else 4))
-    return 0
-
-
-if __name__ == "__main__":
-    sys.exit(main())

@@ -1,7 +1,7 @@
 """Benchmark of the native backend against OpenMM's VerletIntegrator and the CustomIntegrator path.
 
-    python -m openmm_symprk.studies.native_speed            # CPU platform, both systems (a few minutes)
-    python -m openmm_symprk.studies.native_speed --quick    # fewer steps
+    symprk speed            # CPU platform, both systems (a few minutes)
+    symprk speed --quick    # fewer steps
 
 Prints, per system, the time per step of OpenMM's VerletIntegrator and, for each method, of the native
 integrator and of the CustomIntegrator (``openmm_symprk.SymplecticIntegrator``), with the ratios
@@ -92,9 +92,8 @@ def format_table(title, best, methods, constraints: bool = True) -> str:
     return "\n".join(lines)
 
 
-def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m openmm_symprk.studies.native_speed",
-                                 description=__doc__.split("\n\n")[0])
+def build_parser(prog: str = "symprk speed"):
+    ap = argparse.ArgumentParser(prog=prog, description=__doc__.split("\n\n")[0])
     ap.add_argument("--platform", default="CPU")
     ap.add_argument("--precision", default=None, help="OpenCL/CUDA precision property (single, mixed, double)")
     ap.add_argument("--methods", default=",".join(DEFAULT_METHODS))
@@ -107,15 +106,16 @@ def main(argv=None) -> int:
     ap.add_argument("--quick", action="store_true", help="fewer steps and repeats (a rough look)")
     ap.add_argument("--no-forces", action="store_true",
                     help="remove every force (constraints stay): times the integrators' own work alone")
-    args = ap.parse_args(argv)
+    return ap
+
+
+def run(args):
     from .. import plugin
 
     if not plugin.available():
-        print(f"native backend unavailable: {plugin.unavailable_reason()}")
-        return 1
+        raise plugin.NativeUnavailableError(f"the native backend is unavailable: {plugin.unavailable_reason()}")
     if args.platform not in plugin.platforms():
-        print(f"no native kernel for platform {args.platform} (have: {', '.join(plugin.platforms())})")
-        return 1
+        raise ValueError(f"--platform {args.platform}: no native kernel for it (have: {', '.join(plugin.platforms())})")
     methods = [m.strip() for m in args.methods.split(",") if m.strip()]
     props = {"Precision": args.precision} if args.precision else {}
     import os
@@ -131,7 +131,7 @@ def main(argv=None) -> int:
             title, system, pos, vel = water_box_system(args.box_nm)
             steps = args.steps or (20 if args.quick else 100)
         else:
-            raise SystemExit(f"unknown system {which!r} (cluster, box)")
+            raise ValueError(f"--systems: unknown system {which!r}; known: cluster, box")
         if args.no_forces:
             while system.getNumForces():
                 system.removeForce(0)
@@ -141,8 +141,3 @@ def main(argv=None) -> int:
         print(format_table(f"{title}: {steps} steps x best of {1 if args.quick else args.repeats}", best, methods,
                            system.getNumConstraints() > 0))
     print(f"load average after: {os.getloadavg()[0]:.2f}")
-    return 0
-
-
-if __name__ == "__main__":
-    raise SystemExit(main())

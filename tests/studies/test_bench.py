@@ -28,7 +28,10 @@ def _small_config():
 
 
 def test_quick_pipeline_end_to_end_and_resume(tmp_path):
-    from openmm_symprk.studies.bench.cli import main
+    from openmm_symprk.cli import main as symprk
+
+    def main(argv):
+        return symprk(["bench", *argv])
 
     out = str(tmp_path / "quick")
     assert main(["--quick", "--out", out, "--workers", "2", "--no-progress"]) == 0

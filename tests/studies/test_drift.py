@@ -7,12 +7,16 @@ import numpy as np
 import pytest
 
 from openmm_symprk.studies.drift import presets
-from openmm_symprk.studies.drift.cli import main
+from openmm_symprk.cli import main as symprk
 from openmm_symprk.studies.drift.report import format_summary
 from openmm_symprk.studies.drift.study import run_study
 from openmm_symprk.physics.temperature import R_KJ
 from openmm_symprk.studies.drift.verdict import (claim_verdict, cost_verdict, magnitude, ratio, row_estimate,
                                                  run_drift)
+
+
+def main(argv):
+    return symprk(["drift", *argv])
 
 
 # -- the verdict on synthetic drifts -----------------------------------------------------------------------------

@@ -5,9 +5,13 @@ import os
 import pytest
 
 from openmm_symprk.studies.equipartition import presets, run_study
-from openmm_symprk.studies.equipartition.cli import main
+from openmm_symprk.cli import main as symprk
 from openmm_symprk.studies.equipartition.report import format_summary
 from openmm_symprk.studies.equipartition.runs import steps_per_sample
+
+
+def main(argv):
+    return symprk(["equipartition", *argv])
 
 
 def _tiny():

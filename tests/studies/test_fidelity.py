@@ -11,11 +11,15 @@ import pytest
 
 from openmm_symprk.studies.core import jsonable
 from openmm_symprk.studies.fidelity import presets
-from openmm_symprk.studies.fidelity.cli import main
+from openmm_symprk.cli import main as symprk
 from openmm_symprk.analysis.observe import OBSERVABLES
 from openmm_symprk.studies.fidelity.report import K_SE, summarise
 from openmm_symprk.studies.fidelity.rowspec import UNAVAILABLE_THERMOSTAT, check_row, describe, label
 from openmm_symprk.studies.fidelity.simulation import run_key, run_study
+
+
+def main(argv):
+    return symprk(["fidelity", *argv])
 
 
 @pytest.fixture(scope="module")

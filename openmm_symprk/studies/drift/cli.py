@@ -16,7 +16,7 @@ import argparse
 import os
 import sys
 
-from ..core.cli import run_study_command
+from ..core.options import run_study
 from ..core.platforms import split
 from . import presets
 
@@ -84,13 +84,12 @@ def make_config(args) -> dict:
     return cfg
 
 
-def main(argv=None, prog: str = "symprk drift") -> int:
-    args = build_parser(prog).parse_args(argv)
+def run(args):
     if not args.out:
         args.out = os.path.join("drift-results", args.study + ("-quick" if args.quick else ""))
-    rc = run_study_command(prog, args, {}, lambda cfg: cfg.update(make_config(args)),
-                           "openmm_symprk.studies.drift.study", "openmm_symprk.studies.drift.report")
-    if rc == 0 and (args.chart or args.json):
+    run_study(args, {}, lambda cfg: cfg.update(make_config(args)), "openmm_symprk.studies.drift.study",
+              "openmm_symprk.studies.drift.report")
+    if args.chart or args.json:
         import json
         import shutil
 
@@ -102,13 +101,8 @@ def main(argv=None, prog: str = "symprk drift") -> int:
             write_json(args.json, summary)
             print(f"wrote {args.json}")
         if args.chart and not os.path.exists(os.path.join(args.out, "nvt-drift.png")):
-            print(f"{prog}: no chart was drawn (see above), so none is copied to {args.chart}", file=sys.stderr)
+            print(f"{args.prog}: no chart was drawn (see above), so none is copied to {args.chart}", file=sys.stderr)
         elif args.chart:
             os.makedirs(os.path.dirname(os.path.abspath(args.chart)), exist_ok=True)
             shutil.copyfile(os.path.join(args.out, "nvt-drift.png"), args.chart)
             print(f"wrote {args.chart}")
-    return rc
-
-
-if __name__ == "__main__":
-    sys.exit(main())

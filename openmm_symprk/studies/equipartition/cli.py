@@ -2,9 +2,8 @@
 from __future__ import annotations
 
 import argparse
-import sys
 
-from ..core.cli import add_study_arguments, run_study_command
+from ..core.options import add_study_arguments, run_study
 from ..core.rows import Row
 from . import presets
 
@@ -22,8 +21,8 @@ def _rows(text: str) -> list:
     return rows
 
 
-def build_parser():
-    ap = argparse.ArgumentParser(prog="symprk equipartition", description=__doc__)
+def build_parser(prog: str = "symprk equipartition"):
+    ap = argparse.ArgumentParser(prog=prog, description=__doc__)
     add_study_arguments(ap, quick="64 waters, short runs: seconds, large error bars", out="equipartition-results",
                         workers="worker processes (each runs one NVE run at a time)",
                         length="NVE length measured per replica")
@@ -34,8 +33,7 @@ def build_parser():
     return ap
 
 
-def main(argv=None) -> int:
-    args = build_parser().parse_args(argv)
+def run(args):
     cfg = presets.quick() if args.quick else presets.full()
 
     def configure(cfg):
@@ -53,9 +51,5 @@ def main(argv=None) -> int:
             rows = ([ref] if ref not in given else []) + given
             cfg["models"] = {m: rows for m in cfg["models"]}
 
-    return run_study_command("symprk equipartition", args, cfg, configure, "openmm_symprk.studies.equipartition.study",
-                             "openmm_symprk.studies.equipartition.report")
-
-
-if __name__ == "__main__":
-    sys.exit(main())
+    run_study(args, cfg, configure, "openmm_symprk.studies.equipartition.study",
+              "openmm_symprk.studies.equipartition.report")
