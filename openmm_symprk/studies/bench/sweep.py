@@ -37,7 +37,7 @@ from .runs import RunSpec, label
 from .store import Store, run_key
 
 
-class SweepExistsError(RuntimeError):
+class SweepExistsError(FileExistsError):
     """The output folder already holds finished runs and resume was not asked for."""
 
 

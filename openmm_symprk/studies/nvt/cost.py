@@ -139,7 +139,7 @@ def run(scenes=("water", "villin"), quick: bool = False, steps=None, rounds: int
     from ... import plugin
 
     if not plugin.available():
-        raise RuntimeError(f"the native backend is unavailable: {plugin.unavailable_reason()}")
+        raise plugin.NativeUnavailableError(f"the native backend is unavailable: {plugin.unavailable_reason()}")
     where = f"platform CPU, {threads} threads" if platform == "CPU" else f"platform {platform}"
     log(f"openmm {mm.version.full_version}, {where}, load average before "
         f"{os.getloadavg()[0]:.2f} (other processes slow some blocks; each row keeps its fastest)")
