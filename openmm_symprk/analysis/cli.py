@@ -29,7 +29,7 @@ from ..support import require
 __all__ = ["OBSERVED", "observe", "build_parser", "run"]
 
 #: (key, description, unit) of what ``symprk observe`` reports, in its order.  It reads like
-#: :data:`openmm_symprk.analysis.observe.OBSERVABLES` on purpose but is not that table: that one's keys are the keys
+#: :data:`openmm_symprk.studies.fidelity.observables.OBSERVABLES` on purpose but is not that table: that one's keys are the keys
 #: of the fidelity study's stored runs (and hold PE and drift, which a trajectory alone cannot give), these are the
 #: keys of ``--json`` (with D_inf and O-H, which the study does not report).
 OBSERVED = [

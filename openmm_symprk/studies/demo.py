@@ -16,16 +16,16 @@ from dataclasses import dataclass
 
 import numpy as np
 import openmm as mm
-import openmm.unit as unit
 
-from ..conservation.diagnostics import angular_momentum, linear_momentum
+from ..physics import angular_momentum, linear_momentum
 from ..integrators.thermostat import DEFAULT_COLLISION_TIME
 from ..systems.properties import degrees_of_freedom
 from ..systems.scenes import water_cluster
 from .core import platforms
 from .core.options import positive
+from .core.engine import RowEngine
 from .core.rows import Row
-from .timing import interleaved
+from .core.timing import interleaved
 
 __all__ = ["ROWS", "DemoRow", "run_demo", "default_platform", "build_parser", "run"]
 
@@ -65,34 +65,22 @@ def default_platform(names=None) -> tuple[str, str]:
                         "running on Reference as a fallback."
 
 
-def _build(label: str, step_fs: float, system, backend: str):
-    """(row, integrator, backend label) for one row of :data:`ROWS`."""
-    row = Row.parse(label, step_fs=step_fs)
-    if row.is_ours:
-        row = row.replace(backend=backend)
-    ig = row.build(system, quiet=False)
-    return row, ig, ig.backend if row.is_ours else "OpenMM"
-
-
 class _Tracker:
-    """One integrator on its own Context, with its running error figures."""
+    """One row running on its own Context (:class:`~.core.engine.RowEngine`, from the scene's state as it is: the
+    leapfrog row's velocities lag), with its running error figures."""
 
-    def __init__(self, scene, integrator, platform, name, backend, evals_per_step, nvt):
-        self.ig, self.name, self.backend, self.evals, self.nvt = integrator, name, backend, evals_per_step, nvt
-        # the effective energy of a thermostatted row is E + heat-bath energy; OpenMM's Langevin has none
-        self.heat_bath = getattr(integrator, "computeHeatBathEnergy", None) if nvt else None
-        self.ctx = scene.context(integrator, platform)
-        self.masses = scene.masses()
-        self.n_dof = degrees_of_freedom(scene.system)
+    def __init__(self, name, engine, n_dof):
+        self.name, self.eng, self.n_dof = name, engine, n_dof
+        self.backend = engine.integrator.backend if engine.row.is_ours else "OpenMM"
+        self.evals, self.nvt = engine.row.evals_per_step(True), bool(engine.row.thermostat)
         self.e0, self.p0, self.l0 = self._measure()
         self.worst = self.dp = self.dl = 0.0
 
     def _measure(self):
-        st = self.ctx.getState(getEnergy=True, getPositions=True, getVelocities=True)
-        e = (st.getPotentialEnergy() + st.getKineticEnergy()).value_in_unit(unit.kilojoule_per_mole)
-        if self.heat_bath is not None:
-            e += self.heat_bath().value_in_unit(unit.kilojoule_per_mole)
-        return e, linear_momentum(st, masses=self.masses), angular_momentum(st, about="origin", masses=self.masses)
+        # the effective energy of a thermostatted row is E + heat-bath energy; OpenMM's Langevin has none
+        x, v, pe, ke = self.eng.sample()
+        m = self.eng.masses
+        return pe + ke + (self.eng.heat_bath() or 0.0), linear_momentum(v, m), angular_momentum(x, v, m, about="origin")
 
     def record(self):
         e, p, l = self._measure()
@@ -102,7 +90,7 @@ class _Tracker:
 
     @property
     def energy_error(self):
-        return None if self.nvt and self.heat_bath is None else self.worst
+        return None if self.eng.heat_bath() is None else self.worst
 
 
 def _table(rows, width):
@@ -136,12 +124,14 @@ def run_demo(methods=None, n_waters: int = 64, steps: int = 2000, step_fs: float
     out("not an invariant for it; our integrators report synchronous (x_n, v_n).\n")
     trackers = []
     for name, label in specs:
-        row, ig, used = _build(label, step_fs, scene.system, backend)
+        row = Row.parse(label, step_fs=step_fs)
         if row.is_ours:
+            row = row.replace(backend=backend)
             name = name.replace(f"symprk {label.split()[0]}", f"symprk {row.method}", 1)
-        trackers.append(_Tracker(scene, ig, platform, name, used, row.evals_per_step(True), bool(row.thermostat)))
+        eng = RowEngine(row, scene, platform=platform, threads=None, start=False, quiet=False)
+        trackers.append(_Tracker(name, eng, degrees_of_freedom(scene.system)))
     by_name = {tr.name: tr for tr in trackers}
-    timings = interleaved({tr.name: tr.ig.step for tr in trackers}, chunk, rounds=max(1, steps // chunk),
+    timings = interleaved({tr.name: tr.eng.step for tr in trackers}, chunk, rounds=max(1, steps // chunk),
                           after=lambda name: by_name[name].record())
     rows = [DemoRow(tr.name, tr.backend, tr.energy_error, tr.dp, tr.dl, tr.evals, timings[tr.name].best, tr.nvt)
             for tr in trackers]
@@ -150,7 +140,7 @@ def run_demo(methods=None, n_waters: int = 64, steps: int = 2000, step_fs: float
     out("\n|dE| in kJ/mol per degree of freedom; |dP| in Da nm/ps; time per step relative to OpenMM's "
         "VerletIntegrator,\neach the fastest of its blocks of steps, the integrators taking turns block by block.")
     if any(r.nvt for r in rows):
-        out(f"Rows at 300 K are NVT, where the energy is not conserved: for ours |dE| is that of the energy\n"
+        out("Rows at 300 K are NVT, where the energy is not conserved: for ours |dE| is that of the energy\n"
             "plus the heat-bath energy (computeHeatBathEnergy), which is; OpenMM's LangevinMiddleIntegrator (friction\n"
             "1/ps) has no heat-bath energy (-).  Our thermostat rescales the velocities relative to the\n"
             "cluster's rigid motion, so P and L stay; Langevin's random forces change both.")

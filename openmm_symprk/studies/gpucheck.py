@@ -26,8 +26,9 @@ import openmm as mm
 import openmm.app as app
 import openmm.unit as unit
 
+from .core.engine import RowEngine
 from .core.rows import Row
-from .timing import interleaved
+from .core.timing import time_rows
 
 
 def cuda_unavailable_reason() -> str:
@@ -46,8 +47,9 @@ def cuda_unavailable_reason() -> str:
 
 def _solvated_villin(n_target: int, seed: int = 7):
     from ..systems.prepare import maxwell_boltzmann, minimise
+    from ..systems.scenes import openmm_data
 
-    pdb = app.PDBFile(_openmm_data("test.pdb"))
+    pdb = app.PDBFile(openmm_data("test.pdb"))
     ff = app.ForceField("amber14-all.xml", "amber14/tip3p.xml")
     mod = app.Modeller(pdb.topology, pdb.positions)
     mod.deleteWater()
@@ -59,25 +61,6 @@ def _solvated_villin(n_target: int, seed: int = 7):
     return system, pos, maxwell_boltzmann(system, pos, 300.0, seed)
 
 
-def _openmm_data(name):
-    import os
-
-    return os.path.join(os.path.dirname(app.__file__), "data", name)
-
-
-def _context(system, integrator, precision, pos, vel):
-    ctx = mm.Context(system, integrator, mm.Platform.getPlatformByName("CUDA"), {"Precision": precision})
-    ctx.setPositions(pos)
-    ctx.setVelocities(vel)
-    return ctx
-
-
-def _state(ctx):
-    st = ctx.getState(getPositions=True, getVelocities=True)
-    return (st.getPositions(asNumpy=True).value_in_unit(unit.nanometer),
-            st.getVelocities(asNumpy=True).value_in_unit(unit.nanometer / unit.picosecond))
-
-
 def same_program(scenes, precisions, steps):
     rows = ["| scene | precision | method | max abs(dx) nm | max abs(dv) nm/ps |", "|---|---|---|---|---|"]
     for scene in scenes:
@@ -85,13 +68,13 @@ def same_program(scenes, precisions, steps):
             for method in ("verlet", "yoshida-4"):
                 out = []
                 for backend in ("native", "custom"):
-                    ig = Row(method, 1.0, backend=backend).build(scene.system, quiet=False)
-                    ctx = _context(scene.system, ig, prec, scene.positions, scene.velocities)
-                    ig.step(steps)
-                    out.append(_state(ctx))
-                    del ctx
-                dx = float(np.abs(out[0][0] - out[1][0]).max())
-                dv = float(np.abs(out[0][1] - out[1][1]).max())
+                    eng = RowEngine(Row(method, 1.0, backend=backend), scene, platform=f"CUDA:{prec}", start=False,
+                                    quiet=False)
+                    eng.step(steps)
+                    out.append(eng.sample(energy=False))
+                    del eng
+                dx = float(np.abs(out[0].x - out[1].x).max())
+                dv = float(np.abs(out[0].v - out[1].v).max())
                 rows.append(f"| {scene.name} | {prec} | {method} | {dx:.1e} | {dv:.1e} |")
     return "\n".join(rows)
 
@@ -102,14 +85,14 @@ def conservation(scene, precisions, steps):
     rows = ["| precision | exact_momentum | abs(dL)/abs(L) | abs(dP) |", "|---|---|---|---|"]
     for prec in precisions:
         for exact in (False, True):
-            ig = Row("verlet", 2.0, backend="native", exact_momentum=exact).build(scene.system, quiet=False)
-            ctx = _context(scene.system, ig, prec, scene.positions, scene.velocities)
-            L0, P0 = angular_momentum(ctx), linear_momentum(ctx)
-            ig.step(steps)
-            L1, P1 = angular_momentum(ctx), linear_momentum(ctx)
+            eng = RowEngine(Row("verlet", 2.0, backend="native", exact_momentum=exact), scene,
+                            platform=f"CUDA:{prec}", start=False, quiet=False)
+            L0, P0 = angular_momentum(eng.context), linear_momentum(eng.context)
+            eng.step(steps)
+            L1, P1 = angular_momentum(eng.context), linear_momentum(eng.context)
             rows.append(f"| {prec} | {exact} | {np.linalg.norm(L1 - L0) / np.linalg.norm(L0):.1e} | "
                         f"{np.linalg.norm(P1 - P0):.1e} |")
-            del ctx
+            del eng
     return "\n".join(rows)
 
 
@@ -122,24 +105,14 @@ def speed(boxes, precisions, steps, rounds):
             "|---|---|---|---|---|"]
     for name, (system, pos, vel) in boxes.items():
         for prec in precisions:
-            igs = {k: Row.parse(label).build(system, quiet=False) for k, label in SPEED_ROWS.items()}
-            evals = Row.parse(SPEED_ROWS["yoshida-4"]).evals_per_step(system.getNumConstraints() > 0)
-            ctxs = {k: _context(system, ig, prec, pos, vel) for k, ig in igs.items()}
-
-            def stepper(k):
-                def advance(n):
-                    igs[k].step(n)
-                    ctxs[k].getState(getPositions=True)  # wait for the GPU
-                return advance
-
-            for k in igs:
-                igs[k].step(5)
-            t = interleaved({k: stepper(k) for k in igs}, steps, rounds)
+            engines = {k: RowEngine(Row.parse(label), system, pos, vel, platform=f"CUDA:{prec}", start=False,
+                                    quiet=False) for k, label in SPEED_ROWS.items()}
+            evals = engines["yoshida-4"].row.evals_per_step(system.getNumConstraints() > 0)
+            t = time_rows(engines, steps, rounds, warmup=5)
             base = t["verlet-openmm"].best
             rows.append(f"| {name} ({system.getNumParticles()} atoms) | {prec} | {base * 1e3:.3f} | "
                         f"{t['verlet'].best / base:.3f} | {t['yoshida-4'].best / (evals * base):.3f} |")
-            for c in ctxs.values():
-                del c
+            del engines
     return "\n".join(rows)
 
 
@@ -157,8 +130,8 @@ def run(args):
     if reason:
         raise NativeUnavailableError(reason)
     warnings.simplefilter("ignore")
-    from ..studies.native_speed import water_box_system
     from ..systems.scenes import protein_vacuum, water_cluster
+    from .core.scenes import speed_water_box
 
     precisions = [s for s in args.precisions.split(",") if s]
     cluster = water_cluster(27)
@@ -168,7 +141,7 @@ def run(args):
     print(same_program([cluster] + ([] if args.quick else [protein_vacuum()]), precisions, 50 if args.quick else 200))
     print("\nConservation, native verlet, 27-water cluster, 2 fs:\n")
     print(conservation(cluster, precisions, 500 if args.quick else 2000))
-    _, system, pos, vel = water_box_system(3.9)
+    _, system, pos, vel = speed_water_box(3.9)
     boxes = {"TIP3P box, PME": (system, pos, vel)}
     if not args.quick:
         boxes["villin in water, PME"] = _solvated_villin(23000)

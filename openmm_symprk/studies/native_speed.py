@@ -20,8 +20,10 @@ import argparse
 
 import openmm as mm
 
+from .core.engine import RowEngine
+from .core.scenes import speed_water_box
 from .core.rows import Row
-from .timing import interleaved
+from .core.timing import time_rows
 
 DEFAULT_METHODS = ("verlet", "omelyan-2", "yoshida-4", "blanes-moan-srkn6b-4", "kahan-li-6")
 
@@ -33,47 +35,17 @@ def water_cluster_system(n_waters: int):
     return f"rigid water cluster, vacuum, {sc.n_atoms} atoms", sc.system, sc.positions, sc.velocities
 
 
-def water_box_system(box_nm: float):
-    from ..systems.prepare import maxwell_boltzmann, minimise
-    from ..systems.scenes import water_box
-
-    system, _, x = water_box("tip3p", box_nm=box_nm, cutoff_nm=1.0)
-    pos = minimise(system, x, "CPU", tolerance=10.0, max_iterations=200)
-    vel = maxwell_boltzmann(system, pos, 300.0, seed=7)
-    return f"rigid TIP3P water box, PME 1 nm, {system.getNumParticles()} atoms", system, pos, vel
-
-
-def _contexts(system, pos, vel, platform, properties, entries):
-    out = {}
-    for key, make in entries:
-        ig = make()
-        ctx = mm.Context(system, ig, mm.Platform.getPlatformByName(platform), properties)
-        ctx.setPositions(pos)
-        ctx.setVelocities(vel)
-        ig.step(3)  # warm-up: kernels compiled, forces cached
-        out[key] = (ctx, ig)
-    return out
-
-
-def measure(system, pos, vel, methods, platform="CPU", properties=None, steps=100, repeats=3, dt_fs=2.0,
-            custom=True, log=print) -> dict:
-    """Seconds per step for every integrator; keys 'openmm-verlet', 'native:<m>', 'custom:<m>'."""
+def measure(system, pos, vel, methods, platform="CPU", steps=100, repeats=3, dt_fs=2.0, custom=True) -> dict:
+    """Seconds per step (fastest block, rows in turns: :func:`.core.timing.time_rows`) of every integrator; keys
+    'openmm-verlet', 'native:<m>', 'custom:<m>'.  ``platform``: NAME or NAME:PRECISION."""
     from ..integrators import native_available
 
     backends = (["native"] if native_available() else []) + (["custom"] if custom else [])
     rows = {"openmm-verlet": Row("openmm-verlet", dt_fs)}
     rows.update({f"{b}:{m}": Row(m, dt_fs, backend=b) for m in methods for b in backends})
-    entries = [(key, lambda row=row: row.build(system, quiet=False)) for key, row in rows.items()]
-    ctxs = _contexts(system, pos, vel, platform, properties or {}, entries)
-
-    def stepper(ctx, ig):
-        def advance(n):
-            ig.step(n)
-            ctx.getState(getPositions=True)  # finish queued work (OpenCL)
-        return advance
-
-    timings = interleaved({k: stepper(ctx, ig) for k, (ctx, ig) in ctxs.items()}, steps, rounds=repeats)
-    return {k: t.best for k, t in timings.items()}
+    engines = {k: RowEngine(row, system, pos, vel, platform=platform, threads=None, start=False, quiet=False)
+               for k, row in rows.items()}
+    return {k: t.best for k, t in time_rows(engines, steps, repeats, warmup=3).items()}
 
 
 def format_table(title, best, methods, constraints: bool = True) -> str:
@@ -117,18 +89,18 @@ def run(args):
     if args.platform not in plugin.platforms():
         raise ValueError(f"--platform {args.platform}: no native kernel for it (have: {', '.join(plugin.platforms())})")
     methods = [m.strip() for m in args.methods.split(",") if m.strip()]
-    props = {"Precision": args.precision} if args.precision else {}
+    platform = f"{args.platform}:{args.precision}" if args.precision else args.platform
     import os
 
     print(f"load average before: {os.getloadavg()[0]:.2f} (other processes on this machine skew every timing)")
-    print(f"openmm {mm.version.full_version}, platform {args.platform} {props or ''}, "
+    print(f"openmm {mm.version.full_version}, platform {platform}, "
           f"threads: {mm.Platform.getPlatformByName(args.platform).getPropertyDefaultValue('Threads') if args.platform == 'CPU' else '-'}")
     for which in args.systems.split(","):
         if which == "cluster":
             title, system, pos, vel = water_cluster_system(args.cluster_waters)
             steps = args.steps or (50 if args.quick else 200)
         elif which == "box":
-            title, system, pos, vel = water_box_system(args.box_nm)
+            title, system, pos, vel = speed_water_box(args.box_nm)
             steps = args.steps or (20 if args.quick else 100)
         else:
             raise ValueError(f"--systems: unknown system {which!r}; known: cluster, box")
@@ -136,8 +108,8 @@ def run(args):
             while system.getNumForces():
                 system.removeForce(0)
             title += ", no forces (integrator work only)"
-        best = measure(system, pos, vel, methods, args.platform, props, steps=steps,
-                       repeats=1 if args.quick else args.repeats, custom=not args.no_custom)
+        best = measure(system, pos, vel, methods, platform, steps=steps, repeats=1 if args.quick else args.repeats,
+                       custom=not args.no_custom)
         print(format_table(f"{title}: {steps} steps x best of {1 if args.quick else args.repeats}", best, methods,
                            system.getNumConstraints() > 0))
     print(f"load average after: {os.getloadavg()[0]:.2f}")

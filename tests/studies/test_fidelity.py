@@ -12,7 +12,7 @@ import pytest
 from openmm_symprk.studies.core import jsonable
 from openmm_symprk.studies.fidelity import presets
 from openmm_symprk.cli import main as symprk
-from openmm_symprk.analysis.observe import OBSERVABLES
+from openmm_symprk.studies.fidelity.observables import OBSERVABLES
 from openmm_symprk.studies.fidelity.report import K_SE, summarise
 from openmm_symprk.studies.fidelity.rowspec import UNAVAILABLE_THERMOSTAT, check_row, describe, label
 from openmm_symprk.studies.fidelity.simulation import run_key, run_study
@@ -88,7 +88,7 @@ def test_the_equipartition_view_is_made_from_the_same_runs(quick):
 
 
 def test_replica_states_are_at_the_stated_density_with_zero_momentum(quick):
-    from openmm_symprk.studies.equipartition.runs import build_box
+    from openmm_symprk.studies.core.replicas import water_box_scene as build_box
 
     _, out, _ = quick
     cfg = presets.quick()
@@ -165,7 +165,7 @@ def test_an_unavailable_thermostat_row_is_reported_not_run(tmp_path, monkeypatch
 
 def test_an_unrelated_integrator_error_is_not_hidden(monkeypatch):
     import openmm_symprk.integrators as integrators
-    from openmm_symprk.studies.fidelity.simulation.engines import availability
+    from openmm_symprk.studies.fidelity.simulation.study import availability
 
     def broken(*args, **kwargs):
         raise ValueError("stepSize must be positive")
@@ -477,3 +477,31 @@ def test_report_only_remakes_the_summary_from_the_committed_json_alone(quick, tm
     resumed = run_study(presets.quick(), str(kept), workers=1, timing=False, progress=False, log=logs.append)
     n = sum(r["replicas"] for r in resumed["rows"])
     assert n and any(f"reusing {n} finished runs" in line for line in logs) and format_summary(resumed) + "\n" == first
+
+
+def test_the_committed_results_load_and_report_as_committed(tmp_path, monkeypatch, capsys):
+    """docs/fidelity.md's report-only commands on a copy of the committed data (docs/data/fidelity/<model>: states,
+    each run's JSON, timings.json) print summary.txt and table.md byte for byte as committed: every stored run is
+    found under its key, and the report of them is unchanged (the charts are left out here, for time)."""
+    import re
+    import shlex
+    import shutil
+
+    from openmm_symprk.studies.fidelity import report
+
+    docs = os.path.join(os.path.dirname(__file__), "..", "..", "docs")
+    with open(os.path.join(docs, "fidelity.md")) as fh:
+        commands = dict.fromkeys(re.findall(r"^symprk fidelity (--out docs/data/fidelity/\S+ .*--report-only)",
+                                            fh.read(), re.M))
+    assert {c.split()[1] for c in commands} == {"docs/data/fidelity/spce", "docs/data/fidelity/tip3p"}, commands
+    monkeypatch.setattr(report, "chart", lambda *a, **k: None)
+    for command in commands:
+        argv = shlex.split(command.split("#")[0])
+        committed = os.path.join(docs, "..", argv[1])
+        copy_ = str(tmp_path / os.path.basename(argv[1]))
+        shutil.copytree(committed, copy_)
+        assert main(["--no-progress", *argv[2:], "--out", copy_]) == 0
+        for name in ("summary.txt", "table.md"):
+            with open(os.path.join(committed, name), "rb") as a, open(os.path.join(copy_, name), "rb") as b:
+                assert a.read() == b.read(), (command, name)
+    assert "report only" not in capsys.readouterr().err

@@ -55,7 +55,7 @@ def test_cost_quick_measures_every_row(capsys):
 
 
 def test_interleaved_keeps_every_block():
-    from openmm_symprk.studies.timing import interleaved
+    from openmm_symprk.studies.core.timing import interleaved
 
     done = []
     out = interleaved({"a": done.append, "b": done.append}, {"a": 2, "b": 3}, rounds=4)

@@ -130,14 +130,38 @@ def test_a_row_without_a_position_word_runs_the_ends():
 
 
 def test_leapfrog_state_lags_half_a_step():
-    """A leapfrog row starts from v(-h/2) = v - (h/2) F/m; an on-step row from v itself."""
+    """The engine starts a leapfrog row from v(-h/2) = v - (h/2) F/m, an on-step row from v itself, and a leapfrog
+    row with start=False from v as given."""
+    from openmm_symprk.studies.core.engine import RowEngine
+
     system = _system()
     x = np.array([[0.1, 0.0, 0.0], [0.0, 0.2, 0.0], [0.0, 0.0, -0.1], [0.05, 0.05, 0.0]])
     v = np.ones((4, 3))
-    for label, lag in (("openmm-verlet 2 fs", True), ("verlet 2 fs", False)):
+    for label, lag, start in (("openmm-verlet 2 fs", True, True), ("langevin 2 fs", True, True),
+                              ("verlet 2 fs", False, True), ("openmm-verlet 2 fs", False, False)):
         row = Row.parse(label)
-        ctx = mm.Context(system, row.build(system), mm.Platform.getPlatformByName("Reference"))
-        row.set_state(ctx, x, v)
-        got = ctx.getState(getVelocities=True).getVelocities(asNumpy=True).value_in_unit(unit.nanometer / unit.picosecond)
+        got = RowEngine(row, system, x, v, platform="Reference", start=start).sample(energy=False).v
         expect = v + 0.5 * row.h_ps * 100.0 * x / 2.0 if lag else v
         np.testing.assert_allclose(got, expect, rtol=1e-12)
+
+
+def test_numbers_in_a_label_read_back_exactly():
+    """A bisected or divided step (the bench's stability probes and reference runs) is written with every digit."""
+    row = Row("verlet", 300.0 / 1234)
+    assert Row.parse(row.label) == row and Row.parse("verlet 0.5 fs").label == "verlet 0.5 fs"
+
+
+def test_the_grammar_names_the_placements_and_the_rows_default():
+    """A bad position word is refused naming the placements (methods.placement.POSITIONS) and what a row without
+    one runs: the ends, which is not SymplecticIntegrator's default."""
+    from openmm_symprk.integrators.options import NATIVE_OPTIONS
+    from openmm_symprk.methods.placement import POSITIONS
+    from openmm_symprk.studies.core.rows import ROW_POSITION
+
+    with pytest.raises(ValueError, match=f"{' | '.join(POSITIONS)}; none: {ROW_POSITION}"):
+        Row.parse("verlet 2 fs SVR 0.1 ps centre")
+    assert ROW_POSITION == "ends" and Row.parse("verlet 2 fs SVR 0.1 ps").position == ROW_POSITION
+    if "thermostat_position" in NATIVE_OPTIONS:  # the difference the grammar states: verlet's default is the middle
+        ig = SymplecticIntegrator(0.002, "verlet", system=_system(), temperature=300.0, backend="custom")
+        assert ig.thermostat_position != ROW_POSITION == Row.parse("verlet 2 fs SVR 0.1 ps custom").build(
+            _system()).thermostat_position

@@ -42,7 +42,7 @@ def _check_out(out: str):
 
 
 def build_parser(prog: str = "symprk bench") -> argparse.ArgumentParser:
-    from ...systems.scenes.named import SCENES
+    from ..core.scenes import SCENES
 
     p = argparse.ArgumentParser(
         prog=prog,

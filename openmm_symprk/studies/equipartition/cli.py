@@ -9,8 +9,8 @@ from . import presets
 
 
 def _rows(text: str) -> list:
-    """'verlet:0.5,omelyan-2 4 fs' -> the row labels (:meth:`~..core.rows.Row.parse`); a row without a step is
-    refused here, an unknown method when the study is configured."""
+    """'verlet:0.5,omelyan-2 4 fs' -> the rows as written (:meth:`~..core.rows.Row.parse` reads both); a row without
+    a step is refused here, an unknown method when the study is configured."""
     rows = [item.strip() for item in text.split(",") if item.strip()]
     for item in rows:
         try:
@@ -46,9 +46,8 @@ def run(args):
             base = presets.full()["models"]
             cfg["models"] = {m: cfg["models"].get(m, base[m]) for m in wanted}
         if args.rows:
-            ref = [cfg["reference"][0], float(cfg["reference"][1])]
-            given = [[r.who, r.step_fs] for r in map(Row.parse, args.rows)]
-            rows = ([ref] if ref not in given else []) + given
+            given = [Row.parse(r).label for r in args.rows]
+            rows = ([cfg["reference"]] if cfg["reference"] not in given else []) + given
             cfg["models"] = {m: rows for m in cfg["models"]}
 
     run_study(args, cfg, configure, "openmm_symprk.studies.equipartition.study",

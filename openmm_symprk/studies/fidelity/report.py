@@ -1,6 +1,6 @@
 """Summary, verdicts and chart of the fidelity study (numpy; matplotlib for the chart only).
 
-Per row and observable (:data:`openmm_symprk.analysis.observe.OBSERVABLES`): the mean over replicas with the larger of the within- and
+Per row and observable (:data:`.observables.OBSERVABLES`): the mean over replicas with the larger of the within- and
 between-replica standard errors (:func:`openmm_symprk.stats.combine`); the bias against the reference row
 (Verlet 0.5 fs NVE), replica by replica (:func:`openmm_symprk.stats.paired`: every row starts from the same
 replica states); and the bias against a second reference, Verlet extrapolated to h -> 0: for each replica and
@@ -18,7 +18,7 @@ from ...stats import combine, paired
 from ...support import require
 from ...analysis.diffusion import VISCOSITY_MPAS, yeh_hummer
 from .extrapolation import extrapolate_h2
-from ...analysis.observe import OBSERVABLES
+from .observables import OBSERVABLES
 from .rowspec import describe, is_verlet_limit, to_row
 
 __all__ = ["K_SE", "MATCHED", "TARGETS", "summarise", "format_summary", "markdown_table", "chart", "claim",

@@ -20,33 +20,15 @@ import openmm as mm
 import openmm.unit as unit
 
 from ...integrators.noise import sample_thermostat_noise
+from ...systems.scenes import harmonic_oscillators
 from ...physics.temperature import R_KJ
 from ...stats import SeriesStats, series_stats
 
-__all__ = ["OSCILLATORS", "harmonic_oscillators", "stationary_temperatures", "exact_temperatures", "noise_draws",
-           "run"]
+__all__ = ["OSCILLATORS", "stationary_temperatures", "exact_temperatures", "noise_draws", "run"]
 
 #: the oscillators' case: count, temperature (K), step (ps), h w, collision time (ps; c = exp(-h/tau) = 0.018, so the
 #: kinetic energy at the thermostat point is nearly fresh every step)
 OSCILLATORS = dict(n=1000, temperature=300.0, step=0.002, h_omega=0.5, collision_time=0.0005)
-
-
-def harmonic_oscillators(n: int, k: float, temperature: float, seed: int = 2024):
-    """(System, x, v): ``n`` oscillators of mass 1 Da and force constant ``k`` (kJ/mol/nm^2) about the origin,
-    canonical positions and velocities at ``temperature`` with the centre of mass at rest at the origin, where it
-    stays (the thermostat keeps its velocity; the 3 n - 3 other degrees of freedom are the thermostatted ones)."""
-    system = mm.System()
-    force = mm.CustomExternalForce("0.5*k*(x*x + y*y + z*z)")
-    force.addGlobalParameter("k", k)
-    for i in range(n):
-        system.addParticle(1.0)
-        force.addParticle(i, [])
-    system.addForce(force)
-    rng = np.random.default_rng(seed)
-    kT = R_KJ * temperature
-    x = rng.normal(0.0, math.sqrt(kT / k), (n, 3))
-    v = rng.normal(0.0, math.sqrt(kT), (n, 3))
-    return system, x - x.mean(0), v - v.mean(0)
 
 
 def exact_temperatures(position: str, h_omega: float = OSCILLATORS["h_omega"]) -> tuple:

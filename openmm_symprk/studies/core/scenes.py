@@ -1,11 +1,12 @@
 """The named scenes of the bench and the studies: each models no more than the question it answers.
 
-A scene (:class:`.scene.Scene`, the package's one scene type) is a System plus one shared initial state (positions
-and velocities, nm and nm/ps) and what may be measured on it: which quantities are invariants, whether an exact
-solution exists, whether it is for accuracy, speed or production-shaped runs.  A study builds its scenes once,
-stores them in its output folder (:func:`.scene.save_scene`, or with their replica states,
-:func:`.replicas.replica_states`) and ships them to the workers as a :meth:`~.scene.Scene.payload`, so every run
-(and every run of a resumed study) starts from bit-identical coordinates.
+A scene (:class:`openmm_symprk.systems.scenes.Scene`, the package's one scene type) is a System plus one shared
+initial state (positions and velocities, nm and nm/ps) and what may be measured on it: which quantities are
+invariants, whether an exact solution exists, whether it is for accuracy, speed or production-shaped runs.  A study
+builds its scenes once, stores them in its output folder (:func:`~openmm_symprk.systems.scenes.save_scene`, or with
+their replica states, :mod:`.replicas`) and ships them to the workers as a
+:meth:`~openmm_symprk.systems.scenes.Scene.payload`, so every run (and every run of a resumed study) starts from
+bit-identical coordinates.
 
 ``SCENES`` maps the names to their builders; each builder's docstring says why its model is enough for its
 question and no more.  :func:`user_scene` wraps a System of your own.
@@ -19,11 +20,13 @@ import openmm as mm
 import openmm.app as app
 import openmm.unit as unit
 
-from ..forcegroups import split_forces
-from ..prepare import equilibrate, maxwell_boltzmann, minimise
-from ..repartition import repartition_hydrogen_mass
-from .builders import openmm_data, protein_vacuum, water_box, water_cluster
-from .scene import Scene
+from ...systems.forcegroups import split_forces
+from ...systems.prepare import equilibrate, maxwell_boltzmann, minimise
+from ...systems.repartition import repartition_hydrogen_mass
+from ...systems.scenes import Scene, openmm_data, protein_vacuum, water_box, water_cluster
+
+__all__ = ["SCENES", "build", "user_scene", "speed_water_box"]
+
 
 def _why(fn) -> str:
     return " ".join((fn.__doc__ or "").split())
@@ -37,7 +40,7 @@ def harmonic(n: int = 256, omega_max: float | None = None, seed: int = 11) -> Sc
     down to zero is enough to turn "largest stable step" into the linear stability interval (stable for
     every h*omega up to the limit), and nothing else is needed for that question.  External wells:
     energy and angular momentum about the origin are invariants, linear momentum is not."""
-    from . import toys
+    from ...systems.scenes import toys
 
     omega_max = toys.OMEGA_OH if omega_max is None else omega_max
     omega = toys.harmonic_frequencies(n, omega_max)
@@ -55,7 +58,7 @@ def anharmonic(n: int = 64, seed: int = 13) -> Scene:
     Nonlinear forces reach the order conditions that a harmonic force cannot see (on q'' = -q every
     consistent splitting of a given symmetric structure looks alike), and the cn-function solution keeps
     the answer exact.  Separable quartic wells: energy is the only invariant."""
-    from . import toys
+    from ...systems.scenes import toys
 
     a, b, amp = toys.duffing_parameters(n)
     x0, v0, u0 = toys.duffing_initial_state(a, b, amp, seed)
@@ -172,6 +175,16 @@ def water_pme_accurate(box_nm: float = 3.0, ewald_tolerance: float = 1e-6, equil
                       invariants=("energy",), why=_why(water_pme_accurate))
 
 
+def speed_water_box(box_nm: float = 3.9):
+    """(title, System, positions, velocities): a periodic rigid TIP3P box (about 6,000 atoms at 3.9 nm; Modeller's
+    water, PME, 1 nm cutoff), minimised, velocities at 300 K: the speed measurements' box (``symprk speed``,
+    ``symprk gpucheck``)."""
+    system, _, x = water_box("tip3p", box_nm=box_nm, cutoff_nm=1.0)
+    pos = minimise(system, x, "CPU", tolerance=10.0, max_iterations=200)
+    vel = maxwell_boltzmann(system, pos, 300.0, seed=7)
+    return f"rigid TIP3P water box, PME 1 nm, {system.getNumParticles()} atoms", system, pos, vel
+
+
 #: Registry: name -> builder.  Default sweeps use all of them.
 SCENES = {
     "harmonic": harmonic,
@@ -202,7 +215,7 @@ def build(name: str, **params) -> Scene:
 
 # -- helpers and user scenes ---------------------------------------------------------------------
 def _invariants_of(system) -> tuple:
-    from ..checks import conservation_issues
+    from ...systems.checks import conservation_issues
 
     keys = {k for k, _ in conservation_issues(system)}
     inv = []

@@ -4,15 +4,15 @@ Wall-time ratios between integrators are only meaningful when they are measured 
 same load.  :func:`interleaved` runs every stepper for a block of steps in turn, round after round, and
 keeps each one's fastest block (load from other processes only ever slows a block down), its total and every
 block's time (so that a ratio can be taken round by round, between blocks run moments apart).
-Used by ``symprk demo``, the bench (each run against OpenMM's VerletIntegrator), the conservation table
-(projection on/off) and the native speed study.
+:func:`time_rows` times running rows (:class:`~.engine.RowEngine`) so: the studies' cost and speed tables, the
+bench (each run against OpenMM's VerletIntegrator), the replica studies' wall time per simulated ps.
 """
 from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field
 
-__all__ = ["Timing", "interleaved"]
+__all__ = ["Timing", "interleaved", "time_rows"]
 
 
 @dataclass
@@ -27,7 +27,7 @@ class Timing:
         return self.total / self.steps if self.steps else float("nan")
 
 
-def interleaved(steppers: dict, steps: int, rounds: int = 3, after=None) -> dict:
+def interleaved(steppers: dict, steps, rounds: int = 3, after=None) -> dict:
     """Time ``steppers`` ({name: callable(n) that advances n steps}) in turns: ``rounds`` rounds of
     ``steps`` steps each (an int, or {name: steps} when their costs differ).  ``after(name)`` runs after each
     block, outside the timing (e.g. a measurement).  Returns {name: Timing}."""
@@ -51,3 +51,19 @@ def interleaved(steppers: dict, steps: int, rounds: int = 3, after=None) -> dict
             if after is not None:
                 after(name)
     return out
+
+
+def time_rows(engines: dict, steps, rounds: int = 3, warmup: int = 0) -> dict:
+    """{name: Timing} of ``engines`` ({name: RowEngine}) taking turns, each block's work finished before its clock
+    stops (:meth:`~.engine.RowEngine.advance`).  ``steps``: steps per block, an int or {name: int}, or a float
+    number of seconds: each row's block sized, from one block of 2 steps, to last about that long (2 to 400 steps),
+    so that a 17x slower row does not take 17x the time and every row gets as many short blocks.  ``warmup``: steps
+    each row takes first, untimed (kernels compiled, neighbour lists and caches built)."""
+    for engine in engines.values():
+        if warmup:
+            engine.step(warmup)
+    steppers = {name: engine.advance for name, engine in engines.items()}
+    if isinstance(steps, float):
+        first = interleaved(steppers, 2, rounds=1)
+        steps = {name: int(min(400, max(2, round(steps / t.best)))) for name, t in first.items()}
+    return interleaved(steppers, steps, rounds)
