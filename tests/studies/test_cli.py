@@ -132,7 +132,7 @@ def test_console_script_is_installed():
 
 
 def test_gpucheck_says_why_it_cannot_run_without_cuda(capsys):
-    from openmm_symprk.studies.gpucheck import cuda_unavailable_reason
+    from openmm_symprk.studies.platforms.gpucheck import cuda_unavailable_reason
 
     if not cuda_unavailable_reason():
         pytest.skip("a CUDA platform with the native kernel is here: run `symprk gpucheck` itself")

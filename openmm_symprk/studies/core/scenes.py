@@ -25,7 +25,7 @@ from ...systems.prepare import equilibrate, maxwell_boltzmann, minimise
 from ...systems.repartition import repartition_hydrogen_mass
 from ...systems.scenes import Scene, openmm_data, protein_vacuum, water_box, water_cluster
 
-__all__ = ["SCENES", "build", "user_scene", "speed_water_box"]
+__all__ = ["SCENES", "build", "user_scene"]
 
 
 def _why(fn) -> str:
@@ -173,16 +173,6 @@ def water_pme_accurate(box_nm: float = 3.0, ewald_tolerance: float = 1e-6, equil
                       f"rigid TIP3P box, {system.getNumParticles()} atoms, PME with ewaldErrorTolerance "
                       f"{ewald_tolerance:g} (reciprocal space in group 1)", purpose="production", platform="CPU",
                       invariants=("energy",), why=_why(water_pme_accurate))
-
-
-def speed_water_box(box_nm: float = 3.9):
-    """(title, System, positions, velocities): a periodic rigid TIP3P box (about 6,000 atoms at 3.9 nm; Modeller's
-    water, PME, 1 nm cutoff), minimised, velocities at 300 K: the speed measurements' box (``symprk speed``,
-    ``symprk gpucheck``)."""
-    system, _, x = water_box("tip3p", box_nm=box_nm, cutoff_nm=1.0)
-    pos = minimise(system, x, "CPU", tolerance=10.0, max_iterations=200)
-    vel = maxwell_boltzmann(system, pos, 300.0, seed=7)
-    return f"rigid TIP3P water box, PME 1 nm, {system.getNumParticles()} atoms", system, pos, vel
 
 
 #: Registry: name -> builder.  Default sweeps use all of them.

@@ -20,25 +20,37 @@ import argparse
 
 import openmm as mm
 
-from .core.engine import RowEngine
-from .core.scenes import speed_water_box
-from .core.rows import Row
-from .core.timing import time_rows
+from ..core.engine import RowEngine
+from ..core.rows import Row
+from ..core.timing import time_rows
 
 DEFAULT_METHODS = ("verlet", "omelyan-2", "yoshida-4", "blanes-moan-srkn6b-4", "kahan-li-6")
 
 
 def water_cluster_system(n_waters: int):
-    from ..systems.scenes import water_cluster
+    """(title, System, positions, velocities): a rigid water cluster in vacuum, minimised."""
+    from ...systems.scenes import water_cluster
 
     sc = water_cluster(n_waters, minimize=True)
     return f"rigid water cluster, vacuum, {sc.n_atoms} atoms", sc.system, sc.positions, sc.velocities
 
 
+def water_box_system(box_nm: float = 3.9):
+    """(title, System, positions, velocities): a periodic rigid TIP3P box (about 6,000 atoms at 3.9 nm; Modeller's
+    water, PME, 1 nm cutoff), minimised, velocities at 300 K."""
+    from ...systems.prepare import maxwell_boltzmann, minimise
+    from ...systems.scenes import water_box
+
+    system, _, x = water_box("tip3p", box_nm=box_nm, cutoff_nm=1.0)
+    pos = minimise(system, x, "CPU", tolerance=10.0, max_iterations=200)
+    vel = maxwell_boltzmann(system, pos, 300.0, seed=7)
+    return f"rigid TIP3P water box, PME 1 nm, {system.getNumParticles()} atoms", system, pos, vel
+
+
 def measure(system, pos, vel, methods, platform="CPU", steps=100, repeats=3, dt_fs=2.0, custom=True) -> dict:
-    """Seconds per step (fastest block, rows in turns: :func:`.core.timing.time_rows`) of every integrator; keys
+    """Seconds per step (fastest block, rows in turns: :func:`..core.timing.time_rows`) of every integrator; keys
     'openmm-verlet', 'native:<m>', 'custom:<m>'.  ``platform``: NAME or NAME:PRECISION."""
-    from ..integrators import native_available
+    from ...integrators import native_available
 
     backends = (["native"] if native_available() else []) + (["custom"] if custom else [])
     rows = {"openmm-verlet": Row("openmm-verlet", dt_fs)}
@@ -82,7 +94,7 @@ def build_parser(prog: str = "symprk speed"):
 
 
 def run(args):
-    from .. import plugin
+    from ... import plugin
 
     if not plugin.available():
         raise plugin.NativeUnavailableError(f"the native backend is unavailable: {plugin.unavailable_reason()}")
@@ -100,7 +112,7 @@ def run(args):
             title, system, pos, vel = water_cluster_system(args.cluster_waters)
             steps = args.steps or (50 if args.quick else 200)
         elif which == "box":
-            title, system, pos, vel = speed_water_box(args.box_nm)
+            title, system, pos, vel = water_box_system(args.box_nm)
             steps = args.steps or (20 if args.quick else 100)
         else:
             raise ValueError(f"--systems: unknown system {which!r}; known: cluster, box")

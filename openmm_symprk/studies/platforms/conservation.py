@@ -22,12 +22,12 @@ import warnings
 import numpy as np
 import openmm as mm
 
-from ..conservation.diagnostics import angular_momentum, linear_momentum
-from ..support.files import write_text
-from .core import platforms
-from .core.engine import RowEngine
-from .core.rows import Row
-from .core.timing import time_rows
+from ...conservation.diagnostics import angular_momentum, linear_momentum
+from ...support.files import write_text
+from ..core import platforms
+from ..core.engine import RowEngine
+from ..core.rows import Row
+from ..core.timing import time_rows
 
 DEFAULT_PLATFORMS = ("Reference", "CPU", "OpenCL:single", "OpenCL:mixed", "OpenCL:double")
 DEFAULT_METHODS = ("verlet", "yoshida-4")
@@ -35,7 +35,7 @@ DEFAULT_SCENES = ("water", "protein")
 
 
 def _scene(name, n_waters):
-    from ..systems import scenes
+    from ...systems import scenes
 
     if name == "water":
         return scenes.water_cluster(n_waters)
@@ -76,7 +76,7 @@ def compare(scene, spec, method, steps, step_size=0.002, chunk=None, backend="au
 
 def failure_cases(steps=500):
     """Reference-platform runs where momentum is not conserved, for the second table."""
-    from ..systems import scenes
+    from ...systems import scenes
 
     rows = []
     morse = scenes.morse_molecule()

@@ -9,10 +9,10 @@ For mixed and double precision it prints, as markdown tables:
 1. the same program on both backends: max |x_native - x_custom| and |v_native - v_custom| after 200 steps
    of ``verlet`` and ``yoshida-4`` (rigid-water cluster, SETTLE; villin in vacuum, HBonds: CCMA/SHAKE);
 2. conservation: |dL|/|L| and |dP| after 2,000 steps of ``verlet`` on the cluster, with and without
-   ``exact_momentum``;
+   ``exact_momentum`` (:mod:`.conservation`'s table);
 3. speed: time per step of the native ``verlet`` and ``yoshida-4`` against OpenMM's VerletIntegrator (ratio per
-   force evaluation, integrators taking turns) on a periodic rigid TIP3P box with PME and on villin solvated
-   to about 23,000 atoms (PME, HBonds, rigid water).
+   force evaluation, integrators taking turns: :mod:`.speed`'s table) on a periodic rigid TIP3P box with PME and
+   on villin solvated to about 23,000 atoms (PME, HBonds, rigid water).
 
 Without a CUDA platform it says why in one line and exits with status 2.  Not a test: nothing is asserted.
 """
@@ -26,14 +26,17 @@ import openmm as mm
 import openmm.app as app
 import openmm.unit as unit
 
-from .core.engine import RowEngine
-from .core.rows import Row
-from .core.timing import time_rows
+from ..core.engine import RowEngine
+from ..core.rows import Row
+from . import conservation, speed
+
+#: The methods of the speed table.
+SPEED_METHODS = ("verlet", "yoshida-4")
 
 
 def cuda_unavailable_reason() -> str:
     """'' when OpenMM's CUDA platform and the native CUDA kernel are both usable here, else why not."""
-    from .. import plugin
+    from ... import plugin
 
     try:
         mm.Platform.getPlatformByName("CUDA")
@@ -46,8 +49,10 @@ def cuda_unavailable_reason() -> str:
 
 
 def _solvated_villin(n_target: int, seed: int = 7):
-    from ..systems.prepare import maxwell_boltzmann, minimise
-    from ..systems.scenes import openmm_data
+    """(title, System, positions, velocities): villin solvated to about ``n_target`` atoms (PME, HBonds, rigid
+    water), minimised on CUDA."""
+    from ...systems.prepare import maxwell_boltzmann, minimise
+    from ...systems.scenes import openmm_data
 
     pdb = app.PDBFile(openmm_data("test.pdb"))
     ff = app.ForceField("amber14-all.xml", "amber14/tip3p.xml")
@@ -58,7 +63,8 @@ def _solvated_villin(n_target: int, seed: int = 7):
     system = ff.createSystem(mod.topology, nonbondedMethod=app.PME, nonbondedCutoff=0.9 * unit.nanometer,
                              constraints=app.HBonds, rigidWater=True, removeCMMotion=False)
     pos = minimise(system, mod.positions, "CUDA", tolerance=10.0, max_iterations=200)
-    return system, pos, maxwell_boltzmann(system, pos, 300.0, seed)
+    return (f"villin in water, PME, {system.getNumParticles()} atoms", system, pos,
+            maxwell_boltzmann(system, pos, 300.0, seed))
 
 
 def same_program(scenes, precisions, steps):
@@ -79,43 +85,6 @@ def same_program(scenes, precisions, steps):
     return "\n".join(rows)
 
 
-def conservation(scene, precisions, steps):
-    from ..conservation.diagnostics import angular_momentum, linear_momentum
-
-    rows = ["| precision | exact_momentum | abs(dL)/abs(L) | abs(dP) |", "|---|---|---|---|"]
-    for prec in precisions:
-        for exact in (False, True):
-            eng = RowEngine(Row("verlet", 2.0, backend="native", exact_momentum=exact), scene,
-                            platform=f"CUDA:{prec}", start=False, quiet=False)
-            L0, P0 = angular_momentum(eng.context), linear_momentum(eng.context)
-            eng.step(steps)
-            L1, P1 = angular_momentum(eng.context), linear_momentum(eng.context)
-            rows.append(f"| {prec} | {exact} | {np.linalg.norm(L1 - L0) / np.linalg.norm(L0):.1e} | "
-                        f"{np.linalg.norm(P1 - P0):.1e} |")
-            del eng
-    return "\n".join(rows)
-
-
-#: The rows of the speed table, the first the baseline.
-SPEED_ROWS = {"verlet-openmm": "openmm-verlet 2 fs", "verlet": "verlet 2 fs native", "yoshida-4": "yoshida-4 2 fs native"}
-
-
-def speed(boxes, precisions, steps, rounds):
-    rows = ["| system | precision | VerletIntegrator ms/step | native verlet / Verlet | native yoshida-4 / (3 x Verlet) |",
-            "|---|---|---|---|---|"]
-    for name, (system, pos, vel) in boxes.items():
-        for prec in precisions:
-            engines = {k: RowEngine(Row.parse(label), system, pos, vel, platform=f"CUDA:{prec}", start=False,
-                                    quiet=False) for k, label in SPEED_ROWS.items()}
-            evals = engines["yoshida-4"].row.evals_per_step(system.getNumConstraints() > 0)
-            t = time_rows(engines, steps, rounds, warmup=5)
-            base = t["verlet-openmm"].best
-            rows.append(f"| {name} ({system.getNumParticles()} atoms) | {prec} | {base * 1e3:.3f} | "
-                        f"{t['verlet'].best / base:.3f} | {t['yoshida-4'].best / (evals * base):.3f} |")
-            del engines
-    return "\n".join(rows)
-
-
 def build_parser(prog: str = "symprk gpucheck"):
     p = argparse.ArgumentParser(prog=prog, description=__doc__.split("\n\n")[0])
     p.add_argument("--quick", action="store_true", help="fewer steps; the PME box only for speed")
@@ -124,14 +93,13 @@ def build_parser(prog: str = "symprk gpucheck"):
 
 
 def run(args):
-    from ..plugin import NativeUnavailableError
+    from ...plugin import NativeUnavailableError
 
     reason = cuda_unavailable_reason()
     if reason:
         raise NativeUnavailableError(reason)
     warnings.simplefilter("ignore")
-    from ..systems.scenes import protein_vacuum, water_cluster
-    from .core.scenes import speed_water_box
+    from ...systems.scenes import protein_vacuum, water_cluster
 
     precisions = [s for s in args.precisions.split(",") if s]
     cluster = water_cluster(27)
@@ -139,11 +107,13 @@ def run(args):
           f"{mm.Platform.getPlatformByName('CUDA').getPropertyDefaultValue('DeviceName') or 'default'}\n")
     print("Same program on both backends (200 steps of 1 fs):\n")
     print(same_program([cluster] + ([] if args.quick else [protein_vacuum()]), precisions, 50 if args.quick else 200))
-    print("\nConservation, native verlet, 27-water cluster, 2 fs:\n")
-    print(conservation(cluster, precisions, 500 if args.quick else 2000))
-    _, system, pos, vel = speed_water_box(3.9)
-    boxes = {"TIP3P box, PME": (system, pos, vel)}
-    if not args.quick:
-        boxes["villin in water, PME"] = _solvated_villin(23000)
+    print("\nConservation, native verlet, 27-water cluster, 2 fs (off/on: exact_momentum):\n")
+    print(conservation.table([conservation.compare(cluster, f"CUDA:{p}", "verlet", 500 if args.quick else 2000,
+                                                   backend="native") for p in precisions]))
+    boxes = [speed.water_box_system(3.9)] + ([] if args.quick else [_solvated_villin(23000)])
     print("\nSpeed (fastest of the blocks, integrators taking turns):\n")
-    print(speed(boxes, precisions, 50 if args.quick else 300, 2 if args.quick else 4))
+    for title, system, pos, vel in boxes:
+        for p in precisions:
+            best = speed.measure(system, pos, vel, SPEED_METHODS, f"CUDA:{p}", 50 if args.quick else 300,
+                                 2 if args.quick else 4, custom=False)
+            print(speed.format_table(f"{title}, CUDA {p}", best, SPEED_METHODS, system.getNumConstraints() > 0))
