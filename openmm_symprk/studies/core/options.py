@@ -25,17 +25,20 @@ def positive(kind=float):
     return parse
 
 
-def add_study_arguments(ap, *, quick: str, out: str, workers: str, length: str) -> None:
-    """--quick, --out, --workers, --scheduler, --replicas, --length-ps, --no-timing, --no-progress and --report-only."""
+def add_study_arguments(ap, *, quick: str, out: str | None, workers: str, length: str, default_workers: int = 2,
+                        timing: bool = True, out_help: str | None = None) -> None:
+    """--quick, --out (default ``out``, or None where the study picks it: ``out_help`` says how), --workers,
+    --scheduler, --replicas, --length-ps, --no-timing (with ``timing``), --no-progress and --report-only."""
     ap.add_argument("--quick", action="store_true", help=quick)
-    ap.add_argument("--out", default=out, help="output folder (finished runs are reused)")
-    ap.add_argument("--workers", type=int, default=2, help=workers)
+    ap.add_argument("--out", default=out, help=f"output folder (default {out_help or out}; finished runs are reused)")
+    ap.add_argument("--workers", type=int, default=default_workers, help=workers)
     ap.add_argument("--scheduler", metavar="ADDRESS",
                     help="Dask distributed scheduler address (e.g. tcp://host:8786) instead of local workers; "
                          "needs the 'cluster' extra")
-    ap.add_argument("--replicas", type=int, default=None)
+    ap.add_argument("--replicas", type=int, default=None, help="independent replicas per row")
     ap.add_argument("--length-ps", type=float, default=None, help=length)
-    ap.add_argument("--no-timing", action="store_true", help="skip the wall-time measurement in turns")
+    if timing:
+        ap.add_argument("--no-timing", action="store_true", help="skip the wall-time measurement in turns")
     ap.add_argument("--no-progress", action="store_true")
     ap.add_argument("--report-only", action="store_true",
                     help="run nothing: summarise the finished runs in --out (a study still running, or rows run "

@@ -12,7 +12,7 @@ from __future__ import annotations
 import time
 from dataclasses import dataclass, field
 
-__all__ = ["Timing", "interleaved", "time_rows"]
+__all__ = ["Timing", "interleaved", "time_rows", "seconds_per_ps"]
 
 
 @dataclass
@@ -67,3 +67,16 @@ def time_rows(engines: dict, steps, rounds: int = 3, warmup: int = 0) -> dict:
         first = interleaved(steppers, 2, rounds=1)
         steps = {name: int(min(400, max(2, round(steps / t.best)))) for name, t in first.items()}
     return interleaved(steppers, steps, rounds)
+
+
+def seconds_per_ps(rows: dict, scene, x, v, block_fs: float, threads: int = 1, seed: int | None = None,
+                   rounds: int = 3) -> dict:
+    """{label: wall seconds per simulated ps} of ``rows`` ({label: Row}) running from the state (x, v) of
+    ``scene``, timed in turns (:func:`time_rows`) in blocks of about ``block_fs`` femtoseconds each, so that the ratios
+    between rows hold under the machine's load."""
+    from .engine import RowEngine
+
+    engines = {lab: RowEngine(row, scene, x, v, threads=threads, seed=seed) for lab, row in rows.items()}
+    res = time_rows(engines, {lab: row.steps_for(block_fs) for lab, row in rows.items()}, rounds)
+    return {lab: t.best / rows[lab].h_ps for lab, t in res.items()}
+

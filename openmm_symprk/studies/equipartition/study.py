@@ -17,7 +17,7 @@ from ...support.files import content_key
 from ..core import Run, RunStore, Study, run_key as row_run_key, write_json, write_text
 from ..core.replicas import BOX_STATE_KEYS, water_box_replicas, water_box_scene
 from ..core.rows import Row
-from ..core.timing import time_rows
+from ..core.timing import seconds_per_ps
 from .report import summarise
 
 __all__ = ["run_study", "run_key", "load_runs", "EquipartitionStudy"]
@@ -147,16 +147,12 @@ def run_study(cfg: dict, out: str, workers: int = 2, timing: bool = True, progre
 
 
 def _timings(cfg, states, log) -> dict:
-    """Seconds per simulated ps of each row on replica 0, timed in turns (:func:`..core.timing.time_rows`), so the
-    ratios between rows hold under the machine's load."""
-    from ..core.engine import RowEngine
-
+    """Seconds per simulated ps of each row on replica 0, timed in turns in blocks of 50 fs
+    (:func:`..core.timing.seconds_per_ps`)."""
     out = {}
     for model, labels in cfg["models"].items():
-        box, (x, v) = water_box_scene(cfg, model), states[model]
-        rows = {row.label: row for row in map(Row.parse, labels)}
-        engines = {lab: RowEngine(row, box, x[0], v[0], threads=cfg.get("threads", 1)) for lab, row in rows.items()}
-        res = time_rows(engines, {lab: row.steps_for(50.0) for lab, row in rows.items()}, rounds=3)  # 50 fs a block
-        out.update({(model, lab): tm.best / rows[lab].h_ps for lab, tm in res.items()})
+        (x, v), rows = states[model], {row.label: row for row in map(Row.parse, labels)}
+        times = seconds_per_ps(rows, water_box_scene(cfg, model), x[0], v[0], 50.0, cfg.get("threads", 1))
+        out.update({(model, lab): s for lab, s in times.items()})
         log(f"{model}: timed {len(rows)} rows in turns")
     return out

@@ -29,12 +29,6 @@ from .rows import cost_rows
 BASELINE = "LangevinMiddle"
 
 
-def default_rows() -> list:
-    """The rows of the cost table (:data:`.rows.COST_ROWS`): OpenMM's thermostats, ours at interval 1 and 10, NVE for
-    reference, MTS; (name, Row, peer) each."""
-    return cost_rows()
-
-
 def scene(name: str, quick: bool):
     """(title, system, positions, velocities) of a cost scene; ``quick``: a small water box / short equilibration."""
     from ...systems.forcegroups import split_forces
@@ -124,7 +118,7 @@ def run(scenes=("water", "villin"), quick: bool = False, steps=None, rounds: int
     where = f"platform CPU, {threads} threads" if platform == "CPU" else f"platform {platform}"
     log(f"openmm {mm.version.full_version}, {where}, load average before "
         f"{os.getloadavg()[0]:.2f} (other processes slow some blocks; each row keeps its fastest)")
-    rows = [r for r in default_rows() if not (no_forces and r[1].mts)]  # no forces, no groups
+    rows = [r for r in cost_rows() if not (no_forces and r[1].mts)]  # no forces, no groups
     out = {}
     for name in scenes:
         title, system, x, v = scene(name, quick)

@@ -202,19 +202,15 @@ class FidelityStudy(Study):
     def timings(self) -> dict:
         """Seconds per simulated ps of each available row on replica 0, timed in turns
         (:func:`openmm_symprk.studies.core.timing.time_rows`), so the ratios hold under the machine's load."""
-        from ...core.engine import RowEngine
-        from ...core.timing import time_rows
+        from ...core.timing import seconds_per_ps
         from .runs import replica_seed
 
         x, v = self.states
         rows = {r.label: r for r in (to_row(row, self.cfg["temperature"]) for row in self.rows)
                 if r.label not in self.unavailable}
-        engines = {lab: RowEngine(r, self.box, x[0], v[0], threads=self.cfg.get("threads", 1),
-                                  seed=replica_seed(self.cfg, 0)) for lab, r in rows.items()}
-        block = float(self.cfg.get("timing_fs", 50.0))
-        res = time_rows(engines, {lab: r.steps_for(block) for lab, r in rows.items()}, rounds=3)
-        self.log(f"timed {len(engines)} rows in turns")
-        out = {lab: tm.best / rows[lab].h_ps for lab, tm in res.items()}
+        out = seconds_per_ps(rows, self.box, x[0], v[0], float(self.cfg.get("timing_fs", 50.0)),
+                             self.cfg.get("threads", 1), replica_seed(self.cfg, 0))
+        self.log(f"timed {len(rows)} rows in turns")
         import platform
         import time
 
