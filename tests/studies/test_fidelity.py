@@ -4,7 +4,6 @@ import copy
 import glob
 import json
 import os
-import types
 
 import numpy as np
 import pytest
@@ -14,7 +13,7 @@ from openmm_symprk.studies.fidelity import presets
 from openmm_symprk.cli import main as symprk
 from openmm_symprk.studies.fidelity.observables import OBSERVABLES
 from openmm_symprk.studies.fidelity.report import K_SE, summarise
-from openmm_symprk.studies.fidelity.rowspec import UNAVAILABLE_THERMOSTAT, check_row, describe, label
+from openmm_symprk.studies.fidelity.rowspec import check_row, describe, label
 from openmm_symprk.studies.fidelity.simulation import run_key, run_study
 
 
@@ -51,11 +50,7 @@ def test_quick_prints_every_observable_for_every_row(quick):
     rows = {r["label"]: r for r in res["rows"]}
     assert res["reference"] == "verlet 0.5 fs" and rows["verlet 0.5 fs"]["wall_vs_ref"] == 1.0
     for lab, r in rows.items():
-        thermostat = "SVR" in lab
-        if r["status"] != "ok":  # only the package's thermostat rows may be unavailable, and only for that reason
-            assert thermostat and r["status"].startswith(UNAVAILABLE_THERMOSTAT), (lab, r["status"])
-            continue
-        assert r["replicas"] == 2 and not r["failed"], lab
+        assert r["status"] == "ok" and r["replicas"] == 2 and not r["failed"], lab
         for key in ("D", "tau2_dip", "tau2_hh", "w_zero", "w_min", "pe", "dT", "g_r", "g_h"):
             assert r["values"][key] is not None and r["values"][key]["se"] > 0, (lab, key)
         assert 1.0 < r["values"]["D"]["mean"] < 15.0 and 0.26 < r["values"]["g_r"]["mean"] < 0.30
@@ -109,9 +104,9 @@ def test_a_second_call_reuses_every_run(quick):
     _, out, _ = quick
     logs = []
     again = run_study(presets.quick(), out, workers=1, timing=False, progress=False, log=logs.append)
-    n = sum(1 for r in presets.quick()["rows"] if "SVR" not in r) * presets.quick()["replicas"]
-    available = sum(r["replicas"] for r in again["rows"])
-    assert available >= n and any(f"reusing {available} finished runs" in line for line in logs), logs
+    n = len(presets.quick()["rows"]) * presets.quick()["replicas"]
+    assert sum(r["replicas"] for r in again["rows"]) == n and any(f"reusing {n} finished runs" in line
+                                                                   for line in logs), logs
     with open(os.path.join(out, "results.json")) as fh:
         first = {r["label"]: r.get("values") for r in json.load(fh)["rows"]}
     assert {r["label"]: r.get("values") for r in jsonable(again)["rows"]} == first  # the same runs, summarised again
@@ -133,47 +128,6 @@ def test_an_interrupted_study_runs_only_what_is_missing(quick, tmp_path):
     stored = sum(r["replicas"] for r in summary["rows"])
     assert any(f"reusing {stored - 1} finished runs" in line for line in logs), logs
     assert os.path.exists(lost) and len(glob.glob(os.path.join(copy_, "runs", "*.json"))) == stored
-
-
-def test_an_unavailable_thermostat_row_is_reported_not_run(tmp_path, monkeypatch):
-    """A SymplecticIntegrator without the thermostat (TypeError on temperature=): the row is planned no run,
-    stored nowhere and reported 'unavailable: needs the thermostat'; the other rows run."""
-    import openmm_symprk.integrators as integrators
-
-    real = integrators.SymplecticIntegrator
-
-    def without_thermostat(*args, temperature=None, collision_time=None, random_seed=None, **kwargs):
-        if temperature is not None:
-            raise TypeError("__init__() got an unexpected keyword argument 'temperature'")
-        return real(*args, **kwargs)
-
-    monkeypatch.setattr(integrators, "SymplecticIntegrator", without_thermostat)
-    cfg = presets.quick()
-    cfg.update(replicas=1, length_ps=0.24, omega_ps=0.06, omega_max_lag_ps=0.03, msd_window_ps=[0.04, 0.1])
-    cfg["rows"], cfg["references"] = ["verlet 2 fs", "verlet 2 fs SVR 0.1 ps"], {"NVE": "verlet 2 fs"}
-    logs = []
-    summary = run_study(cfg, str(tmp_path), workers=1, timing=False, progress=False, log=logs.append)
-    ref, svr = summary["rows"]
-    assert ref["status"] == "ok" and ref["replicas"] == 1
-    assert svr["status"].startswith(UNAVAILABLE_THERMOSTAT) and svr["replicas"] == 0
-    assert len(glob.glob(str(tmp_path / "runs" / "*.json"))) == 1
-    assert any("verlet 2 fs SVR 0.1 ps: unavailable: needs the thermostat" in line for line in logs)
-    from openmm_symprk.studies.fidelity.report import format_summary
-
-    assert "verlet 2 fs SVR 0.1 ps               unavailable: needs the thermostat" in format_summary(summary)
-
-
-def test_an_unrelated_integrator_error_is_not_hidden(monkeypatch):
-    import openmm_symprk.integrators as integrators
-    from openmm_symprk.studies.fidelity.simulation.study import availability
-
-    def broken(*args, **kwargs):
-        raise ValueError("stepSize must be positive")
-
-    monkeypatch.setattr(integrators, "SymplecticIntegrator", broken)
-    row = check_row("verlet 2 fs SVR 1 ps")
-    with pytest.raises(ValueError, match="stepSize"):
-        availability(row, types.SimpleNamespace(system=None), 300.0)
 
 
 # -- the summary on synthetic replicas ---------------------------------------------------------------------------

@@ -8,7 +8,6 @@ import openmm.unit as unit
 import pytest
 
 from openmm_symprk.integrators import SymplecticIntegrator
-from openmm_symprk.integrators.options import NATIVE_OPTIONS
 from openmm_symprk.methods.resolved import resolve
 from openmm_symprk.studies.core.rows import Row, split_groups
 
@@ -120,10 +119,6 @@ def test_a_row_without_a_position_word_runs_the_ends():
     """Stored results of rows without a position word were run with the ends placement: such a row still runs
     the ends, though the integrator's default ("auto") puts verlet's thermostat in the middle."""
     system = _system()
-    if "thermostat_position" not in NATIVE_OPTIONS:
-        with pytest.raises(TypeError, match="thermostat_position"):
-            Row.parse("verlet 2 fs SVR 0.1 ps middle").build(system)
-        pytest.skip("SymplecticIntegrator has no thermostat_position yet")
     ig = Row.parse("verlet 2 fs SVR 0.1 ps middle custom").build(system)
     assert ig.options.thermostat.position == "middle"
     assert Row.parse("verlet 2 fs SVR 0.1 ps custom").build(system).thermostat_position == "ends"
@@ -156,16 +151,14 @@ def test_numbers_in_a_label_read_back_exactly():
 def test_the_grammar_names_the_placements_and_the_rows_default():
     """A bad position word is refused naming the placements (methods.placement.POSITIONS) and what a row without
     one runs: the ends, which is not SymplecticIntegrator's default."""
-    from openmm_symprk.integrators.options import NATIVE_OPTIONS
     from openmm_symprk.methods.placement import POSITIONS
     from openmm_symprk.studies.core.rows import ROW_POSITION
 
     with pytest.raises(ValueError, match=f"{' | '.join(POSITIONS)}; none: {ROW_POSITION}"):
         Row.parse("verlet 2 fs SVR 0.1 ps centre")
     assert ROW_POSITION == "ends" and Row.parse("verlet 2 fs SVR 0.1 ps").position == ROW_POSITION
-    if "thermostat_position" in NATIVE_OPTIONS:  # the difference the grammar states: verlet's default is the middle
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")  # the harmonic wells' ConservationWarning
-            ig = SymplecticIntegrator(0.002, "verlet", system=_system(), temperature=300.0, backend="custom")
-        assert ig.thermostat_position != ROW_POSITION == Row.parse("verlet 2 fs SVR 0.1 ps custom").build(
-            _system()).thermostat_position
+    with warnings.catch_warnings():  # the difference the grammar states: verlet's default is the middle
+        warnings.simplefilter("ignore")  # the harmonic wells' ConservationWarning
+        ig = SymplecticIntegrator(0.002, "verlet", system=_system(), temperature=300.0, backend="custom")
+    assert ig.thermostat_position != ROW_POSITION == Row.parse("verlet 2 fs SVR 0.1 ps custom").build(
+        _system()).thermostat_position

@@ -10,10 +10,7 @@ from __future__ import annotations
 
 from ..core.rows import Row
 
-__all__ = ["UNAVAILABLE_THERMOSTAT", "check_row", "describe", "label", "to_row", "is_verlet_limit"]
-
-#: What the output says for a thermostat row this installation cannot run.
-UNAVAILABLE_THERMOSTAT = "unavailable: needs the thermostat"
+__all__ = ["check_row", "describe", "label", "to_row", "is_verlet_limit"]
 
 
 def to_row(row, temperature: float = 300.0) -> Row:

@@ -8,8 +8,7 @@
 file, key and states as ``symprk equipartition`` makes for the same box and equilibration settings),
 ``<out>/runs/<key>.json`` (+ .npz) one finished run each; a key (:func:`~...core.store.run_key`) hashes everything a
 run depends on (box, states, row label, replica, lengths, the observables' settings), so a second call reuses every
-finished run and a changed setting never reuses a stale one.  Rows this installation cannot run (the package's thermostat rows before the thermostat exists) are planned
-no runs and reported "unavailable: ..."; nothing of theirs is stored, so they run once the thermostat is there.
+finished run and a changed setting never reuses a stale one.
 """
 from __future__ import annotations
 
@@ -19,9 +18,9 @@ import warnings
 from ....systems.checks import ConservationWarning
 from ...core import Run, Study, run_key as row_run_key, write_json, write_text
 from ...core.replicas import BOX_STATE_KEYS, BOX_STATE_VERSION, water_box_replicas, water_box_scene
-from ..rowspec import UNAVAILABLE_THERMOSTAT, check_row, describe, to_row
+from ..rowspec import check_row, to_row
 
-__all__ = ["FidelityStudy", "run_study", "run_key", "availability", "temperature_view", "RUN_KEYS", "RUN_VERSION"]
+__all__ = ["FidelityStudy", "run_study", "run_key", "temperature_view", "RUN_KEYS", "RUN_VERSION"]
 
 #: What a run depends on besides its row and replica (the observables are computed in the run: their settings too).
 RUN_KEYS = BOX_STATE_KEYS + ("model", "settle_ps", "omega_ps", "omega_fs", "omega_max_lag_ps", "length_ps",
@@ -37,21 +36,6 @@ TIMINGS = "timings.json"
 def run_key(cfg: dict, row, replica: int) -> str:
     return row_run_key(check_row(row), replica, {k: cfg[k] for k in RUN_KEYS}, states=BOX_STATE_VERSION,
                        version=RUN_VERSION)
-
-
-def availability(row, scene, temperature: float) -> str | None:
-    """None when this installation runs ``row`` on ``scene``; else why not: the package's thermostat rows need an
-    integrator that accepts ``temperature=`` (an unknown option: UNAVAILABLE_THERMOSTAT ...)."""
-    r = to_row(row, temperature)
-    if r.thermostat != "svr":
-        return None
-    try:
-        r.build(r.system_for(scene.system, scene.topology) if r.mts or r.hmr_da is not None else scene.system)
-    except TypeError as exc:
-        if not any(k in str(exc) for k in ("unknown option", "unexpected keyword")):
-            raise
-        return f"{UNAVAILABLE_THERMOSTAT} ({exc})"
-    return None
 
 
 def references(cfg: dict, rows: list) -> dict:
@@ -113,7 +97,7 @@ def check(cfg: dict) -> list:
 
 
 class FidelityStudy(Study):
-    """One run per (available row, replica) from the replica states of the model's box."""
+    """One run per (row, replica) from the replica states of the model's box."""
 
     command = "symprk fidelity"
     work = work
@@ -123,7 +107,7 @@ class FidelityStudy(Study):
         self.rows = check(cfg)
         super().__init__(out, workers, scheduler, progress, log)
         self.cfg, self.timing, self.report_only = cfg, timing, False
-        self.states, self.unavailable, self.box = None, {}, None
+        self.states, self.box = None, None
 
     def plan(self) -> list:
         with warnings.catch_warnings():  # the periodic box's angular-momentum warning: expected here
@@ -135,17 +119,10 @@ class FidelityStudy(Study):
         self.states = water_box_replicas(cfg, cfg["model"], self.out, self.log)
         self.box = water_box_scene(cfg, cfg["model"])
         runs = []
-        for row in self.rows:
-            lab = describe(row)["label"]
-            why = availability(row, self.box, float(cfg["temperature"]))
-            if why:
-                self.unavailable[lab] = why
-                self.log(f"{lab}: {why}")
-                continue
-            for r in range(int(cfg["replicas"])):
-                cost = describe(row)["evals_per_step"] * (cfg["settle_ps"] + cfg["omega_ps"] + cfg["length_ps"]) \
-                    / to_row(row).step_fs
-                runs.append(Run(run_key(cfg, row, r), "box", (row, r), {"row": lab, "replica": r}, cost))
+        for row in map(to_row, self.rows):
+            cost = row.evals_per_ps(True) * (cfg["settle_ps"] + cfg["omega_ps"] + cfg["length_ps"])
+            runs += [Run(run_key(cfg, row.label, r), "box", (row.label, r), {"row": row.label, "replica": r}, cost)
+                     for r in range(int(cfg["replicas"]))]
         return runs
 
     def shared(self, runs) -> dict:
@@ -163,7 +140,7 @@ class FidelityStudy(Study):
             warnings.simplefilter("ignore", ConservationWarning)
             timings = self.stored_timings() if self.report_only or not self.timing else self.timings()
         grouped = {k[0]: v for k, v in self.results(runs, ("row",)).items()}
-        summary = summarise(self.cfg, self.rows, grouped, timings, self.unavailable, self.box_edge(),
+        summary = summarise(self.cfg, self.rows, grouped, timings, self.box_edge(),
                             references(self.cfg, self.rows))
         # the temperature view needs each run's time series (<key>.npz), which a committed data set leaves out
         with_series = {lab: [rep for rep in reps if len(rep[0].get("t", ()))] for lab, reps in grouped.items()}
@@ -206,8 +183,7 @@ class FidelityStudy(Study):
         from .runs import replica_seed
 
         x, v = self.states
-        rows = {r.label: r for r in (to_row(row, self.cfg["temperature"]) for row in self.rows)
-                if r.label not in self.unavailable}
+        rows = {r.label: r for r in (to_row(row, self.cfg["temperature"]) for row in self.rows)}
         out = seconds_per_ps(rows, self.box, x[0], v[0], float(self.cfg.get("timing_fs", 50.0)),
                              self.cfg.get("threads", 1), replica_seed(self.cfg, 0))
         self.log(f"timed {len(rows)} rows in turns")
