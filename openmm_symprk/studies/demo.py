@@ -7,7 +7,7 @@ forces; ours with ``exact_momentum`` keep it to round-off, under NVE and under t
 Prints, per row (:data:`ROWS`): the backend it ran on, energy error (for a thermostatted row: of the energy
 plus the heat-bath energy), linear and angular momentum change, force evaluations per step and the wall-time
 ratio to OpenMM's VerletIntegrator measured in the same run (the integrators take turns block by block,
-:mod:`.timing`).
+:mod:`.core.timing`).
 """
 from __future__ import annotations
 

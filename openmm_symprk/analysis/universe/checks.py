@@ -21,14 +21,16 @@ __all__ = ["TIME_RTOL", "OH_RANGE", "HH_RANGE", "SPLIT_LIMIT", "JUMP_FRACTION", 
 
 #: Relative spread of the time steps accepted as one interval (beyond float32's rounding of the times).
 TIME_RTOL = 1e-3
-#: Accepted O-H and H-H distances of a water, Angstrom (rigid and flexible models: 0.96-1.0 and 1.5-1.65).
+#: Accepted O-H distances of a water, Angstrom (rigid and flexible models: 0.96-1.0).
 OH_RANGE = (0.8, 1.2)
+#: Accepted H-H distances of a water, Angstrom (rigid and flexible models: 1.5-1.65).
 HH_RANGE = (1.3, 1.9)
 #: Without a box, a site farther than this from its molecule's first atom (Angstrom) means a split molecule.
 SPLIT_LIMIT = 3.0
 #: A centre of mass stepping more than this fraction of the system's width (and more than MIN_JUMP Angstrom)
 #: between frames is taken for a jump across a box.
 JUMP_FRACTION = 0.8
+#: The smallest step of a centre of mass between frames (Angstrom) taken for a jump across a box.
 MIN_JUMP = 5.0
 
 

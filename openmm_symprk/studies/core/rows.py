@@ -6,7 +6,7 @@ or friction, interval and position in the step), hydrogen mass repartitioning, m
 backend and the random seed.  It builds the integrator for a System (:meth:`Row.build`; a study runs it with
 :class:`~.engine.RowEngine`) and knows its label (a study's runs are stored under it:
 :func:`~.store.run_key`), its force (group) evaluations per step (:meth:`Row.evals_per_step`: the resolved
-method's, :attr:`openmm_symprk.methods.ResolvedMethod.force_evals`; for OpenMM's integrators one table,
+method's ``force_evals``, :class:`openmm_symprk.methods.resolved.ResolvedMethod`; for OpenMM's integrators one table,
 :data:`OPENMM_KINDS`), whether its state velocities are on-step or lag half a step (leapfrog), whether it has a
 heat-bath energy and whether it keeps the total momentum.
 

@@ -21,7 +21,8 @@ __all__ = ["run_key", "RunStore"]
 
 def run_key(row, replica: int | None, settings: dict, length: int = 16, **context) -> str:
     """The key of a run of ``row`` (a Row or a label, hashed as its canonical label) from ``replica``: the SHA-1 of
-    {"cfg": settings, "row": label, "replica": replica, **context} as sorted JSON, cut to ``length`` hex digits."""
+    ``{"cfg": settings, "row": label, "replica": replica, **context}`` as sorted JSON, cut to ``length`` hex
+    digits."""
     label = (row if isinstance(row, Row) else Row.parse(row)).label
     return content_key({"cfg": settings, "row": label, "replica": None if replica is None else int(replica),
                         **context}, length)

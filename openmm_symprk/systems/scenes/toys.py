@@ -118,7 +118,7 @@ def duffing_exact(a, b, amp, u0, t: float):
 
 
 def exact_state(meta: dict, t: float):
-    """Exact (x, v) of a toy scene at time t from its metadata (see :mod:`.named`)."""
+    """Exact (x, v) of a toy scene at time t from its metadata (see :mod:`openmm_symprk.studies.core.scenes`)."""
     if meta["toy"] == "harmonic":
         return harmonic_exact(np.array(meta["omega"]), np.array(meta["x0"]), np.array(meta["v0"]), t)
     if meta["toy"] == "duffing":
