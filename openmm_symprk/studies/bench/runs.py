@@ -295,7 +295,7 @@ def _measure(spec, scene, eng, rec, arrays):
     completed = done == spec.n_steps and not rec.blew_up
     if completed:
         if scene.exact is not None:
-            from ...systems.scenes.toys import exact_state
+            from ..core.toys import exact_state
 
             xe, _ = exact_state(scene.exact, spec.length_ps)
             rec.traj_error = rms_deviation(x, xe)

@@ -44,7 +44,7 @@ _probe_systems: dict = {}
 
 
 def _dense_harmonic(omega_max: float):
-    from ...systems.scenes import toys
+    from ..core import toys
 
     key = float(omega_max)
     if key not in _probe_systems:

@@ -40,7 +40,7 @@ def harmonic(n: int = 256, omega_max: float | None = None, seed: int = 11) -> Sc
     down to zero is enough to turn "largest stable step" into the linear stability interval (stable for
     every h*omega up to the limit), and nothing else is needed for that question.  External wells:
     energy and angular momentum about the origin are invariants, linear momentum is not."""
-    from ...systems.scenes import toys
+    from . import toys
 
     omega_max = toys.OMEGA_OH if omega_max is None else omega_max
     omega = toys.harmonic_frequencies(n, omega_max)
@@ -58,7 +58,7 @@ def anharmonic(n: int = 64, seed: int = 13) -> Scene:
     Nonlinear forces reach the order conditions that a harmonic force cannot see (on q'' = -q every
     consistent splitting of a given symmetric structure looks alike), and the cn-function solution keeps
     the answer exact.  Separable quartic wells: energy is the only invariant."""
-    from ...systems.scenes import toys
+    from . import toys
 
     a, b, amp = toys.duffing_parameters(n)
     x0, v0, u0 = toys.duffing_initial_state(a, b, amp, seed)

@@ -23,7 +23,7 @@ import openmm as mm
 from ...physics.temperature import R_KJ
 from ...support import require
 
-special = require("scipy.special", "studies", "openmm_symprk.systems.scenes.toys")
+special = require("scipy.special", "studies", "openmm_symprk.studies.core.toys")
 ellipj, ellipkinc = special.ellipj, special.ellipkinc
 
 #: kT at 300 K in kJ/mol: the toys hold about this much energy per degree of freedom.
