@@ -1,38 +1,99 @@
-"""The ``symprk`` command: demo, methods, check, info, observe (a trajectory's water observables), and the
-studies (bench, conservation, speed, equipartition, fidelity, drift).
+"""The ``symprk`` command, and the one frame every sub-command runs in.
 
-Every error the user can cause (a bad name, file, platform, value, a blow-up) ends in one line on stderr
-and a non-zero exit status; only a bug shows a traceback.
+A sub-command is a module with ``build_parser(prog)`` (its options) and ``run(args)`` (its work; an exit status,
+None for 0; ``args`` also holds ``command``, ``prog`` and its ``argv``), named in :data:`COMMANDS`: the library's own (``methods``, ``check``, ``info`` here; ``observe`` in
+:mod:`openmm_symprk.analysis.cli`) and the studies' (:mod:`openmm_symprk.studies`).  :func:`main` parses its
+options and runs it in :func:`run_command`, so every sub-command has one error policy: a user's mistake (a bad value,
+name, file or platform, a missing extra, a blow-up: :func:`user_errors`) is one line ``symprk <name>: error: ...``
+on stderr and exit status 2, a bad option argparse's usage and status 2, Ctrl-C status 130; anything else is a bug
+and keeps its traceback.
 """
 from __future__ import annotations
 
 import argparse
 import sys
+from dataclasses import dataclass
+from importlib import import_module
 
-from .studies.core.cli import positive, run_command
+__all__ = ["CommandError", "COMMANDS", "user_errors", "run_command", "build_parser", "main"]
 
 
 class CommandError(Exception):
-    """A user-facing error of a sub-command: printed as one line, exit status 2."""
+    """A user's mistake a sub-command finds itself: printed as one line, exit status 2."""
 
 
-def _platform_name(name: str) -> str:
+@dataclass(frozen=True)
+class Command:
+    module: str  # has build_parser(prog) and run(args)
+    help: str
+    keeps_runs: bool = False  # a study whose finished runs are kept when it is interrupted
+
+
+#: The sub-commands, in the order ``symprk --help`` lists them.
+COMMANDS = {
+    "demo": Command("openmm_symprk.studies.demo", "spinning rigid-water cluster: conservation vs OpenMM's Verlet "
+                                                  "and Langevin"),
+    "methods": Command(__name__, "print the catalogue (or details of named methods)"),
+    "check": Command(__name__, "check a user tableau file (JSON/TOML with A, b, A_hat, b_hat)"),
+    "info": Command(__name__, "versions, platforms and backends"),
+    "observe": Command("openmm_symprk.analysis.cli", "water observables of any trajectory (diffusion, "
+                       "reorientation, omega ACF, T_trans/T_rot, g(r)) with errors (symprk observe --help)"),
+    "bench": Command("openmm_symprk.studies.bench.cli", "work-precision and stability sweeps (symprk bench --help)",
+                     True),
+    "conservation": Command("openmm_symprk.studies.platforms.conservation",
+                            "conservation table: platform x method x projection (symprk conservation --help)"),
+    "speed": Command("openmm_symprk.studies.platforms.speed",
+                     "native backend vs OpenMM's VerletIntegrator, time per step (symprk speed --help)"),
+    "gpucheck": Command("openmm_symprk.studies.platforms.gpucheck",
+                        "the native backend on CUDA: same program, conservation, speed (needs a GPU)"),
+    "equipartition": Command("openmm_symprk.studies.equipartition.cli",
+                             "rigid water: T_rot - T_trans per method and step (symprk equipartition --help)", True),
+    "fidelity": Command("openmm_symprk.studies.fidelity.cli", "rigid water: diffusion, reorientation, omega ACF, "
+                        "g(r), energies per integrator, step and thermostat (symprk fidelity --help)", True),
+    "nvt": Command("openmm_symprk.studies.nvt.cli",
+                   "thermostat: cost vs LangevinMiddleIntegrator, effective-energy drift (symprk nvt --help)"),
+    "drift": Command("openmm_symprk.studies.drift.cli", "energy drift over replicas, paired rows, verdict at 3 SE: "
+                     "hmr, exact-momentum, nvt (symprk drift --help)", True),
+}
+#: Other spellings of a sub-command: ``symprk nvt drift ...`` is ``symprk drift nvt ...``.
+ALIASES = {("nvt", "drift"): ["drift", "nvt"]}
+
+
+def user_errors() -> tuple:
+    """The exceptions that mean "the input was wrong" (one line, exit status 2), not "the package has a bug" (a
+    traceback): bad values (ValueError: unknown methods, bad tableaux and rows included), files (OSError: a study's
+    locked or occupied folder too), a missing extra (ImportError), what OpenMM refuses, a blow-up, the native
+    plugin missing where it is needed, an implicit tableau that does not converge, and :class:`CommandError`."""
     import openmm as mm
 
-    names = [mm.Platform.getPlatform(i).getName() for i in range(mm.Platform.getNumPlatforms())]
-    if name not in names:
-        raise CommandError(f"unknown OpenMM platform {name!r}; this installation has {', '.join(names)}")
-    return name
+    from .integrators import SimulationBlowUpError
+    from .methods.reference import ConvergenceError
+    from .plugin import NativeUnavailableError
+
+    return (ValueError, OSError, ImportError, mm.OpenMMException, SimulationBlowUpError, NativeUnavailableError,
+            ConvergenceError, CommandError)
 
 
-def _cmd_demo(args):
-    from .studies.demo import run_demo
-
-    run_demo(methods=args.method, n_waters=args.waters, steps=args.steps, step_fs=args.step_fs,
-             platform=None if args.platform is None else _platform_name(args.platform), backend=args.backend)
+#: What an interrupted study says.
+KEPT = "interrupted (finished runs are kept; run again to continue)"
 
 
-def _cmd_methods(args):
+def run_command(prog: str, action, interrupted: str = "interrupted") -> int:
+    """``action()``'s exit status (None: 0) under the one error policy (module docstring)."""
+    try:
+        return action() or 0
+    except KeyboardInterrupt:
+        print(f"{prog}: {interrupted}", file=sys.stderr)
+        return 130
+    except Exception as exc:
+        if isinstance(exc, user_errors()):
+            print(f"{prog}: error: {' '.join(str(exc).split())}", file=sys.stderr)
+            return 2
+        raise
+
+
+# -- the library's own sub-commands ----------------------------------------------------------------------------------
+def _methods(args):
     from .methods.catalogue import format_table, methods
 
     entries = [methods[n] for n in args.names] if args.names else None
@@ -68,7 +129,7 @@ def _read_tableau_file(path: str) -> dict:
     return data
 
 
-def _cmd_check(args):
+def _check(args):
     """Check a user tableau pair given as a JSON or TOML file with A, b, A_hat, b_hat."""
     from .methods.reference import measure_order
     from .methods.stability import stability_interval
@@ -86,7 +147,7 @@ def _cmd_check(args):
     return 0 if tab.is_symplectic else 1
 
 
-def _cmd_info(args):
+def _info(args):
     import openmm as mm
 
     import openmm_symprk
@@ -116,72 +177,50 @@ def _cmd_info(args):
     return 0
 
 
-def build_parser():
-    p = argparse.ArgumentParser(prog="symprk", description="Symplectic PRK integrators for OpenMM")
-    sub = p.add_subparsers(dest="command", required=True)
-
-    d = sub.add_parser("demo", help="spinning rigid-water cluster: conservation vs OpenMM's Verlet and Langevin")
-    d.add_argument("--method", nargs="+", default=None,
-                   help="catalogue names, each an NVE row beside OpenMM's Verlet (default: the demo's rows)")
-    d.add_argument("--waters", type=positive(int), default=64)
-    d.add_argument("--steps", type=positive(int), default=2000)
-    d.add_argument("--step-fs", type=positive(float), default=2.0)
-    d.add_argument("--platform", default=None, help="default: CPU (Reference where CPU is missing)")
-    d.add_argument("--backend", default="auto", choices=("auto", "native", "custom"))
-    d.set_defaults(func=_cmd_demo)
-
-    m = sub.add_parser("methods", help="print the catalogue (or details of named methods)")
-    m.add_argument("names", nargs="*")
-    m.set_defaults(func=_cmd_methods)
-
-    c = sub.add_parser("check", help="check a user tableau file (JSON/TOML with A, b, A_hat, b_hat)")
-    c.add_argument("file")
-    c.set_defaults(func=_cmd_check)
-
-    i = sub.add_parser("info", help="versions, platforms and backends")
-    i.add_argument("--require-native", metavar="PLATFORMS",
-                   help="exit with status 2 unless the native plugin serves these platforms (comma-separated)")
-    i.set_defaults(func=_cmd_info)
-
-    for name, text in DELEGATED_HELP.items():
-        sub.add_parser(name, help=text)
+def build_parser(prog: str = "symprk"):
+    """``symprk``'s parser (``prog`` "symprk"), or that of its own sub-command ``prog`` ("symprk methods", ...)."""
+    if prog == "symprk methods":
+        p = argparse.ArgumentParser(prog=prog, description=COMMANDS["methods"].help)
+        p.add_argument("names", nargs="*")
+    elif prog == "symprk check":
+        p = argparse.ArgumentParser(prog=prog, description=COMMANDS["check"].help)
+        p.add_argument("file")
+    elif prog == "symprk info":
+        p = argparse.ArgumentParser(prog=prog, description=COMMANDS["info"].help)
+        p.add_argument("--require-native", metavar="PLATFORMS",
+                       help="exit with status 2 unless the native plugin serves these platforms (comma-separated)")
+    else:
+        p = argparse.ArgumentParser(prog="symprk", description="Symplectic PRK integrators for OpenMM")
+        sub = p.add_subparsers(dest="command", required=True)
+        for name, cmd in COMMANDS.items():
+            sub.add_parser(name, help=cmd.help, add_help=False)
     return p
 
 
-#: sub-commands whose own argument parser lives in another module (argv passed through untouched)
-DELEGATED = {"bench": "openmm_symprk.studies.bench.cli", "conservation": "openmm_symprk.studies.conservation_table",
-             "speed": "openmm_symprk.studies.native_speed", "gpucheck": "openmm_symprk.studies.gpucheck",
-             "equipartition": "openmm_symprk.studies.equipartition.cli", "fidelity": "openmm_symprk.studies.fidelity.cli",
-             "nvt": "openmm_symprk.studies.nvt.cli", "drift": "openmm_symprk.studies.drift.cli",
-             "observe": "openmm_symprk.analysis.cli"}
-DELEGATED_HELP = {"bench": "work-precision and stability sweeps (symprk bench --help)",
-                  "conservation": "conservation table: platform x method x projection (symprk conservation --help)",
-                  "speed": "native backend vs OpenMM's VerletIntegrator, time per step (symprk speed --help)",
-                  "gpucheck": "the native backend on CUDA: same program, conservation, speed (needs a GPU)",
-                  "equipartition": "rigid water: T_rot - T_trans per method and step (symprk equipartition --help)",
-                  "fidelity": "rigid water: diffusion, reorientation, omega ACF, g(r), energies per integrator, step and "
-                              "thermostat (symprk fidelity --help)",
-                  "nvt": "thermostat: cost vs LangevinMiddleIntegrator, effective-energy drift (symprk nvt --help)",
-                  "drift": "energy drift over replicas, paired rows, verdict at 3 SE: hmr, exact-momentum, nvt "
-                           "(symprk drift --help)",
-                  "observe": "water observables of any trajectory (diffusion, reorientation, omega ACF, T_trans/T_rot, "
-                             "g(r)) with errors (symprk observe --help)"}
+def run(args):
+    """The library's own sub-commands (``methods``, ``check``, ``info``)."""
+    return {"methods": _methods, "check": _check, "info": _info}[args.command](args)
 
 
 def main(argv=None):
-    argv = sys.argv[1:] if argv is None else list(argv)
-    if argv and argv[0] in DELEGATED:
-        import importlib
+    argv = list(sys.argv[1:] if argv is None else argv)
+    name = argv[0] if argv else ""
+    prog = f"symprk {' '.join(argv[:2])}" if tuple(argv[:2]) in ALIASES else f"symprk {name}"
+    if tuple(argv[:2]) in ALIASES:
+        argv = ALIASES[tuple(argv[:2])] + argv[2:]
+        name = argv[0]
+    if name not in COMMANDS:
+        build_parser().parse_args(argv)  # --help, or argparse's usage and exit status 2
+        return 2
+    cmd = COMMANDS[name]
 
-        from .support import MissingDependencyError
+    def action():
+        module = import_module(cmd.module)  # a study may need an extra: MissingDependencyError, one line
+        args = module.build_parser(prog).parse_args(argv[1:])
+        args.command, args.prog, args.argv = name, prog, argv[1:]
+        return module.run(args)
 
-        try:  # a study's module may need an extra (matplotlib, scipy, ...): say which, in one line
-            return importlib.import_module(DELEGATED[argv[0]]).main(argv[1:]) or 0
-        except MissingDependencyError as exc:
-            print(f"symprk {argv[0]}: error: {exc}", file=sys.stderr)
-            return 2
-    args = build_parser().parse_args(argv)
-    return run_command(f"symprk {args.command}", lambda: args.func(args), (CommandError,))
+    return run_command(prog, action, KEPT if cmd.keeps_runs else "interrupted")
 
 
 if __name__ == "__main__":

@@ -139,11 +139,40 @@ def test_pure_numerics_do_not_import_openmm(package):
     assert res.returncode == 0, res.stderr[-2000:]
 
 
+#: The modules at the package root: the facade and the command (with its frame).
+ROOT_MODULES = ["__init__.py", "cli.py"]
+
+
 def test_few_modules_at_the_package_root():
     root = sorted(f for f in os.listdir(ROOT) if f.endswith(".py"))
-    assert root == ["__init__.py", "cli.py"], root
+    assert root == ROOT_MODULES, root
 
 
+def _study(module):
+    """The study a module of openmm_symprk.studies belongs to ("bench", "platforms", "demo", ...; "core" for the
+    machinery they share), or None outside the studies."""
+    parts = module.split(".")
+    return parts[2] if len(parts) > 2 and parts[1] == "studies" else None
+
+
+def test_no_study_imports_another():
+    """openmm_symprk/studies/<x>/ (or studies/<x>.py) imports studies/core and the lower layers, never studies/<y>/:
+    what two studies share lives in studies/core."""
+    wrong = [f"{name} imports {target}" for name, path in MODULES.items() for target, _, _ in _imports(name, path)
+             if _study(name) not in (None, "core") and _study(target) not in (None, "core", _study(name))]
+    assert not wrong, "\n".join(wrong)
+    # the machinery imports no study
+    assert not [t for n, p in MODULES.items() if _study(n) == "core" for t, _, _ in _imports(n, p)
+                if _study(t) not in (None, "core")]
+
+
+def test_the_library_does_not_reach_into_the_studies():
+    """Below the studies (and in the command, but for its table of sub-commands, which names them by module path)
+    nothing imports openmm_symprk.studies: studies-only code lives in studies/."""
+    wrong = [f"{name} imports {target}" for name, path in MODULES.items() if _layer(name) is not None
+             and _layer(name) < LAYERS["studies"] for target, _, _ in _imports(name, path)
+             if target.startswith("openmm_symprk.studies")]
+    assert not wrong, wrong
 #: The modules that build or run the step: they execute the resolved method's sub-steps, thermostat events included,
 #: and decide nothing of where the events go (openmm_symprk.methods.resolved does).
 STEP_RUNNERS = ("integrators.program", "integrators.thermostat_program", "integrators.custom_backend",

@@ -11,15 +11,13 @@ Kernels (numpy; g(r) through MDAnalysis' InterRDF), each with known-answer tests
   and the correlation times tau_1, tau_2;
 - :mod:`.angular` - the molecules' angular velocity (space or body frame) and its autocorrelation;
 - :mod:`.structure` - the radial distribution function g(r) and its first peak;
-- :mod:`.literature` - constants and published model data (viscosities) with their sources;
-- :mod:`.observe` - every observable of one run of the fidelity study from its stored series.
+- :mod:`.literature` - constants and published model data (viscosities) with their sources.
 
 Errors come from the package's statistics (:mod:`openmm_symprk.stats`: the jackknife over molecules, block
 and correlated-series errors).  :mod:`openmm_symprk.analysis.universe` runs the same kernels on any
 MDAnalysis Universe (imported on first use: it needs MDAnalysis); ``symprk observe`` (:mod:`.cli`) prints them
 for a trajectory file.
 """
-from . import angular, correlation, diffusion, literature, molecules, observe, reorientation, structure
+from . import angular, correlation, diffusion, literature, molecules, reorientation, structure
 
-__all__ = ["angular", "correlation", "diffusion", "literature", "molecules", "observe", "reorientation",
-           "structure"]
+__all__ = ["angular", "correlation", "diffusion", "literature", "molecules", "reorientation", "structure"]

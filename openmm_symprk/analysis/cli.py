@@ -21,16 +21,15 @@ import argparse
 import json
 import os
 import stat
-import sys
 
 import numpy as np
 
 from ..support import require
 
-__all__ = ["OBSERVED", "observe", "build_parser", "main"]
+__all__ = ["OBSERVED", "observe", "build_parser", "run"]
 
 #: (key, description, unit) of what ``symprk observe`` reports, in its order.  It reads like
-#: :data:`openmm_symprk.analysis.observe.OBSERVABLES` on purpose but is not that table: that one's keys are the keys
+#: :data:`openmm_symprk.studies.fidelity.observables.OBSERVABLES` on purpose but is not that table: that one's keys are the keys
 #: of the fidelity study's stored runs (and hold PE and drift, which a trajectory alone cannot give), these are the
 #: keys of ``--json`` (with D_inf and O-H, which the study does not report).
 OBSERVED = [
@@ -150,8 +149,8 @@ def format_table(obs: dict, notes: dict) -> str:
     return "\n".join(lines)
 
 
-def build_parser():
-    ap = argparse.ArgumentParser(prog="symprk observe", description=__doc__,
+def build_parser(prog: str = "symprk observe"):
+    ap = argparse.ArgumentParser(prog=prog, description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("topology", help="topology file MDAnalysis reads (PDB, PSF, PRMTOP, TPR, GRO ...)")
     ap.add_argument("trajectory", nargs="+", help="trajectory file(s) (DCD, XTC, TRR, NetCDF, H5MD ...)")
@@ -217,28 +216,24 @@ def _write_json(target: str, stream: bool, data: dict) -> None:
         raise ValueError(f"cannot write --json {target}: {exc.strerror or exc}") from None
 
 
-def main(argv=None) -> int:
-    args = build_parser().parse_args(argv)
-    try:
-        if (args.viscosity is None) != (args.temperature is None):
-            raise ValueError("the Yeh-Hummer correction needs both --viscosity and --temperature")
-        if args.dt is not None and not (np.isfinite(args.dt) and args.dt > 0):
-            raise ValueError(f"--dt must be a positive number of ps (the time between the trajectory's frames), "
-                             f"got {args.dt:g}")
-        target, stream = _json_target(args.json) if args.json else (None, False)
-        require("MDAnalysis", "analysis", "symprk observe")
-        from .universe.reading import open_universe, read_waters, stored_box
+def run(args):
+    """The command (:func:`openmm_symprk.cli.main` runs it): ValueError and OSError are the user's mistakes."""
+    if (args.viscosity is None) != (args.temperature is None):
+        raise ValueError("the Yeh-Hummer correction needs both --viscosity and --temperature")
+    if args.dt is not None and not (np.isfinite(args.dt) and args.dt > 0):
+        raise ValueError(f"--dt must be a positive number of ps (the time between the trajectory's frames), "
+                         f"got {args.dt:g}")
+    target, stream = _json_target(args.json) if args.json else (None, False)
+    require("MDAnalysis", "analysis", "symprk observe")
+    from .universe.reading import open_universe, read_waters, stored_box
 
-        u = open_universe(args.topology, args.trajectory)
-        progress = {"auto": PROGRESS_FRAMES, "always": True, "never": False}[args.progress]
-        read = read_waters(u, args.select, args.start, args.stop, args.step, progress, dt=args.dt,
-                           fallback_box=lambda: stored_box(args.topology, args.trajectory))
-        memory, has_v = read.universe, read.has_velocities
-        obs, notes = observe(memory, window_ps=args.window, viscosity_mpas=args.viscosity,
-                             temperature_k=args.temperature, omega_lag_ps=args.omega_lag, has_velocities=has_v)
-    except (ValueError, OSError) as exc:
-        print(f"symprk observe: error: {exc}", file=sys.stderr)
-        return 2
+    u = open_universe(args.topology, args.trajectory)
+    progress = {"auto": PROGRESS_FRAMES, "always": True, "never": False}[args.progress]
+    read = read_waters(u, args.select, args.start, args.stop, args.step, progress, dt=args.dt,
+                       fallback_box=lambda: stored_box(args.topology, args.trajectory))
+    memory, has_v = read.universe, read.has_velocities
+    obs, notes = observe(memory, window_ps=args.window, viscosity_mpas=args.viscosity,
+                         temperature_k=args.temperature, omega_lag_ps=args.omega_lag, has_velocities=has_v)
     n_waters = memory.residues.n_residues
     dt = read.dt
     when = "" if read.dt_from == "the file's times" else f" ({read.dt_from})"
@@ -259,14 +254,5 @@ def main(argv=None) -> int:
                 "observables": {key: None if obs[key] is None else
                                 {"value": obs[key][0], "se": obs[key][1], "unit": units[key]} for key in obs},
                 "notes": notes}
-        try:
-            _write_json(target, stream, data)
-        except ValueError as exc:
-            print(f"symprk observe: error: {exc}", file=sys.stderr)
-            return 2
+        _write_json(target, stream, data)
         print(f"\nwrote {args.json}")
-    return 0
-
-
-if __name__ == "__main__":
-    sys.exit(main())

@@ -7,24 +7,27 @@ forces; ours with ``exact_momentum`` keep it to round-off, under NVE and under t
 Prints, per row (:data:`ROWS`): the backend it ran on, energy error (for a thermostatted row: of the energy
 plus the heat-bath energy), linear and angular momentum change, force evaluations per step and the wall-time
 ratio to OpenMM's VerletIntegrator measured in the same run (the integrators take turns block by block,
-:mod:`.timing`).
+:mod:`.core.timing`).
 """
 from __future__ import annotations
 
+import argparse
 from dataclasses import dataclass
 
 import numpy as np
 import openmm as mm
-import openmm.unit as unit
 
-from ..conservation.diagnostics import angular_momentum, linear_momentum
+from ..physics import angular_momentum, linear_momentum
 from ..integrators.thermostat import DEFAULT_COLLISION_TIME
 from ..systems.properties import degrees_of_freedom
 from ..systems.scenes import water_cluster
+from .core import platforms
+from .core.options import positive
+from .core.engine import RowEngine
 from .core.rows import Row
-from .timing import interleaved
+from .core.timing import interleaved
 
-__all__ = ["ROWS", "DemoRow", "run_demo", "default_platform"]
+__all__ = ["ROWS", "DemoRow", "run_demo", "default_platform", "build_parser", "run"]
 
 #: The demo's rows, in order: (name printed, row label without its step; :class:`~.core.rows.Row`).  The first row is
 #: the timing reference.  The thermostatted rows run at 300 K: ours with the package's default collision time, OpenMM's
@@ -55,42 +58,29 @@ class DemoRow:
 def default_platform(names=None) -> tuple[str, str]:
     """(platform, note): CPU where this installation has it (``names``: the platform names, default OpenMM's),
     else Reference with a note saying why."""
-    if names is None:
-        names = [mm.Platform.getPlatform(i).getName() for i in range(mm.Platform.getNumPlatforms())]
+    names = platforms.names() if names is None else names
     if "CPU" in names:
         return "CPU", ""
     return "Reference", f"OpenMM's CPU platform is not available here (platforms: {', '.join(names)}); " \
                         "running on Reference as a fallback."
 
 
-def _build(label: str, step_fs: float, system, backend: str):
-    """(row, integrator, backend label) for one row of :data:`ROWS`."""
-    row = Row.parse(label, step_fs=step_fs)
-    if row.is_ours:
-        row = row.replace(backend=backend)
-    ig = row.build(system, quiet=False)
-    return row, ig, ig.backend if row.is_ours else "OpenMM"
-
-
 class _Tracker:
-    """One integrator on its own Context, with its running error figures."""
+    """One row running on its own Context (:class:`~.core.engine.RowEngine`, from the scene's state as it is: the
+    leapfrog row's velocities lag), with its running error figures."""
 
-    def __init__(self, scene, integrator, platform, name, backend, evals_per_step, nvt):
-        self.ig, self.name, self.backend, self.evals, self.nvt = integrator, name, backend, evals_per_step, nvt
-        # the effective energy of a thermostatted row is E + heat-bath energy; OpenMM's Langevin has none
-        self.heat_bath = getattr(integrator, "computeHeatBathEnergy", None) if nvt else None
-        self.ctx = scene.context(integrator, platform)
-        self.masses = scene.masses()
-        self.n_dof = degrees_of_freedom(scene.system)
+    def __init__(self, name, engine, n_dof):
+        self.name, self.eng, self.n_dof = name, engine, n_dof
+        self.backend = engine.integrator.backend if engine.row.is_ours else "OpenMM"
+        self.evals, self.nvt = engine.row.evals_per_step(True), bool(engine.row.thermostat)
         self.e0, self.p0, self.l0 = self._measure()
         self.worst = self.dp = self.dl = 0.0
 
     def _measure(self):
-        st = self.ctx.getState(getEnergy=True, getPositions=True, getVelocities=True)
-        e = (st.getPotentialEnergy() + st.getKineticEnergy()).value_in_unit(unit.kilojoule_per_mole)
-        if self.heat_bath is not None:
-            e += self.heat_bath().value_in_unit(unit.kilojoule_per_mole)
-        return e, linear_momentum(st, masses=self.masses), angular_momentum(st, about="origin", masses=self.masses)
+        # the effective energy of a thermostatted row is E + heat-bath energy; OpenMM's Langevin has none
+        x, v, pe, ke = self.eng.sample()
+        m = self.eng.masses
+        return pe + ke + (self.eng.heat_bath() or 0.0), linear_momentum(v, m), angular_momentum(x, v, m, about="origin")
 
     def record(self):
         e, p, l = self._measure()
@@ -100,7 +90,7 @@ class _Tracker:
 
     @property
     def energy_error(self):
-        return None if self.nvt and self.heat_bath is None else self.worst
+        return None if self.eng.heat_bath() is None else self.worst
 
 
 def _table(rows, width):
@@ -134,12 +124,14 @@ def run_demo(methods=None, n_waters: int = 64, steps: int = 2000, step_fs: float
     out("not an invariant for it; our integrators report synchronous (x_n, v_n).\n")
     trackers = []
     for name, label in specs:
-        row, ig, used = _build(label, step_fs, scene.system, backend)
+        row = Row.parse(label, step_fs=step_fs)
         if row.is_ours:
+            row = row.replace(backend=backend)
             name = name.replace(f"symprk {label.split()[0]}", f"symprk {row.method}", 1)
-        trackers.append(_Tracker(scene, ig, platform, name, used, row.evals_per_step(True), bool(row.thermostat)))
+        eng = RowEngine(row, scene, platform=platform, threads=None, start=False, quiet=False)
+        trackers.append(_Tracker(name, eng, degrees_of_freedom(scene.system)))
     by_name = {tr.name: tr for tr in trackers}
-    timings = interleaved({tr.name: tr.ig.step for tr in trackers}, chunk, rounds=max(1, steps // chunk),
+    timings = interleaved({tr.name: tr.eng.step for tr in trackers}, chunk, rounds=max(1, steps // chunk),
                           after=lambda name: by_name[name].record())
     rows = [DemoRow(tr.name, tr.backend, tr.energy_error, tr.dp, tr.dl, tr.evals, timings[tr.name].best, tr.nvt)
             for tr in trackers]
@@ -148,8 +140,26 @@ def run_demo(methods=None, n_waters: int = 64, steps: int = 2000, step_fs: float
     out("\n|dE| in kJ/mol per degree of freedom; |dP| in Da nm/ps; time per step relative to OpenMM's "
         "VerletIntegrator,\neach the fastest of its blocks of steps, the integrators taking turns block by block.")
     if any(r.nvt for r in rows):
-        out(f"Rows at 300 K are NVT, where the energy is not conserved: for ours |dE| is that of the energy\n"
+        out("Rows at 300 K are NVT, where the energy is not conserved: for ours |dE| is that of the energy\n"
             "plus the heat-bath energy (computeHeatBathEnergy), which is; OpenMM's LangevinMiddleIntegrator (friction\n"
             "1/ps) has no heat-bath energy (-).  Our thermostat rescales the velocities relative to the\n"
             "cluster's rigid motion, so P and L stay; Langevin's random forces change both.")
     return rows
+
+
+def build_parser(prog: str = "symprk demo"):
+    p = argparse.ArgumentParser(prog=prog, description="spinning rigid-water cluster: conservation vs OpenMM's "
+                                                       "Verlet and Langevin")
+    p.add_argument("--method", nargs="+", default=None,
+                   help="catalogue names, each an NVE row beside OpenMM's Verlet (default: the demo's rows)")
+    p.add_argument("--waters", type=positive(int), default=64)
+    p.add_argument("--steps", type=positive(int), default=2000)
+    p.add_argument("--step-fs", type=positive(float), default=2.0)
+    p.add_argument("--platform", default=None, help="default: CPU (Reference where CPU is missing)")
+    p.add_argument("--backend", default="auto", choices=("auto", "native", "custom"))
+    return p
+
+
+def run(args):
+    run_demo(methods=args.method, n_waters=args.waters, steps=args.steps, step_fs=args.step_fs,
+             platform=None if args.platform is None else platforms.check(args.platform), backend=args.backend)

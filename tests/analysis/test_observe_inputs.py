@@ -16,8 +16,12 @@ import pytest
 mda = pytest.importorskip("MDAnalysis")
 datafiles = pytest.importorskip("MDAnalysisTests.datafiles")
 
-from openmm_symprk.analysis.cli import main  # noqa: E402
 from openmm_symprk.analysis.universe import Reorientation, SelfDiffusion  # noqa: E402
+from openmm_symprk.cli import main as symprk  # noqa: E402
+
+
+def main(argv):
+    return symprk(["observe", *argv])
 
 pytestmark = [pytest.mark.filterwarnings("ignore::DeprecationWarning"),
               pytest.mark.filterwarnings("ignore:Reader has no dt"), pytest.mark.filterwarnings("ignore:Found no"),

@@ -1,5 +1,5 @@
 """The MDAnalysis analyses (openmm_symprk.analysis.universe) on trajectories this package did not write: they give
-the fidelity study's figures (openmm_symprk.analysis.observe on the same frames kept in memory), and agree with
+the fidelity study's figures (openmm_symprk.studies.fidelity.observables on the same frames kept in memory), and agree with
 what others wrote on the same frames: MDAnalysis' EinsteinMSD, the waterdynamics MDAKit's
 WaterOrientationalRelaxation, transport-analysis' VelocityAutocorr and MDAnalysis' InterRDF."""
 import numpy as np
@@ -11,7 +11,7 @@ from MDAnalysis.coordinates.memory import MemoryReader  # noqa: E402
 from openmm_symprk.analysis import reorientation  # noqa: E402
 from openmm_symprk.analysis.angular import angular_velocities  # noqa: E402
 from openmm_symprk.analysis.molecules import centre_of_mass_trajectory  # noqa: E402
-from openmm_symprk.analysis.observe import observables  # noqa: E402
+from openmm_symprk.studies.fidelity.observables import observables  # noqa: E402
 from openmm_symprk.analysis.universe import (AngularVelocityCorrelation, KineticTemperatures,  # noqa: E402
                                              RadialDistribution, Reorientation, SelfDiffusion, find_waters)
 from openmm_symprk.physics.temperature import kinetic_temperatures  # noqa: E402

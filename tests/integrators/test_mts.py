@@ -132,11 +132,11 @@ def test_split_forces_and_group_checks(water8):
 
 
 def test_split_forces_puts_pme_reciprocal_space_in_the_slow_group():
-    from openmm_symprk.studies.native_speed import water_box_system
+    from openmm_symprk.systems.scenes import water_box
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        _, system, _, _ = water_box_system(2.0)
+        system, _, _ = water_box("tip3p", box_nm=2.0, cutoff_nm=0.9)
     groups = split_forces(system, slow="reciprocal", substeps=2)
     nb = next(f for f in system.getForces() if isinstance(f, mm.NonbondedForce))
     assert groups == [(1, 1), (0, 2)] and nb.getReciprocalSpaceForceGroup() == 1 and nb.getForceGroup() == 0

@@ -1,6 +1,6 @@
 """The CUDA kernel library: built, exporting OpenMM's plugin entry points, and linkable against OpenMM's CUDA
 platform from PyPI (``pip install "openmm_symprk[cuda12]"``).  Read from the ELF symbol tables (pyelftools),
-so no GPU, driver or binutils are needed; running on CUDA is ``symprk gpucheck`` (openmm_symprk.studies.gpucheck)."""
+so no GPU, driver or binutils are needed; running on CUDA is ``symprk gpucheck`` (openmm_symprk.studies.platforms.gpucheck)."""
 import os
 import sysconfig
 

@@ -8,7 +8,7 @@ import os
 import pytest
 
 from openmm_symprk.studies.bench import presets, stability
-from openmm_symprk.systems.scenes import named as scenes
+from openmm_symprk.studies.core import scenes
 from openmm_symprk.studies.bench.runs import RunSpec, execute
 from openmm_symprk.studies.bench.sweep import SweepExistsError, run_sweep
 from openmm_symprk.methods.catalogue import methods
@@ -28,7 +28,10 @@ def _small_config():
 
 
 def test_quick_pipeline_end_to_end_and_resume(tmp_path):
-    from openmm_symprk.studies.bench.cli import main
+    from openmm_symprk.cli import main as symprk
+
+    def main(argv):
+        return symprk(["bench", *argv])
 
     out = str(tmp_path / "quick")
     assert main(["--quick", "--out", out, "--workers", "2", "--no-progress"]) == 0
@@ -116,16 +119,16 @@ def test_harmonic_stability_reproduces_catalogue_intervals():
 
 def test_failing_runs_are_recorded_not_raised():
     flex = scenes.build("water-flexible", n_waters=4)
-    rec, _ = execute(RunSpec("water-flexible", "verlet", 8.0, 200, 10, timing_s=0.01), flex)
+    rec, _ = execute(RunSpec("water-flexible", "verlet 8 fs", 200, 10, timing_s=0.01), flex)
     assert rec.status == "failed" and rec.failed and rec.blew_up
     assert rec.failure.startswith(("blow-up", "energy"))
     assert rec.traj_error is None and rec.wall_per_ps is None
-    rec, _ = execute(RunSpec("water-flexible", "openmm-verlet", 8.0, 200, 10), flex)
+    rec, _ = execute(RunSpec("water-flexible", "openmm-verlet 8 fs", 200, 10), flex)
     assert rec.status == "failed"
     rigid = scenes.build("water-rigid", n_waters=4)
-    rec, _ = execute(RunSpec("water-rigid", "gauss-2", 1.0, 10, 2), rigid)
+    rec, _ = execute(RunSpec("water-rigid", "gauss-2 1 fs", 10, 2), rigid)
     assert rec.status == "unsupported" and "constraints" in rec.failure
-    rec, _ = execute(RunSpec("water-rigid", "no-such-method", 1.0, 10, 2), rigid)
+    rec, _ = execute(RunSpec("water-rigid", "no-such-method 1 fs", 10, 2), rigid)
     assert rec.status == "error" and "no-such-method" in rec.failure
     # a stability search on a scene where everything fails at the first probe still returns a result
     res = stability.largest_stable_step(flex, "verlet", {"h0_fs": 8.0, "cap_fs": 16.0, "grow": 2.0,
@@ -208,12 +211,14 @@ def test_production_scene_measures_drift_fluctuation_and_speed_against_a_baselin
 
 
 def test_run_keys_of_stored_sweeps_do_not_change():
-    """``--resume`` finds a sweep's stored runs by their keys (spec and scene fingerprint): this is the key the
-    bench has used since schema 3, so a stored sweep can be summarised again with the current estimators."""
-    from openmm_symprk.studies.bench.store import run_key
+    """``--resume`` finds a sweep's stored runs by their keys (the row's label, the rest of the spec, the scene's
+    fingerprint); the key the bench used from schema 3 until runs were keyed by their rows' labels is the spec's
+    legacy key, under which a sweep stored then is found."""
+    from openmm_symprk.studies.bench.store import legacy_key, run_key
 
-    spec = RunSpec("villin-pme", "verlet", 2.0, 12000, 240, "run", timing_s=4.0, threads=2)
-    assert run_key(spec.to_dict(), "0123456789abcdef") == "2fb18ad1d6637b608fd2"
+    spec = RunSpec("villin-pme", "verlet 2 fs", 12000, 240, "run", timing_s=4.0, threads=2)
+    assert legacy_key(spec, "0123456789abcdef") == "2fb18ad1d6637b608fd2"
+    assert run_key(spec, "0123456789abcdef") == "ef6722c8b8739bc91c96"
 
 
 def test_stored_production_runs_are_summarised_with_the_current_estimator():
@@ -241,3 +246,19 @@ def test_stored_production_runs_are_summarised_with_the_current_estimator():
         d = drift(r["trace_t"], r["trace_de_per_dof"])
         assert row["drift"] == pytest.approx(d.slope * 1e3 / kT) and row["drift_err"] == pytest.approx(d.se * 1e3 / kT)
     assert rows[0]["matches"] and not rows[1]["matches"]  # 2e-5 kJ/mol/ps/DOF = 8e-3 kT/ns/DOF, many SE
+
+
+def test_runs_stored_before_rows_were_labels_keep_their_keys():
+    """A run is keyed by its row's label; the key the bench used before (its spec with the bench's name of the row
+    and the step apart) is the legacy key, so a sweep stored then is resumed, not rerun."""
+    from openmm_symprk.studies.bench.store import legacy_key, run_key
+    from openmm_symprk.studies.bench.runs import bench_row
+    from openmm_symprk.support.files import content_key
+
+    scene = scenes.build("harmonic", n=8)
+    fp = scene.payload()["fingerprint"]
+    for name, h in (("openmm-langevin", 2.0), ("omelyan-2/verlet@mts2", 4.0), ("verlet", 300.0 / 1234)):
+        spec = RunSpec("harmonic", bench_row(name, h, scene).label, 100, 10, timing_s=0.5)
+        old = {"scene": "harmonic", "method": name, "step_fs": h, "n_steps": 100, "n_samples": 10, "role": "run",
+               "platform": None, "timing_s": 0.5, "threads": 1, "seed": 1}
+        assert legacy_key(spec, fp) == content_key({"spec": old, "scene": fp}, length=20) != run_key(spec, fp)

@@ -132,10 +132,37 @@ def test_console_script_is_installed():
 
 
 def test_gpucheck_says_why_it_cannot_run_without_cuda(capsys):
-    from openmm_symprk.studies.gpucheck import cuda_unavailable_reason
+    from openmm_symprk.studies.platforms.gpucheck import cuda_unavailable_reason
 
     if not cuda_unavailable_reason():
         pytest.skip("a CUDA platform with the native kernel is here: run `symprk gpucheck` itself")
-    assert main(["gpucheck", "--quick"]) == 1
+    assert main(["gpucheck", "--quick"]) == 2
     err = capsys.readouterr().err
-    assert err.startswith("symprk gpucheck: ") and ("CUDA platform" in err or "CUDA kernel" in err)
+    assert err.startswith("symprk gpucheck: error: ") and ("CUDA platform" in err or "CUDA kernel" in err)
+    assert len(err.strip().splitlines()) == 1
+
+
+def test_every_sub_command_runs_in_the_one_frame():
+    """Each sub-command is a parser and an action, run by ``symprk``'s one frame: none has a ``main`` of its own that
+    could answer errors its own way."""
+    import importlib
+
+    from openmm_symprk.cli import COMMANDS
+
+    for name, cmd in COMMANDS.items():
+        module = importlib.import_module(cmd.module)
+        assert callable(module.run) and module.build_parser(f"symprk {name}").prog == f"symprk {name}", name
+        assert module.__name__ == "openmm_symprk.cli" or not hasattr(module, "main"), name
+
+
+def test_a_bug_keeps_its_traceback(monkeypatch, capsys):
+    """A user's mistake is one line and status 2; an exception that is not one (here a KeyError) is a bug: raised."""
+    from openmm_symprk import cli
+
+    def broken(args):
+        raise KeyError("a bug")
+
+    monkeypatch.setattr(cli, "_methods", broken)
+    with pytest.raises(KeyError, match="a bug"):
+        main(["methods"])
+    assert capsys.readouterr().err == ""

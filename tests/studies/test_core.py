@@ -7,7 +7,8 @@ import numpy as np
 import pytest
 
 from openmm_symprk.stats import paired, series_stats
-from openmm_symprk.studies.core import FolderLock, FolderLockedError, Run, RunStore, Study, run_key, write_json
+from openmm_symprk.studies.core import FolderLock, FolderLockedError, Run, RunStore, Study, write_json
+from openmm_symprk.support.files import content_key as run_key
 
 
 def toy_work(shared, row, replica):
@@ -23,13 +24,15 @@ class ToyStudy(Study):
     command = "symprk toy"
     work = toy_work
 
-    def __init__(self, out, rows, replicas=4, **kw):
+    def __init__(self, out, rows, replicas=4, legacy=False, **kw):
         super().__init__(out, progress=False, log=lambda *a: None, **kw)
-        self.rows, self.replicas, self.calls = rows, replicas, 0
+        self.rows, self.replicas, self.calls, self.legacy = rows, replicas, 0, legacy
 
     def plan(self):
-        return [Run(run_key({"row": row, "replica": r}), "toy", (row, r), {"row": row, "replica": r}, cost=r)
-                for row in self.rows for r in range(self.replicas)]
+        """Runs keyed by {row, replica}; ``legacy``: keyed by {row, replica, "form": 2}, the former key legacy."""
+        return [Run(run_key({"row": row, "replica": r, **({"form": 2} if self.legacy else {})}), "toy", (row, r),
+                    {"row": row, "replica": r}, cost=r, legacy=run_key({"row": row, "replica": r}) if self.legacy
+                    else None) for row in self.rows for r in range(self.replicas)]
 
     def shared(self, runs):
         self.calls += len(runs)
@@ -99,6 +102,24 @@ def test_report_only_summarises_what_is_stored_runs_nothing_and_ignores_the_lock
     assert logged == ["report only: 6 of 10 planned runs are not finished and are left out"]
     with pytest.raises(ValueError, match="none of the 4 planned runs is stored"):
         ToyStudy(out, ["a", "c"], replicas=2).run(report_only=True)
+
+
+def test_runs_stored_under_a_legacy_key_are_found_not_rerun(tmp_path):
+    """A study whose keys changed form finds the runs stored under the former keys (Run.legacy): reused by a run,
+    summarised by a report-only; only the runs missing under both keys run, stored under the new key."""
+    out = str(tmp_path / "toy")
+    first = ToyStudy(out, ["ref", "b"], replicas=2).run()
+    old = RunStore(out).keys()
+    study = ToyStudy(out, ["ref", "b"], replicas=3, legacy=True)
+    again = study.run()
+    assert study.calls == 2  # replica 2 of each row: the only runs stored under neither key
+    kept = RunStore(out).keys()
+    assert old <= kept and len(kept) == 6  # the four under their legacy keys, two under the new form
+    assert set(study.store.aliases.values()) == old
+    report = ToyStudy(out, ["ref", "b"], replicas=3, legacy=True)
+    res = report.run(report_only=True)
+    assert report.calls == 0 and res["b"].replicas == again["b"].replicas == 3 and first["b"].replicas == 2
+    assert res["b"].mean == pytest.approx(again["b"].mean)
 
 
 def test_json_is_written_atomically_and_plainly(tmp_path):

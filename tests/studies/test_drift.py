@@ -7,12 +7,16 @@ import numpy as np
 import pytest
 
 from openmm_symprk.studies.drift import presets
-from openmm_symprk.studies.drift.cli import main
+from openmm_symprk.cli import main as symprk
 from openmm_symprk.studies.drift.report import format_summary
 from openmm_symprk.studies.drift.study import run_study
 from openmm_symprk.physics.temperature import R_KJ
 from openmm_symprk.studies.drift.verdict import (claim_verdict, cost_verdict, magnitude, ratio, row_estimate,
                                                  run_drift)
+
+
+def main(argv):
+    return symprk(["drift", *argv])
 
 
 # -- the verdict on synthetic drifts -----------------------------------------------------------------------------
@@ -79,9 +83,9 @@ def hmr(tmp_path_factory):
 
 
 def _states(out, scene):
-    from openmm_symprk.studies.drift.study import scene_state_key
+    from openmm_symprk.studies.drift.study import states_key
 
-    with np.load(os.path.join(out, "states", f"{scene}-{scene_state_key(presets.hmr(quick=True), scene)}.npz")) as d:
+    with np.load(os.path.join(out, "states", f"{scene}-{states_key(presets.hmr(quick=True), scene)}.npz")) as d:
         return d["x"], d["v"]
 
 
@@ -116,7 +120,7 @@ def test_replicas_are_independent(hmr):
     drifts = [d[0] for d in summary["rows"][0]["per_replica"].values()]
     assert len(set(drifts)) == 3
     # the HMR scene has heavier hydrogens than the plain one
-    from openmm_symprk.systems.scenes.named import build
+    from openmm_symprk.studies.core.scenes import build
 
     plain, heavy = build("villin-vacuum").system, build("villin-vacuum-hmr").system
     m = [plain.getParticleMass(i)._value for i in range(plain.getNumParticles())]
@@ -169,21 +173,32 @@ def test_cli_errors_name_the_bad_value(tmp_path, capsys):
         main(["energy"])
 
 
-def test_runs_stored_by_earlier_versions_keep_their_keys():
-    """Rows are Row labels now; a run's key still hashes the fields of the earlier rows (integrator, step_fs,
-    exact_momentum), so the runs stored before are found again, and a row that says more (a thermostat) gets a key
-    of its own."""
-    from openmm_symprk.studies.core import run_key as hash_key
-    from openmm_symprk.studies.drift.study import _RUN_KEYS, run_key, scene_state_key
+def test_runs_stored_by_earlier_versions_are_found_by_their_legacy_keys(tmp_path):
+    """Rows are keyed by their labels now; a run's legacy key is the one earlier versions stored it under (the row as
+    integrator, step_fs, platform, precision and exact_momentum, and its label only where it says more), so those
+    runs are found again, and every row has a key of its own."""
+    from openmm_symprk.support.files import content_key
+    from openmm_symprk.studies.core import RunStore
+    from openmm_symprk.studies.drift.study import _RUN_KEYS, DriftStudy, legacy_key, run_key, states_key
 
-    cfg = presets.exact_momentum(quick=True, platforms=("CPU",))
-    for new, exact in zip(cfg["rows"], (False, True)):
-        old = {"name": new["name"], "scene": "villin-vacuum", "integrator": "verlet", "step_fs": 2.0, "platform": "CPU",
-               "precision": None, "exact_momentum": exact}
-        expected = hash_key({"cfg": {k: cfg[k] for k in _RUN_KEYS}, "row": {k: old[k] for k in (
-            "scene", "integrator", "step_fs", "platform", "precision", "exact_momentum")}, "replica": 1,
-            "states": scene_state_key(cfg, "villin-vacuum"), "version": 1})
-        assert run_key(cfg, new, 1) == run_key(cfg, old, 1) == expected
+    cfg = presets.exact_momentum(quick=True, platforms=("CPU", "OpenCL:mixed"))
+    for row, (platform, precision, exact) in zip(cfg["rows"], [("CPU", None, False), ("CPU", None, True),
+                                                                ("OpenCL", "mixed", False), ("OpenCL", "mixed", True)]):
+        old = {"scene": "villin-vacuum", "integrator": "verlet", "step_fs": 2.0, "platform": platform,
+               "precision": precision, "exact_momentum": exact}
+        expected = content_key({"cfg": {k: cfg[k] for k in _RUN_KEYS}, "row": old, "replica": 1,
+                                "states": states_key(cfg, "villin-vacuum"), "version": 1})
+        assert legacy_key(cfg, row, 1) == expected != run_key(cfg, row, 1)
     nvt = presets.nvt(quick=True)
-    keys = {run_key(nvt, row, 0) for row in nvt["rows"]}
-    assert len(keys) == len(nvt["rows"])
+    keys = {run_key(nvt, row, 0) for row in nvt["rows"]} | {legacy_key(nvt, row, 0) for row in nvt["rows"]}
+    assert len(keys) == 2 * len(nvt["rows"])
+    # a run stored under its legacy key is reported, not run again
+    cfg = presets.exact_momentum(quick=True, platforms=("CPU",))
+    cfg["replicas"] = 1
+    study = DriftStudy(cfg, str(tmp_path), progress=False, log=lambda *a: None)
+    row = cfg["rows"][0]
+    RunStore(str(tmp_path)).put(legacy_key(cfg, row, 0), {"status": "ok", "n_dof": 10, "wall_per_ps": 1.0,
+                                                           "row": row["name"], "replica": 0},
+                                {"t": np.arange(4.0), "e": np.array([0.0, 1.0, 2.0, 3.1])})
+    summary = study.run(report_only=True)
+    assert [r["replicas_done"] for r in summary["rows"]] == [1, 0]

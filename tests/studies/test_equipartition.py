@@ -5,15 +5,19 @@ import os
 import pytest
 
 from openmm_symprk.studies.equipartition import presets, run_study
-from openmm_symprk.studies.equipartition.cli import main
+from openmm_symprk.cli import main as symprk
+from openmm_symprk.studies.core.rows import Row
 from openmm_symprk.studies.equipartition.report import format_summary
-from openmm_symprk.studies.equipartition.runs import steps_per_sample
+
+
+def main(argv):
+    return symprk(["equipartition", *argv])
 
 
 def _tiny():
     cfg = presets.quick()
     cfg.update(replicas=2, length_ps=0.06, settle_ps=0.012, equilibrate_ps=0.2, spacing_ps=0.05)
-    cfg["models"] = {"spce": [["verlet", 0.5], ["verlet", 2.0], ["rigid:verlet", 2.0]]}
+    cfg["models"] = {"spce": ["verlet 0.5 fs", "verlet 2 fs", "rigid:verlet 2 fs"]}
     return cfg
 
 
@@ -82,17 +86,18 @@ def test_a_changed_setting_does_not_reuse_runs():
     cfg = _tiny()
     other = copy.deepcopy(cfg)
     other["length_ps"] = 0.1
-    assert run_key(cfg, "spce", "verlet", 2.0, 0) != run_key(other, "spce", "verlet", 2.0, 0)
-    assert run_key(cfg, "spce", "verlet", 2.0, 0) != run_key(cfg, "spce", "verlet", 2.0, 1)
+    assert run_key(cfg, "spce", "verlet 2 fs", 0) != run_key(other, "spce", "verlet 2 fs", 0)
+    assert run_key(cfg, "spce", "verlet 2 fs", 0) != run_key(cfg, "spce", "verlet 2 fs", 1)
+    assert run_key(cfg, "spce", "verlet 2 fs", 0) == run_key(cfg, "spce", "verlet:2", 0)  # one row, two spellings
 
 
 def test_samples_fall_on_steps():
-    assert [steps_per_sample(h, 24.0) for h in (0.5, 1.0, 2.0, 3.0, 4.0)] == [48, 24, 12, 8, 6]
+    assert [Row("verlet", h).steps_for(24.0) for h in (0.5, 1.0, 2.0, 3.0, 4.0)] == [48, 24, 12, 8, 6]
 
 
 def test_bad_settings_are_refused(tmp_path, capsys):
     cfg = _tiny()
-    cfg["models"]["spce"] = [["verlet", 2.0]]
+    cfg["models"]["spce"] = ["verlet 2 fs"]
     with pytest.raises(ValueError, match="reference row"):
         run_study(cfg, str(tmp_path), workers=1, progress=False)
     assert main(["--quick", "--rows", "verlt:2", "--out", str(tmp_path)]) == 2
@@ -111,7 +116,7 @@ def test_runs_on_a_dask_cluster(tmp_path):
     distributed = pytest.importorskip("dask.distributed")
     cfg = copy.deepcopy(presets.quick())
     cfg.update(replicas=1, length_ps=0.05)
-    cfg["models"] = {"spce": [["verlet", 0.5], ["omelyan-2", 4.0]]}
+    cfg["models"] = {"spce": ["verlet 0.5 fs", "omelyan-2 4 fs"]}
     with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=False,
                                   dashboard_address=None) as cluster:
         summary = run_study(cfg, str(tmp_path / "dask"), timing=False, progress=False, log=lambda *a: None,
@@ -122,8 +127,28 @@ def test_runs_on_a_dask_cluster(tmp_path):
 
 def test_run_keys_of_stored_studies_do_not_change():
     """A study's stored runs are found by their keys: a change of the key (or of what it hashes) orphans every
-    stored run, so a re-summary would rerun them all.  This is the key the study has used since run version 3
-    (the box at 0.997 g/cm^3 and replica states with zero total momentum; version 2's was 6ad2710190f9cc83)."""
-    from openmm_symprk.studies.equipartition.study import run_key
+    stored run, so a re-summary would rerun them all.  Runs are keyed by their rows' labels; the key the study used
+    from run version 3 (the box at 0.997 g/cm^3 and replica states with zero total momentum) to then, with the row as
+    [method, step], is its legacy key (version 2's was 6ad2710190f9cc83)."""
+    from openmm_symprk.studies.equipartition.study import legacy_key, run_key
 
-    assert run_key(presets.full(), "spce", "omelyan-2", 4.0, 3) == "3a5f658bbb3391cd"
+    assert legacy_key(presets.full(), "spce", "omelyan-2 4 fs", 3) == "3a5f658bbb3391cd"
+    assert run_key(presets.full(), "spce", "omelyan-2 4 fs", 3) == "404c7b31362732c3"
+
+
+def test_runs_stored_under_the_legacy_key_are_found(tmp_path):
+    """A run stored before rows were keyed by their labels (its info naming method and step) is read back as its
+    row's run; one of other settings is not."""
+    import numpy as np
+
+    from openmm_symprk.studies.core import RunStore
+    from openmm_symprk.studies.equipartition.study import legacy_key, load_runs
+
+    cfg, store = _tiny(), RunStore(str(tmp_path))
+    arrays = {k: np.arange(3.0) for k in ("t", "T_trans", "T_rot", "pe", "etot")}
+    info = {"model": "spce", "method": "verlet", "step_fs": 2.0, "replica": 1, "status": "ok"}
+    store.put(legacy_key(cfg, "spce", "verlet 2 fs", 1), info, arrays)
+    other = dict(cfg, length_ps=1.0)
+    store.put(legacy_key(other, "spce", "verlet 2 fs", 0), dict(info, replica=0), arrays)
+    found = load_runs(cfg, str(tmp_path))
+    assert [i["replica"] for _, i in found[("spce", "verlet 2 fs")]] == [1] and not found[("spce", "verlet 0.5 fs")]

@@ -14,12 +14,12 @@ def test_rows_are_compared_replica_by_replica():
 
     rng = np.random.default_rng(7)
     cfg = presets.quick()
-    cfg["models"] = {"spce": [["verlet", 0.5], ["verlet", 3.0], ["omelyan-2", 4.0]]}
-    shift = {("verlet", 0.5): 0.0, ("verlet", 3.0): 0.05, ("omelyan-2", 4.0): 0.0}
+    shift = {"verlet 0.5 fs": 0.0, "verlet 3 fs": 0.05, "omelyan-2 4 fs": 0.0}
+    cfg["models"] = {"spce": list(shift)}
     offsets = rng.normal(scale=0.3, size=8)  # per replica, kJ/mol per molecule
     t = np.arange(400) * 0.024
     runs = {}
-    for (method, h), d in shift.items():
+    for label, d in shift.items():
         reps = []
         for r, off in enumerate(offsets):
             pe = (-45.5 + off + d + rng.normal(scale=0.02, size=t.size)) * cfg["n_waters"]
@@ -27,7 +27,7 @@ def test_rows_are_compared_replica_by_replica():
             arrays = {"t": t, "T_trans": tt, "T_rot": tt + rng.normal(scale=5, size=t.size), "pe": pe,
                       "etot": np.full(t.size, -1e4) + rng.normal(scale=1.0, size=t.size)}
             reps.append((arrays, {"status": "ok", "replica": r}))
-        runs[("spce", method, float(h))] = reps
+        runs[("spce", label)] = reps
     rows = {r["label"]: r for r in summarise(cfg, runs)["models"]["spce"]["rows"]}
     far, near = rows["verlet 3 fs"], rows["omelyan-2 4 fs"]
     assert far["vs_ref"]["pe"]["mean"] == pytest.approx(0.05, abs=0.005)

@@ -4,18 +4,21 @@ import copy
 import glob
 import json
 import os
-import types
 
 import numpy as np
 import pytest
 
 from openmm_symprk.studies.core import jsonable
 from openmm_symprk.studies.fidelity import presets
-from openmm_symprk.studies.fidelity.cli import main
-from openmm_symprk.analysis.observe import OBSERVABLES
+from openmm_symprk.cli import main as symprk
+from openmm_symprk.studies.fidelity.observables import OBSERVABLES
 from openmm_symprk.studies.fidelity.report import K_SE, summarise
-from openmm_symprk.studies.fidelity.rowspec import UNAVAILABLE_THERMOSTAT, check_row, describe, label
+from openmm_symprk.studies.fidelity.rowspec import check_row, describe, label
 from openmm_symprk.studies.fidelity.simulation import run_key, run_study
+
+
+def main(argv):
+    return symprk(["fidelity", *argv])
 
 
 @pytest.fixture(scope="module")
@@ -47,11 +50,7 @@ def test_quick_prints_every_observable_for_every_row(quick):
     rows = {r["label"]: r for r in res["rows"]}
     assert res["reference"] == "verlet 0.5 fs" and rows["verlet 0.5 fs"]["wall_vs_ref"] == 1.0
     for lab, r in rows.items():
-        thermostat = "SVR" in lab
-        if r["status"] != "ok":  # only the package's thermostat rows may be unavailable, and only for that reason
-            assert thermostat and r["status"].startswith(UNAVAILABLE_THERMOSTAT), (lab, r["status"])
-            continue
-        assert r["replicas"] == 2 and not r["failed"], lab
+        assert r["status"] == "ok" and r["replicas"] == 2 and not r["failed"], lab
         for key in ("D", "tau2_dip", "tau2_hh", "w_zero", "w_min", "pe", "dT", "g_r", "g_h"):
             assert r["values"][key] is not None and r["values"][key]["se"] > 0, (lab, key)
         assert 1.0 < r["values"]["D"]["mean"] < 15.0 and 0.26 < r["values"]["g_r"]["mean"] < 0.30
@@ -84,7 +83,7 @@ def test_the_equipartition_view_is_made_from_the_same_runs(quick):
 
 
 def test_replica_states_are_at_the_stated_density_with_zero_momentum(quick):
-    from openmm_symprk.studies.equipartition.runs import build_box
+    from openmm_symprk.studies.core.replicas import water_box_scene as build_box
 
     _, out, _ = quick
     cfg = presets.quick()
@@ -105,9 +104,9 @@ def test_a_second_call_reuses_every_run(quick):
     _, out, _ = quick
     logs = []
     again = run_study(presets.quick(), out, workers=1, timing=False, progress=False, log=logs.append)
-    n = sum(1 for r in presets.quick()["rows"] if "SVR" not in r) * presets.quick()["replicas"]
-    available = sum(r["replicas"] for r in again["rows"])
-    assert available >= n and any(f"reusing {available} finished runs" in line for line in logs), logs
+    n = len(presets.quick()["rows"]) * presets.quick()["replicas"]
+    assert sum(r["replicas"] for r in again["rows"]) == n and any(f"reusing {n} finished runs" in line
+                                                                   for line in logs), logs
     with open(os.path.join(out, "results.json")) as fh:
         first = {r["label"]: r.get("values") for r in json.load(fh)["rows"]}
     assert {r["label"]: r.get("values") for r in jsonable(again)["rows"]} == first  # the same runs, summarised again
@@ -129,47 +128,6 @@ def test_an_interrupted_study_runs_only_what_is_missing(quick, tmp_path):
     stored = sum(r["replicas"] for r in summary["rows"])
     assert any(f"reusing {stored - 1} finished runs" in line for line in logs), logs
     assert os.path.exists(lost) and len(glob.glob(os.path.join(copy_, "runs", "*.json"))) == stored
-
-
-def test_an_unavailable_thermostat_row_is_reported_not_run(tmp_path, monkeypatch):
-    """A SymplecticIntegrator without the thermostat (TypeError on temperature=): the row is planned no run,
-    stored nowhere and reported 'unavailable: needs the thermostat'; the other rows run."""
-    import openmm_symprk.integrators as integrators
-
-    real = integrators.SymplecticIntegrator
-
-    def without_thermostat(*args, temperature=None, collision_time=None, random_seed=None, **kwargs):
-        if temperature is not None:
-            raise TypeError("__init__() got an unexpected keyword argument 'temperature'")
-        return real(*args, **kwargs)
-
-    monkeypatch.setattr(integrators, "SymplecticIntegrator", without_thermostat)
-    cfg = presets.quick()
-    cfg.update(replicas=1, length_ps=0.24, omega_ps=0.06, omega_max_lag_ps=0.03, msd_window_ps=[0.04, 0.1])
-    cfg["rows"], cfg["references"] = ["verlet 2 fs", "verlet 2 fs SVR 0.1 ps"], {"NVE": "verlet 2 fs"}
-    logs = []
-    summary = run_study(cfg, str(tmp_path), workers=1, timing=False, progress=False, log=logs.append)
-    ref, svr = summary["rows"]
-    assert ref["status"] == "ok" and ref["replicas"] == 1
-    assert svr["status"].startswith(UNAVAILABLE_THERMOSTAT) and svr["replicas"] == 0
-    assert len(glob.glob(str(tmp_path / "runs" / "*.json"))) == 1
-    assert any("verlet 2 fs SVR 0.1 ps: unavailable: needs the thermostat" in line for line in logs)
-    from openmm_symprk.studies.fidelity.report import format_summary
-
-    assert "verlet 2 fs SVR 0.1 ps               unavailable: needs the thermostat" in format_summary(summary)
-
-
-def test_an_unrelated_integrator_error_is_not_hidden(monkeypatch):
-    import openmm_symprk.integrators as integrators
-    from openmm_symprk.studies.fidelity.simulation.engines import availability
-
-    def broken(*args, **kwargs):
-        raise ValueError("stepSize must be positive")
-
-    monkeypatch.setattr(integrators, "SymplecticIntegrator", broken)
-    row = check_row("verlet 2 fs SVR 1 ps")
-    with pytest.raises(ValueError, match="stepSize"):
-        availability(row, types.SimpleNamespace(system=None), 300.0)
 
 
 # -- the summary on synthetic replicas ---------------------------------------------------------------------------
@@ -473,3 +431,31 @@ def test_report_only_remakes_the_summary_from_the_committed_json_alone(quick, tm
     resumed = run_study(presets.quick(), str(kept), workers=1, timing=False, progress=False, log=logs.append)
     n = sum(r["replicas"] for r in resumed["rows"])
     assert n and any(f"reusing {n} finished runs" in line for line in logs) and format_summary(resumed) + "\n" == first
+
+
+def test_the_committed_results_load_and_report_as_committed(tmp_path, monkeypatch, capsys):
+    """docs/fidelity.md's report-only commands on a copy of the committed data (docs/data/fidelity/<model>: states,
+    each run's JSON, timings.json) print summary.txt and table.md byte for byte as committed: every stored run is
+    found under its key, and the report of them is unchanged (the charts are left out here, for time)."""
+    import re
+    import shlex
+    import shutil
+
+    from openmm_symprk.studies.fidelity import report
+
+    docs = os.path.join(os.path.dirname(__file__), "..", "..", "docs")
+    with open(os.path.join(docs, "fidelity.md")) as fh:
+        commands = dict.fromkeys(re.findall(r"^symprk fidelity (--out docs/data/fidelity/\S+ .*--report-only)",
+                                            fh.read(), re.M))
+    assert {c.split()[1] for c in commands} == {"docs/data/fidelity/spce", "docs/data/fidelity/tip3p"}, commands
+    monkeypatch.setattr(report, "chart", lambda *a, **k: None)
+    for command in commands:
+        argv = shlex.split(command.split("#")[0])
+        committed = os.path.join(docs, "..", argv[1])
+        copy_ = str(tmp_path / os.path.basename(argv[1]))
+        shutil.copytree(committed, copy_)
+        assert main(["--no-progress", *argv[2:], "--out", copy_]) == 0
+        for name in ("summary.txt", "table.md"):
+            with open(os.path.join(committed, name), "rb") as a, open(os.path.join(copy_, name), "rb") as b:
+                assert a.read() == b.read(), (command, name)
+    assert "report only" not in capsys.readouterr().err

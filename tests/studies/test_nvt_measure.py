@@ -22,7 +22,7 @@ def test_every_cost_row_builds_its_integrator():
     expected = {"LangevinMiddle": (mm.LangevinMiddleIntegrator, 1), "NoseHoover (chain 3)": (mm.NoseHooverIntegrator, 1),
                 "DPD": (mm.DPDIntegrator, 1), "MTSLangevin 1x1+0x2": (mm.MTSLangevinIntegrator, 3),
                 "OpenMM Verlet (NVE)": (mm.VerletIntegrator, 1), "omelyan-2 + thermostat": (None, 2)}
-    found = {name: row for name, row, _ in cost.default_rows()}
+    found = {name: row for name, row, _ in rows.cost_rows()}
     for name, (cls, evals) in expected.items():
         row = found[name]
         if cls is not None:
@@ -38,7 +38,7 @@ def test_every_cost_row_builds_its_integrator():
 def test_cost_quick_measures_every_row(capsys):
     out = cost.run(scenes=("water",), quick=True, steps=2, rounds=3)
     table = out["water"]
-    names = [name for name, _, _ in cost.default_rows()]
+    names = [name for name, _, _ in rows.cost_rows()]
     assert [r["row"] for r in table] == names
     for r in table:
         assert r["s_per_step"] > 0 and math.isfinite(r["ratio"]) and r["ratio"] > 0, r
@@ -55,7 +55,7 @@ def test_cost_quick_measures_every_row(capsys):
 
 
 def test_interleaved_keeps_every_block():
-    from openmm_symprk.studies.timing import interleaved
+    from openmm_symprk.studies.core.timing import interleaved
 
     done = []
     out = interleaved({"a": done.append, "b": done.append}, {"a": 2, "b": 3}, rounds=4)

@@ -1,12 +1,13 @@
 """The studies' one row type: labels read back to the same row, the earlier grammars map onto it, bad labels are
 refused naming the bad part, evaluations come from the resolved method, and each row builds its integrator."""
+import warnings
+
 import numpy as np
 import openmm as mm
 import openmm.unit as unit
 import pytest
 
 from openmm_symprk.integrators import SymplecticIntegrator
-from openmm_symprk.integrators.options import NATIVE_OPTIONS
 from openmm_symprk.methods.resolved import resolve
 from openmm_symprk.studies.core.rows import Row, split_groups
 
@@ -118,10 +119,6 @@ def test_a_row_without_a_position_word_runs_the_ends():
     """Stored results of rows without a position word were run with the ends placement: such a row still runs
     the ends, though the integrator's default ("auto") puts verlet's thermostat in the middle."""
     system = _system()
-    if "thermostat_position" not in NATIVE_OPTIONS:
-        with pytest.raises(TypeError, match="thermostat_position"):
-            Row.parse("verlet 2 fs SVR 0.1 ps middle").build(system)
-        pytest.skip("SymplecticIntegrator has no thermostat_position yet")
     ig = Row.parse("verlet 2 fs SVR 0.1 ps middle custom").build(system)
     assert ig.options.thermostat.position == "middle"
     assert Row.parse("verlet 2 fs SVR 0.1 ps custom").build(system).thermostat_position == "ends"
@@ -130,14 +127,38 @@ def test_a_row_without_a_position_word_runs_the_ends():
 
 
 def test_leapfrog_state_lags_half_a_step():
-    """A leapfrog row starts from v(-h/2) = v - (h/2) F/m; an on-step row from v itself."""
+    """The engine starts a leapfrog row from v(-h/2) = v - (h/2) F/m, an on-step row from v itself, and a leapfrog
+    row with start=False from v as given."""
+    from openmm_symprk.studies.core.engine import RowEngine
+
     system = _system()
     x = np.array([[0.1, 0.0, 0.0], [0.0, 0.2, 0.0], [0.0, 0.0, -0.1], [0.05, 0.05, 0.0]])
     v = np.ones((4, 3))
-    for label, lag in (("openmm-verlet 2 fs", True), ("verlet 2 fs", False)):
+    for label, lag, start in (("openmm-verlet 2 fs", True, True), ("langevin 2 fs", True, True),
+                              ("verlet 2 fs", False, True), ("openmm-verlet 2 fs", False, False)):
         row = Row.parse(label)
-        ctx = mm.Context(system, row.build(system), mm.Platform.getPlatformByName("Reference"))
-        row.set_state(ctx, x, v)
-        got = ctx.getState(getVelocities=True).getVelocities(asNumpy=True).value_in_unit(unit.nanometer / unit.picosecond)
+        got = RowEngine(row, system, x, v, platform="Reference", start=start).sample(energy=False).v
         expect = v + 0.5 * row.h_ps * 100.0 * x / 2.0 if lag else v
         np.testing.assert_allclose(got, expect, rtol=1e-12)
+
+
+def test_numbers_in_a_label_read_back_exactly():
+    """A bisected or divided step (the bench's stability probes and reference runs) is written with every digit."""
+    row = Row("verlet", 300.0 / 1234)
+    assert Row.parse(row.label) == row and Row.parse("verlet 0.5 fs").label == "verlet 0.5 fs"
+
+
+def test_the_grammar_names_the_placements_and_the_rows_default():
+    """A bad position word is refused naming the placements (methods.placement.POSITIONS) and what a row without
+    one runs: the ends, which is not SymplecticIntegrator's default."""
+    from openmm_symprk.methods.placement import POSITIONS
+    from openmm_symprk.studies.core.rows import ROW_POSITION
+
+    with pytest.raises(ValueError, match=f"{' | '.join(POSITIONS)}; none: {ROW_POSITION}"):
+        Row.parse("verlet 2 fs SVR 0.1 ps centre")
+    assert ROW_POSITION == "ends" and Row.parse("verlet 2 fs SVR 0.1 ps").position == ROW_POSITION
+    with warnings.catch_warnings():  # the difference the grammar states: verlet's default is the middle
+        warnings.simplefilter("ignore")  # the harmonic wells' ConservationWarning
+        ig = SymplecticIntegrator(0.002, "verlet", system=_system(), temperature=300.0, backend="custom")
+    assert ig.thermostat_position != ROW_POSITION == Row.parse("verlet 2 fs SVR 0.1 ps custom").build(
+        _system()).thermostat_position

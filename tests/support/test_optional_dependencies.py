@@ -201,7 +201,7 @@ FEATURES = {
     "stability_interval": ("from openmm_symprk.methods.stability import stability_interval\n"
                            "stability_interval('verlet')", "scipy", "analysis"),
     "bench charts": ("import openmm_symprk.studies.bench.charts", "matplotlib", "studies"),
-    "bench toys": ("import openmm_symprk.systems.scenes.toys", "scipy", "studies"),
+    "bench toys": ("import openmm_symprk.studies.core.toys", "scipy", "studies"),
     "equipartition chart": ("from openmm_symprk.studies.equipartition.report import chart\n"
                             "chart({'models': {}}, os.path.join(TMP, 'x.png'))", "matplotlib", "studies"),
     "dask executor": ("from openmm_symprk.studies.core.executors import DaskExecutor\n"

@@ -1,11 +1,11 @@
 """``symprk bench``: speed against accuracy, and where each method stops being stable.
 
-Its scenes are the named scenes of :mod:`openmm_symprk.systems.scenes.named` (analytic toys with exact solutions,
-water, villin, PME boxes, user systems).  Modules: :mod:`.measure` (observables), :mod:`.runs` (one run), :mod:`.stability` (largest
+Its scenes are the named scenes of :mod:`openmm_symprk.studies.core.scenes` (analytic toys with exact solutions,
+water, villin, PME boxes, user systems).  Modules: :mod:`.runs` (one run), :mod:`.stability` (largest
 stable step by bisection), :mod:`.records` and :mod:`.store` (typed records of finished runs on disk),
 :mod:`.presets` (quick and full sweeps), :mod:`.sweep` (scenes x methods x steps in parallel, resumable),
 :mod:`.aggregate` (results and tables), :mod:`.charts` (figures) and :mod:`.cli` (the command line).  The
-folder lock, atomic files, run keys, executors and job loop are the studies' shared skeleton
+rows, the engine that runs them, the folder lock, atomic files, run keys, executors and job loop are the studies' shared skeleton
 (:mod:`openmm_symprk.studies.core`); drifts and their errors come from :mod:`openmm_symprk.stats`.  Python
 use::
 

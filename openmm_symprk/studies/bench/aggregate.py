@@ -7,7 +7,7 @@ OpenMM's VerletIntegrator, the cheapest method per accuracy, and the summary tab
   itself, an upper bound of the reference's own error.
 * ``wall_vs_verlet``: wall time per ps divided by OpenMM VerletIntegrator's at the same step size, i.e.
   the ratio of per-step wall times.  Each run times itself and a VerletIntegrator on the same scene in
-  alternating calls (``wall_vs_verlet_paired``, see :func:`.runs._time`): that is the ratio reported.
+  alternating calls (``wall_vs_verlet_paired``, see :mod:`.runs`): that is the ratio reported.
   Runs without it (older records) fall back to the median per-step time of the ``openmm-verlet`` runs
   of the scene in the same sweep.
 """
@@ -19,9 +19,8 @@ from statistics import median
 
 from ...stats import Estimate, drift, no_larger
 from ..core.units import kt_per_ns_per_dof
-from .measure import rms_deviation
 from .records import SCHEMA_VERSION
-from .runs import label
+from .runs import label, rms_deviation
 
 #: Accuracy targets for "which method is cheapest": RMS trajectory error (nm) ...
 TRAJ_TARGETS = (1e-3, 1e-5, 1e-7)

@@ -15,10 +15,9 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import sys
 
 from ..core import platforms
-from ..core.cli import KEPT, positive, run_command
+from ..core.options import positive
 
 
 def _list(values):
@@ -29,14 +28,6 @@ def _list(values):
     for v in values:
         out += [s for s in v.split(",") if s]
     return out
-
-
-def _check_platform(name):
-    import openmm as mm
-
-    if not platforms.available(name) or ":" in name:
-        names = [mm.Platform.getPlatform(i).getName() for i in range(mm.Platform.getNumPlatforms())]
-        raise ValueError(f"unknown OpenMM platform {name!r}; this installation has {', '.join(names)}")
 
 
 def _check_out(out: str):
@@ -50,11 +41,11 @@ def _check_out(out: str):
         raise ValueError(f"--out {out}: {os.path.abspath(parent or '.')} is not writable")
 
 
-def build_parser() -> argparse.ArgumentParser:
-    from ...systems.scenes.named import SCENES
+def build_parser(prog: str = "symprk bench") -> argparse.ArgumentParser:
+    from ..core.scenes import SCENES
 
     p = argparse.ArgumentParser(
-        prog="symprk bench",
+        prog=prog,
         description="Speed against accuracy: scenes x methods x step sizes from one shared initial state per "
                     "scene; energy, momentum, constraint and trajectory errors; force evaluations and wall time "
                     "per ps; largest stable step by bisection.  Writes results.json, summary.txt and charts.")
@@ -120,7 +111,7 @@ def make_config(args) -> dict:
         if bad:
             raise ValueError(f"--steps-fs must be positive, got {', '.join(f'{h:g}' for h in bad)}")
     if args.platform:
-        _check_platform(args.platform)
+        platforms.check(args.platform)
     cfg = presets.select(base, scenes=scenes, methods=_list(args.methods), steps_fs=steps,
                          length_ps=args.length_ps, stability=not args.no_stability)
     if args.platform:
@@ -131,27 +122,19 @@ def make_config(args) -> dict:
     return cfg
 
 
-def main(argv=None) -> int:
-    args = build_parser().parse_args(argv)
-    out = args.out or os.path.join("bench-results", "quick" if args.quick else
-                                   "production" if args.production else "full")
-    if args.summary:
-        from .aggregate import format_summary
-
-        path = os.path.join(out, "results.json")
-        if not os.path.exists(path):
-            print(f"no results in {out} (run 'symprk bench --out {out}' first)", file=sys.stderr)
-            return 2
-        with open(path) as fh:
-            print(format_summary(json.load(fh)))
-        return 0
-    return run_command("symprk bench", lambda: _sweep(args, out), interrupted=KEPT)
-
-
-def _sweep(args, out: str):
+def run(args):
     from .aggregate import format_summary
     from .sweep import retime_sweep, run_sweep
 
+    out = args.out or os.path.join("bench-results", "quick" if args.quick else
+                                   "production" if args.production else "full")
+    if args.summary:
+        path = os.path.join(out, "results.json")
+        if not os.path.exists(path):
+            raise FileNotFoundError(f"no results in {out} (run 'symprk bench --out {out}' first)")
+        with open(path) as fh:
+            print(format_summary(json.load(fh)))
+        return
     _check_out(out)
     cfg = make_config(args)
     if args.retime:
@@ -163,7 +146,3 @@ def _sweep(args, out: str):
     print(format_summary(results))
     for path in results.get("charts", []):
         print(f"chart: {path}")
-
-
-if __name__ == "__main__":
-    sys.exit(main())

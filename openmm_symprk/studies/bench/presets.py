@@ -143,7 +143,7 @@ def select(config: dict, scenes=None, methods=None, steps_fs=None, length_ps=Non
     if scenes:
         unknown = [s for s in scenes if s not in cfg["scenes"]]
         if unknown:
-            from ...systems.scenes.named import SCENES
+            from ..core.scenes import SCENES
 
             known = dict(full()["scenes"], **production()["scenes"])
             extra = {s: known[s] for s in unknown if s in SCENES}

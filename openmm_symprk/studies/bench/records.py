@@ -1,7 +1,7 @@
 """Typed records of the bench, and the version of their JSON schema.
 
 :class:`RunRecord` is what one run (or stability probe) produces: the :class:`~.runs.RunSpec` that named
-it, then what was measured (units nm, ps, Da, kJ/mol; see :mod:`.runs` for the meaning of each figure).
+it (its row as the bench's name and its step), then what was measured (units nm, ps, Da, kJ/mol; see :mod:`.runs` for the meaning of each figure).
 :class:`StabilityRecord` is what a stability search concludes.  Both are written to disk as JSON objects
 carrying ``"schema": SCHEMA_VERSION``; reading a record of another schema raises :class:`SchemaError`
 (rerun that sweep, or use the package version that wrote it), so stale results are never mixed in.

@@ -1,4 +1,5 @@
-"""One run of the bench: one method at one step size on one scene, from the scene's shared state.
+"""One run of the bench: one row (a :class:`~..core.rows.Row` label: method and step) on one scene, from the scene's
+shared state.
 
 :class:`RunSpec` names the run; :func:`execute` turns (spec, scene payload) into a plain-dict record and
 never raises for a failing integrator (blow-up, NaN, unsupported method, OpenMM error): the failure is
@@ -11,19 +12,18 @@ the record.  What a record holds (units nm, ps, Da, kJ/mol):
 * ``constraint_error``: max relative bond-length error max |r - d| / d.
 * ``traj_error``: RMS position error (nm) at the final time against the exact solution (toys); for the
   molecular scenes the sweep fills it in against the reference run (see :mod:`.sweep`).
-* ``force_evals_per_step`` (from ``integrator.program_info.force_evals``; OpenMM's integrators: 1) and
-  ``force_evals_per_ps``; ``wall_per_step`` and ``wall_per_ps`` (seconds) from uninterrupted ``step(n)``
-  calls after the measured segment (sampling clears OpenMM's force cache, so it is not timed), alternated
-  with the same calls of OpenMM's VerletIntegrator on the same scene: ``wall_vs_verlet_paired`` is the
-  ratio of the two minima (see :func:`_time`).
+* ``force_evals_per_step`` (:meth:`~..core.rows.Row.evals_per_step`) and ``force_evals_per_ps``;
+  ``wall_per_step`` and ``wall_per_ps`` (seconds) from uninterrupted ``step(n)`` calls after the measured segment
+  (sampling clears OpenMM's force cache, so it is not timed), in turns with the same calls of OpenMM's
+  VerletIntegrator on the same scene: ``wall_vs_verlet_paired`` is the ratio of the two minima (see :func:`_time`).
 * ``failed`` / ``failure``: blow-up ("blow-up: ..."), energy error above the scene's threshold, or a
   constraint error above 1e-3 (see :mod:`.stability`); ``status`` is "ok", "failed", "unsupported"
   (the method cannot run this system, e.g. an implicit tableau with constraints) or "error".
 
-The comparison rows ``openmm-verlet`` (VerletIntegrator) and ``openmm-langevin``
-(LangevinMiddleIntegrator, 1/ps, the scene temperature, seed 1) are leapfrog integrators whose state
-velocities lag half a step: they start from v(-h/2) = v0 - (h/2) F(x0)/m (then constrained), which
-gives them the same position trajectory as velocity Verlet from (x0, v0).
+The bench names its rows without their step (:func:`bench_name`: a catalogue name, ``openmm-verlet``,
+``openmm-langevin``, ``openmm-mts<n>``, ``<method>[/<inner>]@mts<n>``); a record keeps that name and the step.
+OpenMM's leapfrog integrators start from v(-h/2) (:class:`~..core.engine.RowEngine`), which gives them the same
+position trajectory as velocity Verlet from (x0, v0).
 """
 from __future__ import annotations
 
@@ -34,18 +34,16 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 import openmm as mm
-import openmm.unit as unit
 
 from ...physics import angular_momentum, linear_momentum
-from ..timing import interleaved
-from ...systems.properties import constraint_violation
 from ...stats import drift
-from . import measure
-from .records import RunRecord
+from ...systems.properties import constraint_violation
 from ...systems.scenes import Scene
-from ..core import platforms
+from ..core.engine import RowEngine
 from ..core.rows import Row
+from ..core.timing import time_rows
 from ..core.units import kT, kt_per_ns_per_dof
+from .records import RunRecord
 
 #: Constraint tolerance for every run (SETTLE ignores it; CCMA iterates to it) ...
 CONSTRAINT_TOLERANCE = 1e-10
@@ -61,19 +59,21 @@ SPEED_LIMIT = 1e5  # nm/ps: a velocity above this is a blow-up
 @dataclass(frozen=True)
 class RunSpec:
     scene: str
-    method: str
-    step_fs: float
+    row: str  # a Row label: who, step, thermostat (at the scene's temperature), seed
     n_steps: int
     n_samples: int = 50
     role: str = "run"  # "run", "reference", "probe" (stability: stop at the first failure), "linear-probe"
     platform: str | None = None  # None: the scene's platform
     timing_s: float = 0.0  # seconds of uninterrupted stepping to time (0: no timing)
     threads: int = 1  # CPU platform threads
-    seed: int = 1
+
+    @property
+    def spec_row(self) -> Row:
+        return Row.parse(self.row)
 
     @property
     def h_ps(self) -> float:
-        return self.step_fs * 1e-3
+        return self.spec_row.h_ps
 
     @property
     def length_ps(self) -> float:
@@ -81,6 +81,25 @@ class RunSpec:
 
     def to_dict(self) -> dict:
         return asdict(self)
+
+    def record_fields(self) -> dict:
+        """The record's fields of the run (a row as the bench's name and its step): what a key hashed before runs
+        were keyed by their rows' labels."""
+        row = self.spec_row
+        out = {k: v for k, v in asdict(self).items() if k != "row"}
+        return dict(out, method=bench_name(row), step_fs=row.step_fs, seed=row.seed)
+
+
+def bench_name(row: Row) -> str:
+    """The bench's name of a row, without its step: ``openmm-langevin``, ``openmm-mts<n>``,
+    ``<method>[/<inner>]@mts<n>`` or the row's who."""
+    if row.who == "langevin":
+        return "openmm-langevin"
+    if row.who == "openmm-mts":
+        return f"openmm-mts{row.mts}"
+    if row.mts:
+        return f"{row.method}{'/' + row.inner if row.inner else ''}@mts{row.mts}"
+    return row.who
 
 
 def label(method: str) -> str:
@@ -91,15 +110,11 @@ def label(method: str) -> str:
 PRECISION = {"OpenCL": "double", "CUDA": "mixed", "HIP": "mixed"}
 
 
-def platform_properties(name: str, threads: int) -> dict:
-    return platforms.properties(name, threads, PRECISION.get(name))
-
-
 class Unsupported(Exception):
     """The method cannot run on this system."""
 
 
-def bench_row(method: str, step_fs: float, scene: Scene | None = None, seed: int = 1, temperature=None) -> Row:
+def bench_row(method: str, step_fs: float, scene: Scene | None = None, temperature=None) -> Row:
     """The :class:`~..core.rows.Row` of a bench row name at ``step_fs`` (its thermostat, if any, at the scene's
     temperature unless ``temperature`` is given).  The bench's names are row labels without the step:
     ``openmm-verlet``, ``openmm-langevin``, ``openmm-mts<n>``, ``<method>[/<inner>]@mts<n>`` (the scene's slow force
@@ -107,48 +122,37 @@ def bench_row(method: str, step_fs: float, scene: Scene | None = None, seed: int
     row = Row.parse(method, step_fs=step_fs)
     if row.thermostat:
         t = temperature if temperature is not None else (scene.temperature if scene is not None else row.temperature)
-        row = row.replace(temperature=float(t), seed=int(seed))
+        row = row.replace(temperature=float(t))
     return row
 
 
 def canonical_row(name: str) -> str:
     """The canonical name of a bench row (catalogue aliases resolved); ValueError naming what is accepted."""
     try:
-        row = Row.parse(name, step_fs=1.0)
+        return bench_name(Row.parse(name, step_fs=1.0))
     except ValueError as exc:
         raise ValueError(f"{exc}. Bench rows are catalogue names, openmm-verlet, openmm-langevin, openmm-mts<n> "
                          f"(OpenMM's MTSIntegrator) or <method>[/<inner>]@mts<n> (multiple time stepping)") from None
-    if row.who == "langevin":
-        return "openmm-langevin"
-    if row.who == "openmm-mts":
-        return f"openmm-mts{row.mts}"
-    if row.mts:
-        return f"{row.method}{'/' + row.inner if row.inner else ''}@mts{row.mts}"
-    return row.who
 
 
-def make_integrator(method: str, step_fs: float, scene: Scene, seed: int = 1, temperature=None):
-    """(integrator, force evaluations per step, row) for a row name; Unsupported when the method cannot run
+def engine(row: Row, scene: Scene, platform: str, threads: int = 1, start: bool = True, x=None, v=None) -> RowEngine:
+    """The row running on ``scene`` (a GPU platform in :data:`PRECISION`); Unsupported when the method cannot run
     the scene's System."""
     from ...integrators import ConstraintSupportError
 
     tolerance = PRODUCTION_CONSTRAINT_TOLERANCE if scene.purpose == "production" else CONSTRAINT_TOLERANCE
-    row = bench_row(method, step_fs, scene, seed, temperature)
+    spec = f"{platform}:{PRECISION[platform]}" if platform in PRECISION else platform
     try:
-        ig = row.build(scene.system, constraint_tolerance=tolerance)
+        return RowEngine(row, scene, x, v, platform=spec, threads=threads, constraint_tolerance=tolerance,
+                         start=start, quiet=True, tolerance=CONSTRAINT_TOLERANCE)
     except ConstraintSupportError as exc:
         raise Unsupported(str(exc)) from None
-    return ig, row.evals_per_step(scene.system.getNumConstraints() > 0), row
-
-
-def make_context(scene: Scene, integrator, platform: str, threads: int = 1):
-    plat = mm.Platform.getPlatformByName(platform)
-    return mm.Context(scene.system, integrator, plat, platform_properties(platform, threads))
 
 
 def base_record(spec: RunSpec, scene: Scene, platform: str) -> RunRecord:
-    return RunRecord(**dict(spec.to_dict(), platform=platform), label=label(spec.method), length_ps=spec.length_ps,
-                     n_atoms=scene.n_atoms, n_dof=scene.n_dof)
+    fields = dict(spec.record_fields(), platform=platform)
+    return RunRecord(**fields, label=label(fields["method"]), length_ps=spec.length_ps, n_atoms=scene.n_atoms,
+                     n_dof=scene.n_dof)
 
 
 def _failure(rec, reason, t):
@@ -165,15 +169,18 @@ def execute(spec: RunSpec, scene: Scene) -> tuple[RunRecord, dict]:
     if spec.role == "linear-probe":
         raise ValueError("linear probes are run by stability.run_spec, not by runs.execute")
     platform = spec.platform or scene.platform
-    rec = base_record(spec, scene, platform)
     arrays = {}
+    try:
+        rec = base_record(spec, scene, platform)
+    except ValueError as exc:  # a row that does not read (e.g. an unknown method): an error record under its label
+        return RunRecord(scene=spec.scene, method=spec.row, step_fs=0.0, n_steps=spec.n_steps, role=spec.role,
+                         platform=platform, status="error", failure=f"{type(exc).__name__}: {exc}"), arrays
     t_setup = time.perf_counter()
     try:
-        ig, evals, row = make_integrator(spec.method, spec.step_fs, scene, spec.seed)
-        rec.force_evals_per_step = evals
-        rec.force_evals_per_ps = evals / spec.h_ps
-        ctx = make_context(scene, ig, platform, spec.threads)
-        row.set_state(ctx, scene.positions, scene.velocities, CONSTRAINT_TOLERANCE)
+        row = spec.spec_row
+        eng = engine(row, scene, platform, spec.threads)
+        rec.force_evals_per_step = row.evals_per_step(scene.system.getNumConstraints() > 0)
+        rec.force_evals_per_ps = rec.force_evals_per_step / spec.h_ps
     except Unsupported as exc:
         rec.update(status="unsupported", failure=str(exc).split(". ")[0])
         return rec, arrays
@@ -182,15 +189,13 @@ def execute(spec: RunSpec, scene: Scene) -> tuple[RunRecord, dict]:
         return rec, arrays
     rec.setup_s = time.perf_counter() - t_setup
     try:
-        _measure(spec, scene, ctx, ig, rec, arrays)
+        _measure(spec, scene, eng, rec, arrays)
     except Exception as exc:
         if is_blowup(exc):  # e.g. in the timing segment
             rec.blew_up = True
             _failure(rec, _blowup_reason(exc), rec.steps_done * spec.h_ps)
         else:
             rec.update(status="error", failure=f"{type(exc).__name__}: {exc}", traceback=traceback.format_exc())
-    finally:
-        del ctx
     return rec, arrays
 
 
@@ -212,12 +217,23 @@ def _blowup_reason(exc) -> str:
     return f"blow-up: {what.group(1) if what else 'non-finite state'}" + (f" (step {step.group(1)})" if step else "")
 
 
-def _measure(spec, scene, ctx, ig, rec, arrays):
+def rms_deviation(x, y) -> float:
+    """Root-mean-square distance between two (N, 3) position sets (nm)."""
+    return float(np.sqrt(np.mean(np.sum((np.asarray(x) - np.asarray(y)) ** 2, axis=1))))
+
+
+def _state(eng):
+    """(x, v, E = kinetic + potential energy) now."""
+    x, v, pe, ke = eng.sample()
+    return x, v, ke + pe
+
+
+def _measure(spec, scene, eng, rec, arrays):
     m = scene.masses()
     cons = scene.constraints()
     n_dof = scene.n_dof
     inv = set(scene.invariants)
-    x, v, e0 = measure.read_state(ctx)
+    x, v, e0 = _state(eng)
     p0, l0 = linear_momentum(v, m), angular_momentum(x, v, m, about="origin")
     rec.E0 = e0
     threshold = ENERGY_THRESHOLD_KT * KT300 * n_dof
@@ -229,7 +245,7 @@ def _measure(spec, scene, ctx, ig, rec, arrays):
     t_loop = time.perf_counter()
     for mark in marks:
         try:
-            ig.step(mark - done)
+            eng.step(mark - done)
         except Exception as exc:
             if not is_blowup(exc):
                 raise
@@ -239,8 +255,8 @@ def _measure(spec, scene, ctx, ig, rec, arrays):
         done = mark
         rec.steps_done = done
         t = done * spec.h_ps
-        x, v, e = measure.read_state(ctx)
-        if not measure.finite(x, v, e) or np.max(np.abs(v)) > SPEED_LIMIT:
+        x, v, e = _state(eng)
+        if not (np.all(np.isfinite(x)) and np.all(np.isfinite(v)) and np.isfinite(e)) or np.max(np.abs(v)) > SPEED_LIMIT:
             rec.blew_up = True
             _failure(rec, "blow-up: non-finite or runaway state", t)
             break
@@ -254,7 +270,7 @@ def _measure(spec, scene, ctx, ig, rec, arrays):
             worst_l = max(worst_l, float(np.linalg.norm(angular_momentum(x, v, m, about="origin") - l0)
                                          / np.linalg.norm(l0)))
         worst_c = max(worst_c, constraint_violation(x, cons))
-        if spec.method != "openmm-langevin" and "energy" in inv and abs(de) > threshold:
+        if rec.method != "openmm-langevin" and "energy" in inv and abs(de) > threshold:
             _failure(rec, f"energy error above {ENERGY_THRESHOLD_KT:g} kT per DOF", t)
         if worst_c > CONSTRAINT_THRESHOLD:
             _failure(rec, f"constraint error above {CONSTRAINT_THRESHOLD:g}", t)
@@ -279,14 +295,14 @@ def _measure(spec, scene, ctx, ig, rec, arrays):
     completed = done == spec.n_steps and not rec.blew_up
     if completed:
         if scene.exact is not None:
-            from ...systems.scenes.toys import exact_state
+            from ..core.toys import exact_state
 
             xe, _ = exact_state(scene.exact, spec.length_ps)
-            rec.traj_error = measure.rms_deviation(x, xe)
+            rec.traj_error = rms_deviation(x, xe)
         elif scene.purpose == "accuracy" and spec.role in ("run", "reference"):
             arrays["positions"] = x
     if spec.timing_s > 0 and completed and done:
-        _time(spec, scene, ig, rec, loop_s / done)
+        _time(spec, scene, eng, rec, loop_s / done)
 
 
 #: Timing: rounds of (this integrator, then OpenMM's VerletIntegrator); the minimum of each is kept.
@@ -299,28 +315,22 @@ def _steps_for(seconds, per_step):
     return int(min(100_000, max(10, math.ceil(seconds / max(per_step, 1e-9)))))
 
 
-def _time(spec, scene, ig, rec, per_step_estimate, rounds=TIMING_ROUNDS):
-    """Wall time per step of ``ig`` (continuing from where the measured run ended) and of a fresh OpenMM
-    VerletIntegrator on the same scene and platform, taking turns (:func:`..timing.interleaved`): the
-    fastest block of each is kept, so that load from other processes cancels out of the ratio as far as
-    it can."""
+def _time(spec, scene, eng, rec, per_step_estimate, rounds=TIMING_ROUNDS):
+    """Wall time per step of ``eng`` (continuing from where the measured run ended) and of a fresh OpenMM
+    VerletIntegrator on the same scene and platform, taking turns (:func:`..core.timing.time_rows`): the fastest
+    block of each is kept, so that load from other processes cancels out of the ratio as far as it can."""
     n_time = _steps_for(spec.timing_s / (2 * rounds), per_step_estimate)
-    platform = spec.platform or scene.platform
-    v_ig, _, v_row = make_integrator("openmm-verlet", VERLET_TIMING_STEP_FS, scene)
-    v_ctx = make_context(scene, v_ig, platform, spec.threads)
-    v_row.set_state(v_ctx, scene.positions, scene.velocities, CONSTRAINT_TOLERANCE)
-    v_ig.step(2)  # warm up (kernels, force cache)
+    verlet = engine(Row("openmm-verlet", VERLET_TIMING_STEP_FS), scene, spec.platform or scene.platform, spec.threads)
+    verlet.step(2)  # warm up (kernels, force cache)
     t0 = time.perf_counter()
-    v_ig.step(10)
+    verlet.advance(10)
     n_verlet = _steps_for(spec.timing_s / (2 * rounds), (time.perf_counter() - t0) / 10)
     try:
-        t = interleaved({"own": ig.step, "verlet": v_ig.step}, {"own": n_time, "verlet": n_verlet}, rounds)
+        t = time_rows({"own": eng, "verlet": verlet}, {"own": n_time, "verlet": n_verlet}, rounds)
     except Exception as exc:
         if not is_blowup(exc):
             raise
         return  # the run blew up while being timed: no timing
-    finally:
-        del v_ctx
     best, verlet = t["own"].best, t["verlet"].best
     rec.update(wall_per_step=best, wall_per_ps=best / spec.h_ps, timing_steps=n_time * rounds,
                verlet_wall_per_step=verlet, wall_vs_verlet_paired=best / verlet)
@@ -333,15 +343,9 @@ def retime(spec: RunSpec, scene: Scene, rec: RunRecord, rounds: int = TIMING_ROU
     if not rec.wall_per_step:
         raise ValueError(f"run {rec.method} at {rec.step_fs:g} fs on {rec.scene} has no timing to measure again "
                          f"(status {rec.status!r})")
-    platform = spec.platform or scene.platform
-    ig, _, row = make_integrator(spec.method, spec.step_fs, scene, spec.seed)
-    ctx = make_context(scene, ig, platform, spec.threads)
-    try:
-        row.set_state(ctx, scene.positions, scene.velocities, CONSTRAINT_TOLERANCE)
-        ig.step(2)  # warm up (kernels, force cache)
-        t0 = time.perf_counter()
-        ig.step(5)
-        _time(spec, scene, ig, rec, (time.perf_counter() - t0) / 5, rounds)
-    finally:
-        del ctx
+    eng = engine(spec.spec_row, scene, spec.platform or scene.platform, spec.threads)
+    eng.step(2)  # warm up (kernels, force cache)
+    t0 = time.perf_counter()
+    eng.advance(5)
+    _time(spec, scene, eng, rec, (time.perf_counter() - t0) / 5, rounds)
     return rec.update(retimed=True)

@@ -32,7 +32,7 @@ import numpy as np
 
 from ...methods.stability import spectral_radius
 from .records import StabilityRecord
-from .runs import RunSpec, Unsupported, base_record, execute, is_blowup, label, make_context, make_integrator
+from .runs import RunSpec, Unsupported, base_record, bench_row, engine, execute, is_blowup, label
 
 #: Oscillators in the linear probe, over [omega_max/2, omega_max]: spacing x/8192 < 4e-4 at x < 3.3 and
 #: < 7.4e-4 at x = 6, below the narrowest band known (7.6e-4 wide, sofroniou-spaletta-10 at 3.1411).
@@ -44,7 +44,7 @@ _probe_systems: dict = {}
 
 
 def _dense_harmonic(omega_max: float):
-    from ...systems.scenes import toys
+    from ..core import toys
 
     key = float(omega_max)
     if key not in _probe_systems:
@@ -54,46 +54,38 @@ def _dense_harmonic(omega_max: float):
 
 
 def linear_probe(spec: RunSpec, scene):
-    """One step of ``spec.method`` on the dense harmonic spectrum; fails if the one-step map grows."""
+    """One step of the spec's row on the dense harmonic spectrum; fails if the one-step map grows."""
     from ...systems.scenes import Scene
 
     omega_max = scene.linear["omega_max"]
     omega, system = _dense_harmonic(omega_max)
-    probe_scene = Scene(scene.name, system, np.zeros((len(omega), 3)), np.zeros((len(omega), 3)), "",
-                             invariants=())
+    n = len(omega)
+    q, w = 1e-3, 1e-3 * omega_max  # column 1: (q, 0) on the x axis; column 2: (0, w) on the y axis
+    x0, v0 = np.zeros((n, 3)), np.zeros((n, 3))
+    x0[:, 0] = q
+    v0[:, 1] = w
+    probe_scene = Scene(scene.name, system, x0, v0, "", invariants=())
     platform = spec.platform or scene.platform
     rec = base_record(spec, probe_scene, platform)
-    rec.n_oscillators = len(omega)
-    try:
-        ig, evals, _ = make_integrator(spec.method, spec.step_fs, probe_scene, spec.seed, temperature=0.0)
+    rec.n_oscillators = n
+    row = spec.spec_row
+    row = row.replace(temperature=0.0) if row.thermostat else row
+    try:  # (x0, v0) as given, also for a leapfrog row: the map of its own state
+        eng = engine(row, probe_scene, platform, spec.threads, start=False)
     except Unsupported as exc:
         rec.update(status="unsupported", failure=str(exc).split(". ")[0])
         return rec
-    rec.update(force_evals_per_step=evals, force_evals_per_ps=evals / spec.h_ps)
-    q, w = 1e-3, 1e-3 * omega_max  # column 1: (q, 0) on the x axis; column 2: (0, w) on the y axis
-    x0 = np.zeros((len(omega), 3))
-    v0 = np.zeros((len(omega), 3))
-    x0[:, 0] = q
-    v0[:, 1] = w
-    ctx = make_context(probe_scene, ig, platform, spec.threads)
+    rec.update(force_evals_per_step=row.evals_per_step(False), force_evals_per_ps=row.evals_per_ps(False))
     try:
-        ctx.setPositions(x0)
-        ctx.setVelocities(v0)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            ig.step(1)
-        st = ctx.getState(getPositions=True, getVelocities=True)
-        import openmm.unit as unit
-
-        x = np.array(st.getPositions(asNumpy=True).value_in_unit(unit.nanometer))
-        v = np.array(st.getVelocities(asNumpy=True).value_in_unit(unit.nanometer / unit.picosecond))
+            eng.step(1)
+        x, v, _, _ = eng.sample(energy=False)
     except Exception as exc:
         if not is_blowup(exc):
             raise
         rec.update(failed=True, status="failed", failure="blow-up in one step", steps_done=1)
         return rec
-    finally:
-        del ctx
     rec.steps_done = 1
     # one-step matrix in the scaled coordinates (x/q, v/w)
     m11, m21 = x[:, 0] / q, v[:, 0] / w
@@ -136,8 +128,9 @@ def search(h0: float, cap: float, grow: float = 1.25, rel_tol: float = 0.01, flo
             h = 0.5 * (lo + hi)
 
 
-def driver(scene_name: str, method: str, settings: dict, platform=None, threads: int = 1):
-    """Generator for the sweep: yields probe RunSpecs, is sent their records, returns the summary.
+def driver(scene_name: str, method: str, settings: dict, platform=None, threads: int = 1, temperature: float = 300.0):
+    """Generator for the sweep: yields probe RunSpecs of the bench row ``method`` (a thermostat at ``temperature``),
+    is sent their records, returns the summary.
 
     ``settings``: linear (bool), h0_fs, cap_fs, grow, rel_tol, probe_steps, samples, omega_max."""
     linear = settings.get("linear", False)
@@ -147,7 +140,8 @@ def driver(scene_name: str, method: str, settings: dict, platform=None, threads:
     fail_reason = None
     evals = None
     while True:
-        spec = RunSpec(scene_name, method, h, 1 if linear else settings["probe_steps"],
+        spec = RunSpec(scene_name, bench_row(method, h, temperature=temperature).label,
+                       1 if linear else settings["probe_steps"],
                        1 if linear else settings.get("samples", 20),
                        role="linear-probe" if linear else "probe", platform=platform, threads=threads)
         rec = yield spec
@@ -210,7 +204,7 @@ def largest_stable_step(scene, method: str, settings: dict, platform=None) -> di
     """Run one stability search in this process (no sweep, nothing stored); returns its summary.
 
     ``settings`` as for :func:`driver`, e.g. ``linear_settings(700.0)`` on the harmonic scene."""
-    gen = driver(scene.name, method, settings, platform=platform)
+    gen = driver(scene.name, method, settings, platform=platform, temperature=scene.temperature)
     spec = next(gen)
     while True:
         rec, _ = run_spec(spec, scene)

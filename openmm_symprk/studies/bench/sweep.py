@@ -33,11 +33,11 @@ from ..core.jobs import Job, run_jobs, single
 from . import presets
 from .records import RunRecord
 from ..core.rows import Row
-from .runs import RunSpec, label
-from .store import Store, run_key
+from .runs import RunSpec, bench_row, label
+from .store import Store, legacy_key, run_key
 
 
-class SweepExistsError(RuntimeError):
+class SweepExistsError(FileExistsError):
     """The output folder already holds finished runs and resume was not asked for."""
 
 
@@ -54,7 +54,7 @@ def _evals(method):
 def prepare_scenes(config: dict, out: str, reuse: bool = True, log=print) -> dict:
     """Build (or, with ``reuse``, load the saved copy of) every scene of ``config``."""
     from ...systems.scenes import load_scene, save_scene
-    from ...systems.scenes.named import build, user_scene
+    from ..core.scenes import build, user_scene
 
     folder = os.path.join(out, "scenes")
     result = {}
@@ -100,14 +100,15 @@ def plan(config: dict, scenes: dict) -> list:
         length = sc["length_ps"]
         for m, h in presets.rows_of(config, name):
             n = round(length * 1e3 / h)
-            spec = RunSpec(name, m, float(h), n, sc.get("samples", 50), "run", timing_s=timing, threads=threads)
+            spec = RunSpec(name, bench_row(m, h, scene).label, n, sc.get("samples", 50), "run", timing_s=timing,
+                           threads=threads)
             jobs.append(Job(single(spec), n * _evals(m) * eval_s, kind="run", scene=name, method=m))
         if scene.purpose == "accuracy" and scene.exact is None and not sc.get("rows"):
             ref = config.get("reference", presets.REFERENCE)
             h_min = min(sc["steps_fs"])
             n = round(length * 1e3 / h_min) * int(ref["factor"])
-            spec = RunSpec(name, ref["method"], length * 1e3 / n, n, sc.get("samples", 50), "reference",
-                           threads=threads)
+            spec = RunSpec(name, bench_row(ref["method"], length * 1e3 / n, scene).label, n, sc.get("samples", 50),
+                           "reference", threads=threads)
             jobs.append(Job(single(spec), n * _evals(ref["method"]) * eval_s * 2, kind="reference", scene=name,
                             method=ref["method"]))
         st = sc.get("stability")
@@ -117,7 +118,7 @@ def plan(config: dict, scenes: dict) -> list:
             for m in sc.get("methods", methods):
                 est = 20 if st.get("linear") else 11
                 steps = 1 if st.get("linear") else st["probe_steps"]
-                jobs.append(Job(driver(name, m, st, threads=threads),
+                jobs.append(Job(driver(name, m, st, threads=threads, temperature=scene.temperature),
                                 steps * _evals(m) * (eval_s if not st.get("linear") else 4096 * 3e-7), est,
                                 kind="stability", scene=name, method=m))
     return jobs
@@ -141,7 +142,9 @@ def work(payload: dict, spec_dict: dict):
 
 def _run_jobs(jobs, store, executor, fingerprints, progress=True, on_result=None):
     def key_of(spec):
-        return run_key(spec.to_dict(), fingerprints[spec.scene])
+        key = run_key(spec, fingerprints[spec.scene])
+        store.adopt(key, legacy_key(spec, fingerprints[spec.scene]))
+        return key
 
     def stored(spec):
         rec = store.get(key_of(spec))
@@ -167,7 +170,8 @@ def _result(fut, spec):
     except Exception as exc:  # a worker that died or a bug: record it, keep the sweep going
         import traceback
 
-        rec = RunRecord(**spec.to_dict(), label=label(spec.method), status="error",
+        fields = spec.record_fields()
+        rec = RunRecord(**fields, label=label(fields["method"]), status="error",
                         failure=f"{type(exc).__name__}: {exc}", traceback=traceback.format_exc())
         return rec, {}
 
@@ -207,7 +211,8 @@ def retime_sweep(config: dict, out: str, rounds: int = 3, workers: int = 1, char
             if job.kind != "run":
                 continue
             spec = next(job.gen)
-            key = run_key(spec.to_dict(), fingerprints[spec.scene])
+            key = run_key(spec, fingerprints[spec.scene])
+            store.adopt(key, legacy_key(spec, fingerprints[spec.scene]))
             rec = store.get(key)
             if rec is not None and rec.wall_per_step and spec.timing_s > 0:
                 todo.append((spec, key, rec))

@@ -1,7 +1,11 @@
 """The machinery every study shares (in the spirit of MDAnalysis' AnalysisBase: plan, run one, keep, summarise).
 
 * :mod:`.folders` -- the output folder: an exclusive lock, atomic JSON and array files;
-* :mod:`.store` -- run keys (a hash of everything a run depends on) and finished runs on disk, one
+* :mod:`.rows` -- the one row type, :class:`~.rows.Row` (a configuration written as one line, its label);
+* :mod:`.engine` -- a row running from a state on any platform, and its sampler (:class:`~.engine.RowEngine`);
+* :mod:`.timing` -- rows timed in turns;
+* :mod:`.scenes`, :mod:`.replicas` -- the named scenes, and the replica states of a scene or a rigid-water box;
+* :mod:`.store` -- run keys (a row's label and everything else a run depends on) and finished runs on disk, one
   ``runs/<key>.json`` (+ ``<key>.npz``) each, written atomically;
 * :mod:`.executors` -- where runs execute: this process, spawned worker processes, or a Dask cluster;
 * :mod:`.jobs` -- generators of runs (one run, or a search that picks each run from the results before it)

@@ -1,49 +1,88 @@
-"""One row running from a state of a scene, sampled as a study needs it (the equipartition and fidelity studies).
+"""One row running from a state, sampled as a study needs it: the studies' one way to set up a Context from a row.
 
 :class:`RowEngine` builds the row's System (:meth:`~.rows.Row.system_for`: HMR, MTS force groups) and integrator
-(:meth:`~.rows.Row.build`), or for a ``rigid:`` row the rigid-body engine
-(:class:`~openmm_symprk.rigid.bodies.RigidBodies`), on the CPU platform, and starts it from (x, v) as given (the
-velocities of an HMR row carried over to its masses by
-:func:`~openmm_symprk.systems.repartition.rigid_velocities_for_masses`).
+(:meth:`~.rows.Row.build`) on any platform (``"CPU"``, ``"OpenCL:mixed"``: :mod:`.platforms`), or for a ``rigid:``
+row the rigid-body engine (:class:`~openmm_symprk.rigid.bodies.RigidBodies`), and starts it from (x, v): an HMR
+row's velocities carried over to its masses
+(:func:`~openmm_symprk.systems.repartition.rigid_velocities_for_masses`), and OpenMM's leapfrog integrators
+(VerletIntegrator, LangevinMiddleIntegrator, DPDIntegrator: :attr:`~.rows.Row.leapfrog`, their State velocities
+lag half a step) from v(-h/2) = v - (h/2) F(x)/m, constrained, which gives them the positions of velocity Verlet
+from (x, v).  :meth:`RowEngine.sample` is the one sampler of positions, velocities and energies.
 """
 from __future__ import annotations
+
+from typing import NamedTuple
 
 import numpy as np
 import openmm as mm
 import openmm.unit as unit
 
+from ...physics.momenta import kinetic_energy
 from ...systems.properties import masses
+from . import platforms
 from .rows import Row
 
-__all__ = ["RowEngine"]
+__all__ = ["RowEngine", "Sample"]
+
+KJ = unit.kilojoule_per_mole
+
+
+class Sample(NamedTuple):
+    """A state: x (nm), v (nm/ps), pe and ke (kJ/mol; ke as the State reports it); None where not asked for."""
+    x: np.ndarray | None
+    v: np.ndarray | None
+    pe: float | None
+    ke: float | None
 
 
 class RowEngine:
-    """``row`` running from the state (x, v) of ``scene`` (a Scene with a topology); ``masses``: the row's masses."""
+    """``row`` running on ``platform`` from the state (x, v) (default: the scene's own).  ``source``: a Scene (its
+    topology and molecules serve HMR and rigid rows) or a System.  ``seed``: a stochastic row's random seed (default
+    the row's); ``start=False`` sets (x, v) as given, also for a leapfrog row."""
 
-    def __init__(self, scene, x, v, row: Row, seed: int = 1, threads: int = 1):
-        self.row = row
-        props = {"Threads": str(threads)}
+    def __init__(self, row: Row, source, x=None, v=None, *, platform: str = "CPU", threads: int | None = 1,
+                 seed: int | None = None, constraint_tolerance: float | None = None, start: bool = True,
+                 quiet: bool = True, tolerance: float = 1e-10):
+        scene = source if hasattr(source, "system") else None
+        system = scene.system if scene is not None else source
+        x = scene.positions if x is None else x
+        v = scene.velocities if v is None else v
+        name, precision = platforms.split(platform)
+        self.row, self.platform = row, name
+        props = platforms.properties(name, threads, precision)
+        self.integrator = self.context = self.rigid = None
         if row.is_rigid:
             from ...rigid.bodies import RigidBodies
 
-            self.system, self.masses, self.integrator, self.context = scene.system, scene.masses(), None, None
-            self.rigid = RigidBodies(scene.system, x, v, scene.molecules, row.h_ps, row.method, "CPU", props)
+            self.system, self.masses = system, masses(system)
+            self.rigid = RigidBodies(system, x, v, scene.molecules, row.h_ps, row.method, name, props)
             return
-        self.rigid = None
-        self.system = row.system_for(scene.system, scene.topology)
+        self.system = row.system_for(system, scene.topology if scene is not None else None)
         self.masses = masses(self.system)
         if row.hmr_da is not None:
             from ...systems.repartition import rigid_velocities_for_masses
 
-            v = rigid_velocities_for_masses(x, v, scene.masses(), self.masses, scene.molecules)
-        self.integrator = row.build(self.system, seed=seed)
-        self.context = mm.Context(self.system, self.integrator, mm.Platform.getPlatformByName("CPU"), props)
+            v = rigid_velocities_for_masses(x, v, masses(system), self.masses, scene.molecules)
+        self.integrator = row.build(self.system, seed=seed, constraint_tolerance=constraint_tolerance, quiet=quiet)
+        self.context = mm.Context(self.system, self.integrator, mm.Platform.getPlatformByName(name), props)
         self.context.setPositions(x)
+        v = np.array(v, dtype=np.float64)
+        if start and row.leapfrog:
+            f = self.context.getState(getForces=True).getForces(asNumpy=True).value_in_unit(KJ / unit.nanometer)
+            inv = np.where(self.masses > 0, 1.0 / np.where(self.masses > 0, self.masses, 1.0), 0.0)
+            v = v - 0.5 * row.h_ps * np.asarray(f) * inv[:, None]
         self.context.setVelocities(v)
+        if start and row.leapfrog and self.system.getNumConstraints():
+            self.context.applyVelocityConstraints(tolerance)
 
     def step(self, n: int):
         (self.rigid or self.integrator).step(int(n))
+
+    def advance(self, n: int):
+        """``n`` steps, done when this returns: a GPU platform's queued work is waited for (for timing)."""
+        self.step(n)
+        if self.context is not None and self.platform != "CPU":
+            self.context.getState(getPositions=True)
 
     def heat_bath(self) -> float | None:
         """The heat bath's energy (kJ/mol): 0 for NVE, None for a thermostat that reports none."""
@@ -52,16 +91,18 @@ class RowEngine:
         if not self.row.has_heat_bath:
             return None
         e = self.integrator.computeHeatBathEnergy()
-        return float(e.value_in_unit(unit.kilojoule_per_mole) if unit.is_quantity(e) else e)
+        return float(e.value_in_unit(KJ) if unit.is_quantity(e) else e)
 
-    def sample(self, velocities: bool = True, energy: bool = True):
-        """(x nm, v nm/ps or None, potential energy kJ/mol or None) now."""
+    def sample(self, positions: bool = True, velocities: bool = True, energy: bool = True) -> Sample:
+        """The state now, in float64, from one State."""
         if self.rigid is not None:
-            return (self.rigid.positions(), self.rigid.velocities() if velocities else None,
-                    self.rigid.potential_energy() if energy else None)
-        st = self.context.getState(getPositions=True, getVelocities=velocities, getEnergy=energy)
-        x = np.asarray(st.getPositions(asNumpy=True).value_in_unit(unit.nanometer))
-        v = np.asarray(st.getVelocities(asNumpy=True).value_in_unit(unit.nanometer / unit.picosecond)) \
-            if velocities else None
-        pe = st.getPotentialEnergy().value_in_unit(unit.kilojoule_per_mole) if energy else None
-        return x, v, pe
+            v = self.rigid.velocities()
+            return Sample(self.rigid.positions() if positions else None, v if velocities else None,
+                          self.rigid.potential_energy() if energy else None,
+                          kinetic_energy(v, self.masses) if energy else None)
+        st = self.context.getState(getPositions=positions, getVelocities=velocities, getEnergy=energy)
+        return Sample(np.array(st.getPositions(asNumpy=True).value_in_unit(unit.nanometer)) if positions else None,
+                      np.array(st.getVelocities(asNumpy=True).value_in_unit(unit.nanometer / unit.picosecond))
+                      if velocities else None,
+                      st.getPotentialEnergy().value_in_unit(KJ) if energy else None,
+                      st.getKineticEnergy().value_in_unit(KJ) if energy else None)

@@ -9,8 +9,8 @@ from ...support.files import jsonable, write_json, write_npz, write_text
 __all__ = ["FolderLock", "FolderLockedError", "write_text", "write_json", "write_npz", "jsonable"]
 
 
-class FolderLockedError(RuntimeError):
-    """Another process holds the folder's lock."""
+class FolderLockedError(BlockingIOError):
+    """Another process holds the folder's lock (an OSError: the command says so in one line)."""
 
 
 class FolderLock:

@@ -3,7 +3,7 @@ this installation has one, and the Context properties a run sets (the CPU platfo
 precision)."""
 from __future__ import annotations
 
-__all__ = ["PRECISIONS", "split", "available", "properties"]
+__all__ = ["PRECISIONS", "split", "names", "available", "check", "properties"]
 
 #: The precision modes of OpenMM's OpenCL, CUDA and HIP platforms.
 PRECISIONS = ("single", "mixed", "double")
@@ -18,15 +18,23 @@ def split(spec: str) -> tuple:
     return name, precision or None
 
 
-def available(name: str) -> bool:
-    """Whether this installation of OpenMM has the platform ``name`` (a spec's precision is ignored)."""
+def names() -> list:
+    """The names of this installation's OpenMM platforms."""
     import openmm as mm
 
-    try:
-        mm.Platform.getPlatformByName(split(name)[0])
-        return True
-    except Exception:
-        return False
+    return [mm.Platform.getPlatform(i).getName() for i in range(mm.Platform.getNumPlatforms())]
+
+
+def available(name: str) -> bool:
+    """Whether this installation of OpenMM has the platform ``name`` (a spec's precision is ignored)."""
+    return split(name)[0] in names()
+
+
+def check(name: str) -> str:
+    """``name`` if this installation has that platform (a name, no precision); ValueError naming those it has."""
+    if name not in names():
+        raise ValueError(f"unknown OpenMM platform {name!r}; this installation has {', '.join(names())}")
+    return name
 
 
 def properties(name: str, threads: int | None = None, precision: str | None = None) -> dict:

@@ -3,15 +3,17 @@
 A :class:`Row` says who integrates (a catalogue method run by :class:`~openmm_symprk.SymplecticIntegrator`, a rigid
 body engine, or one of OpenMM's integrators), the step, the thermostat (kind, target temperature, collision time
 or friction, interval and position in the step), hydrogen mass repartitioning, multiple time stepping, the
-backend and the random seed.  It builds the integrator for a System (:meth:`Row.build`) and knows its label,
-its force (group) evaluations per step (from the resolved method, :func:`openmm_symprk.methods.resolve`),
-whether its state velocities are on-step or lag half a step (leapfrog), whether it has a heat-bath energy and
-whether it keeps the total momentum.
+backend and the random seed.  It builds the integrator for a System (:meth:`Row.build`; a study runs it with
+:class:`~.engine.RowEngine`) and knows its label (a study's runs are stored under it:
+:func:`~.store.run_key`), its force (group) evaluations per step (:meth:`Row.evals_per_step`: the resolved
+method's ``force_evals``, :class:`openmm_symprk.methods.resolved.ResolvedMethod`; for OpenMM's integrators one table,
+:data:`OPENMM_KINDS`), whether its state velocities are on-step or lag half a step (leapfrog), whether it has a
+heat-bath energy and whether it keeps the total momentum.
 
 One grammar of labels, :meth:`Row.parse` reading what :attr:`Row.label` writes::
 
     WHO[/INNER] [H fs | H/N fs] [SVR TAU ps | friction G/ps | collision NU/ps | NU/ps] [cutoff C nm] [every K]
-        [middle | auto] [T K] [exact-momentum] [HMR M Da] [native | custom] [seed S]
+        [ends | middle | auto] [T K] [exact-momentum] [HMR M Da] [native | custom] [seed S]
 
 * WHO: a catalogue method (``verlet``, ``omelyan-2``, ...; aliases resolved), ``rigid:<method>`` (the molecules
   as rigid bodies, :class:`~openmm_symprk.rigid.bodies.RigidBodies`), or OpenMM's ``openmm-verlet``
@@ -20,7 +22,11 @@ One grammar of labels, :meth:`Row.parse` reading what :attr:`Row.label` writes::
 * ``H/N fs``: multiple time stepping, force group 1 (the scenes put PME's reciprocal space there) once per step of
   H fs, group 0 N times; ``/INNER`` names the inner levels' method (:func:`openmm_symprk.methods.resolve`);
 * ``SVR TAU ps``: this package's stochastic velocity rescaling with collision time TAU, every K steps, at the
-  ends of the step or in its ``middle`` (``auto``: the method's choice); OpenMM's Langevin kinds take a friction
+  ``ends`` of the step or in its ``middle`` (``auto``: the method's choice, :mod:`openmm_symprk.methods.placement`).
+  **A row without a position word runs the thermostat at the ends** (:data:`ROW_POSITION`, what the stored results
+  of such rows were run with, and what their labels, the keys of those results, mean), where
+  :class:`~openmm_symprk.SymplecticIntegrator`'s default is ``auto`` (verlet: the middle); the label leaves
+  ``ends`` out and writes any other placement.  OpenMM's Langevin kinds take a friction
   (default 1/ps), Nose-Hoover a collision frequency (default 1/ps), DPD a cutoff (default: the System's
   nonbonded cutoff); T is the target temperature (default 300 K).
 
@@ -37,23 +43,27 @@ import re
 import warnings
 from dataclasses import dataclass
 
-__all__ = ["Row", "OPENMM_KINDS", "THERMOSTAT_POSITIONS", "split_groups"]
+from ...methods.placement import POSITIONS
 
-#: OpenMM's integrators a row may name: who -> thermostat kind ("" for NVE).
+__all__ = ["Row", "OPENMM_KINDS", "ROW_POSITION", "split_groups"]
+
+#: OpenMM's integrators a row may name: who -> thermostat kind ("" for NVE); each evaluates the forces (all groups)
+#: once per step, its multiple-time-step kinds (openmm-mts, mts-langevin) 1 + N times (:meth:`Row.evals_per_step`).
 OPENMM_KINDS = {"openmm-verlet": "", "openmm-mts": "", "langevin": "langevin", "mts-langevin": "langevin",
                 "nose-hoover": "nose-hoover", "dpd": "dpd"}
 #: Other spellings of OpenMM's integrators (earlier grammars).
 ALIASES = {"openmm-langevin": "langevin", "openmm-nosehoover": "nose-hoover", "nosehoover": "nose-hoover",
            "openmm-dpd": "dpd", "openmm-mtslangevin": "mts-langevin"}
-#: Where a velocity thermostat sits in the step (:mod:`openmm_symprk.methods.placement`).
-THERMOSTAT_POSITIONS = ("ends", "middle", "auto")
+#: A row's thermostat position when its label names none: the ends (not the integrator's default, "auto"; one of
+#: :data:`openmm_symprk.methods.placement.POSITIONS`, which lists the placements).
+ROW_POSITION = "ends"
 #: OpenMM integrators whose State velocities lag half a step behind the positions.
 LEAPFROG = ("openmm-verlet", "langevin", "dpd")
 #: ...and those that do not keep the total momentum (per-particle friction and noise).
 NO_MOMENTUM = ("langevin", "mts-langevin")
 RIGID_PREFIX = "rigid:"
 _NUMBER = r"[0-9]*\.?[0-9]+(?:[eE][-+]?[0-9]+)?"
-_OLD_MTS = re.compile(rf"^(?P<who>[^/@\s]+)(?:/(?P<inner>[^@\s]+))?@mts(?P<n>[0-9]+)$")
+_OLD_MTS = re.compile(r"^(?P<who>[^/@\s]+)(?:/(?P<inner>[^@\s]+))?@mts(?P<n>[0-9]+)$")
 _OLD_OPENMM_MTS = re.compile(r"^openmm-mts(?P<n>[0-9]+)$")
 _OLD_AT_STEP = re.compile(rf"^(?P<who>[^@\s]+)[@:](?P<h>{_NUMBER})$")
 
@@ -64,7 +74,9 @@ def split_groups(inner_steps: int) -> list:
 
 
 def _g(x) -> str:
-    return f"{float(x):g}"
+    """A number as a label writes it: short (%g) where that reads back exactly, else every digit (a bisected step)."""
+    short = f"{float(x):g}"
+    return short if float(short) == float(x) else repr(float(x))
 
 
 @dataclass(frozen=True)
@@ -80,7 +92,7 @@ class Row:
     collision_per_ps: float | None = None  # OpenMM's Nose-Hoover
     cutoff_nm: float | None = None  # DPD (None: the System's nonbonded cutoff)
     every: int = 1  # thermostat_interval
-    position: str = "ends"  # thermostat_position
+    position: str = ROW_POSITION  # thermostat_position
     temperature: float = 300.0  # K, the thermostat's target
     exact_momentum: bool = False
     hmr_da: float | None = None  # hydrogen mass repartitioning (the System is repartitioned by system_for)
@@ -133,10 +145,9 @@ class Row:
             value = getattr(self, name)
             if value is not None and not (float(value) > 0 and math.isfinite(float(value))):
                 raise ValueError(f"row {who!r}: {name} must be a positive number, got {value!r}")
-        if self.position not in THERMOSTAT_POSITIONS:
-            raise ValueError(f"row {who!r}: thermostat position {self.position!r}; known: "
-                             f"{', '.join(THERMOSTAT_POSITIONS)}")
-        if (self.every != 1 or self.position != "ends") and self.tau_ps is None:
+        if self.position not in POSITIONS:
+            raise ValueError(f"row {who!r}: thermostat position {self.position!r}; known: {', '.join(POSITIONS)}")
+        if (self.every != 1 or self.position != ROW_POSITION) and self.tau_ps is None:
             raise ValueError(f"row {who!r}: 'every' and the thermostat position need a thermostat (SVR TAU ps)")
         if int(self.every) != self.every or self.every < 1:
             raise ValueError(f"row {who!r}: every must be a whole number >= 1, got {self.every!r}")
@@ -226,6 +237,10 @@ class Row:
     def evals_per_ps(self, constraints: bool | None = None) -> float:
         return self.evals_per_step(constraints) / self.h_ps
 
+    def steps_for(self, fs: float) -> int:
+        """The whole number of this row's steps closest to ``fs`` femtoseconds (at least 1): a sampling interval."""
+        return max(1, int(round(float(fs) / self.step_fs)))
+
     # -- the label -----------------------------------------------------------------------------------------------
     @property
     def label(self) -> str:
@@ -242,7 +257,7 @@ class Row:
             parts.append(f"cutoff {_g(self.cutoff_nm)} nm")
         if self.every != 1:
             parts.append(f"every {int(self.every)}")
-        if self.position != "ends":
+        if self.position != ROW_POSITION:
             parts.append(self.position)
         if self.temperature != 300.0:
             parts.append(f"T {_g(self.temperature)} K")
@@ -321,7 +336,7 @@ class Row:
                 elif w == "every" and nxt:
                     fields["every"] = int(number(nxt, "every"))
                     i += 2
-                elif w in ("middle", "auto", "ends"):
+                elif w in POSITIONS:
                     fields["position"] = w
                     i += 1
                 elif w == "T" and words[i + 2:i + 3] == ["K"]:
@@ -343,8 +358,8 @@ class Row:
                     raise ValueError(f"row {text!r}: {' '.join(words[i:])!r} not understood")
         except ValueError as exc:
             raise ValueError(f"{exc}; a row reads WHO[/INNER] [H fs | H/N fs] [SVR TAU ps | friction G/ps | "
-                             f"collision NU/ps] [cutoff C nm] [every K] [middle|auto] [T K] [exact-momentum] "
-                             f"[HMR M Da] [native|custom] [seed S]") from None
+                             f"collision NU/ps] [cutoff C nm] [every K] [{' | '.join(POSITIONS)}; none: "
+                             f"{ROW_POSITION}] [T K] [exact-momentum] [HMR M Da] [native|custom] [seed S]") from None
         if "step_fs" not in fields:
             raise ValueError(f"row {text!r}: no step; write e.g. '{who} 2 fs'")
         if fields.get("collision_per_ps") is not None and ALIASES.get(who, who) in ("langevin", "mts-langevin", "dpd"):
@@ -414,28 +429,6 @@ class Row:
             ig.setConstraintTolerance(float(constraint_tolerance))
         return ig
 
-    def set_state(self, context, positions, velocities, tolerance: float = 1e-10):
-        """Put the state (x, v) (nm, nm/ps) into ``context``; a leapfrog row starts from
-        v(-h/2) = v - (h/2) F(x)/m, constrained, which gives it the position trajectory of velocity Verlet from
-        (x, v)."""
-        import numpy as np
-        import openmm.unit as unit
-
-        from ...systems.properties import masses
-
-        context.setPositions(positions)
-        v = np.array(velocities, dtype=np.float64)
-        system = context.getSystem()
-        if self.leapfrog:
-            f = context.getState(getForces=True).getForces(asNumpy=True).value_in_unit(
-                unit.kilojoule_per_mole / unit.nanometer)
-            m = masses(system)
-            inv = np.where(m > 0, 1.0 / np.where(m > 0, m, 1.0), 0.0)
-            v = v - 0.5 * self.h_ps * np.asarray(f) * inv[:, None]
-        context.setVelocities(v)
-        if self.leapfrog and system.getNumConstraints():
-            context.applyVelocityConstraints(tolerance)
-
     def _ours(self, system, h, seed):
         from ...integrators import SymplecticIntegrator
         from ...methods.catalogue import get_method
@@ -451,9 +444,7 @@ class Row:
             options.update(temperature=self.temperature, collision_time=self.tau_ps, random_seed=seed)
             if self.every != 1:
                 options["thermostat_interval"] = int(self.every)
-            # always passed: a row without a position word means "ends", what its stored results were run with,
-            # whatever the integrator's default placement
-            options["thermostat_position"] = self.position
+            options["thermostat_position"] = self.position  # always: ROW_POSITION is not the integrator's default
         return SymplecticIntegrator(h, self.method, system=system, **options)
 
 

@@ -1,8 +1,10 @@
 """Finished runs on disk: ``<out>/runs/<key>.json`` (what the run measured, plain data) and, when it has arrays,
 ``<key>.npz``; both written atomically, the arrays first, so a JSON file on disk means a complete run.
 
-A run's key hashes everything the run depends on (its settings and the fingerprint of its starting state), so a
-study called again finds exactly the runs it already did, and a changed setting never reuses a stale run.
+Every study keys its runs one way, :func:`run_key`: the row's label (:attr:`~.rows.Row.label`, however the row was
+written), the replica and everything else the run depends on (its settings and the key of its starting states),
+so a study called again finds exactly the runs it already did, and a changed setting never reuses a stale run.
+A run stored under a key of an earlier form is found through its ``legacy`` key (:meth:`RunStore.adopt`).
 """
 from __future__ import annotations
 
@@ -12,13 +14,18 @@ import os
 import numpy as np
 
 from ...support.files import content_key, write_json, write_npz
+from .rows import Row
 
 __all__ = ["run_key", "RunStore"]
 
 
-def run_key(obj, length: int = 16) -> str:
-    """The key of a run: the SHA-1 of ``obj`` as sorted JSON, cut to ``length`` hex digits."""
-    return content_key(obj, length)
+def run_key(row, replica: int | None, settings: dict, length: int = 16, **context) -> str:
+    """The key of a run of ``row`` (a Row or a label, hashed as its canonical label) from ``replica``: the SHA-1 of
+    ``{"cfg": settings, "row": label, "replica": replica, **context}`` as sorted JSON, cut to ``length`` hex
+    digits."""
+    label = (row if isinstance(row, Row) else Row.parse(row)).label
+    return content_key({"cfg": settings, "row": label, "replica": None if replica is None else int(replica),
+                        **context}, length)
 
 
 class RunStore:
@@ -27,11 +34,19 @@ class RunStore:
     def __init__(self, out: str, folder: str = "runs", create: bool = True):
         self.out = out
         self.folder = os.path.join(out, folder)
+        self.aliases: dict = {}  # key -> the legacy key its run is stored under
         if create:
             os.makedirs(self.folder, exist_ok=True)
 
     def path(self, key: str, ext: str) -> str:
+        """Where the run of ``key`` is stored (under its legacy key when adopted so)."""
+        key = self.aliases.get(key, key)
         return os.path.join(self.folder, f"{key}.{ext}")
+
+    def adopt(self, key: str, legacy: str | None) -> None:
+        """Read the run of ``key`` from ``legacy``, a key of an earlier form, when only that one is stored."""
+        if legacy and key not in self and legacy in self:
+            self.aliases[key] = legacy
 
     def info(self, key: str) -> dict | None:
         """The stored JSON of a run, or None (missing or unreadable)."""
@@ -49,6 +64,7 @@ class RunStore:
             return None
 
     def put(self, key: str, info: dict, arrays: dict | None = None):
+        self.aliases.pop(key, None)
         if arrays:
             write_npz(self.path(key, "npz"), arrays)
         write_json(self.path(key, "json"), info)

@@ -42,6 +42,7 @@ class Run:
     args: tuple = ()  # passed to Study.work after the shared data (picklable)
     meta: dict = field(default_factory=dict)  # stored with the run: what identifies it (row, replica, ...)
     cost: float = 1.0  # relative cost, to start the longest runs first
+    legacy: str | None = None  # its key in an earlier form, under which a stored run is found (RunStore.adopt)
 
 
 class Study:
@@ -82,7 +83,7 @@ class Study:
             self.store = RunStore(self.out, create=False)
             if not len(self.store):
                 raise ValueError(f"no finished runs in {self.out}: run the study without --report-only first")
-            runs = self.plan()
+            runs = self._adopt(self.plan())
             missing = sum(r.key not in self.store for r in runs)
             if missing == len(runs):
                 raise ValueError(f"none of the {len(runs)} planned runs is stored in {self.out} (other settings?)")
@@ -93,7 +94,7 @@ class Study:
         lock = FolderLock(self.out, self.command)
         try:
             self.store = RunStore(self.out)
-            runs = self.plan()
+            runs = self._adopt(self.plan())
             todo = [r for r in runs if r.key not in self.store]
             if len(runs) - len(todo):
                 self.log(f"reusing {len(runs) - len(todo)} finished runs in {self.out}")
@@ -129,6 +130,11 @@ class Study:
         for reps in out.values():
             reps.sort(key=lambda rep: rep[1].get("replica", 0))
         return out
+
+    def _adopt(self, runs: list) -> list:
+        for run in runs:
+            self.store.adopt(run.key, run.legacy)
+        return runs
 
     def _keep(self, run: Run, result) -> dict:
         arrays, info = result

@@ -11,7 +11,7 @@ Three questions use it (presets in :mod:`.presets`):
   as NVE keeps the energy, method by method (docs/thermostat.md)?  Its work-precision chart is :mod:`.chart`.
 
 Modules: :mod:`.verdict` (pure statistics: drifts per row, paired comparisons, the verdict), :mod:`.presets`
-(configurations), :mod:`openmm_symprk.systems.scenes.replicas` (the named scenes' independent replica states), :mod:`.runs` (one NVE run),
+(configurations), :mod:`openmm_symprk.studies.core.replicas` (the named scenes' independent replica states), :mod:`.runs` (one NVE run),
 :mod:`.study` (the study on :mod:`openmm_symprk.studies.core`: resumable, one stored run per key), :mod:`.report`
 (tables) and :mod:`.cli`.
 """

@@ -16,7 +16,7 @@ import argparse
 import os
 import sys
 
-from ..core.cli import run_study_command
+from ..core.options import add_study_arguments, run_study
 from ..core.platforms import split
 from . import presets
 
@@ -28,10 +28,10 @@ def build_parser(prog: str = "symprk drift"):
                     help="hmr: our verlet vs OpenMM's VerletIntegrator at 4 fs with HMR (docs/production.md); "
                          "exact-momentum: drift with and without exact_momentum per precision (docs/conservation.md); "
                          "nvt: the thermostat's effective-energy drift next to NVE (docs/thermostat.md)")
-    ap.add_argument("--quick", action="store_true", help="seconds: tiny runs, the pipeline end to end")
-    ap.add_argument("--out", help="output folder (default drift-results/<study>[-quick]); finished runs are reused")
-    ap.add_argument("--replicas", type=int, help="independent replicas per row (default 3)")
-    ap.add_argument("--length-ps", type=float, help="NVE length per run (default 100 ps; --quick 0.2)")
+    add_study_arguments(ap, quick="seconds: tiny runs, the pipeline end to end", default_workers=1,
+                        out=None, out_help="drift-results/<study> or drift-results/<study>-quick",
+                        workers="worker processes (default 1: runs use --threads each; 2 cores take one run at a time)",
+                        length="NVE length per run (default 100 ps; --quick 0.2)", timing=False)
     ap.add_argument("--sample-ps", type=float, help="energy sampling interval (default 0.1 ps)")
     ap.add_argument("--constraint-tolerance", type=float, help="integrators' constraint tolerance (default 1e-5)")
     ap.add_argument("--threads", type=int, help="CPU platform threads per run (default 2; --quick 1)")
@@ -42,12 +42,6 @@ def build_parser(prog: str = "symprk drift"):
                     help="nvt: only these pairs, e.g. omelyan-2@4,nosehoover@2 (default: the full set)")
     ap.add_argument("--chart", help="nvt: also write the work-precision chart (PNG) here (always: <out>/nvt-drift.png)")
     ap.add_argument("--json", help="also write the summary as JSON to this file (always: <out>/results.json)")
-    ap.add_argument("--workers", type=int, default=1,
-                    help="worker processes (default 1: runs use --threads each; 2 cores take one run at a time)")
-    ap.add_argument("--scheduler", metavar="ADDRESS", help="Dask scheduler address instead of local workers")
-    ap.add_argument("--no-progress", action="store_true")
-    ap.add_argument("--report-only", action="store_true",
-                    help="run nothing: summarise the finished runs in --out (unfinished ones are left out)")
     return ap
 
 
@@ -84,13 +78,12 @@ def make_config(args) -> dict:
     return cfg
 
 
-def main(argv=None, prog: str = "symprk drift") -> int:
-    args = build_parser(prog).parse_args(argv)
+def run(args):
     if not args.out:
         args.out = os.path.join("drift-results", args.study + ("-quick" if args.quick else ""))
-    rc = run_study_command(prog, args, {}, lambda cfg: cfg.update(make_config(args)),
-                           "openmm_symprk.studies.drift.study", "openmm_symprk.studies.drift.report")
-    if rc == 0 and (args.chart or args.json):
+    run_study(args, {}, lambda cfg: cfg.update(make_config(args)), "openmm_symprk.studies.drift.study",
+              "openmm_symprk.studies.drift.report")
+    if args.chart or args.json:
         import json
         import shutil
 
@@ -102,13 +95,8 @@ def main(argv=None, prog: str = "symprk drift") -> int:
             write_json(args.json, summary)
             print(f"wrote {args.json}")
         if args.chart and not os.path.exists(os.path.join(args.out, "nvt-drift.png")):
-            print(f"{prog}: no chart was drawn (see above), so none is copied to {args.chart}", file=sys.stderr)
+            print(f"{args.prog}: no chart was drawn (see above), so none is copied to {args.chart}", file=sys.stderr)
         elif args.chart:
             os.makedirs(os.path.dirname(os.path.abspath(args.chart)), exist_ok=True)
             shutil.copyfile(os.path.join(args.out, "nvt-drift.png"), args.chart)
             print(f"wrote {args.chart}")
-    return rc
-
-
-if __name__ == "__main__":
-    sys.exit(main())

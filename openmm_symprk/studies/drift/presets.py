@@ -2,11 +2,12 @@
 
     {"study": name, "replicas": R, "length_ps": T, "sample_ps": dt, "decorrelate_ps": t, "temperature": K,
      "seed": s, "threads": n, "constraint_tolerance": tol,
-     "rows": [{"name", "scene", "row", "step_fs", "platform", "precision"}, ...],
+     "rows": [{"name", "scene", "row", "platform"}, ...],
      "comparisons": [{"row": name, "ref": name, "kind": "claim" | "cost", "factor": f | None}, ...]}
 
 ``row`` is a :class:`~..core.rows.Row` label (one line a row: who, step, thermostat, options); ``scene`` a named
-scene (:mod:`openmm_symprk.systems.scenes.named`).  A "claim" comparison asks whether ``row`` drifts less than
+scene (:mod:`..core.scenes`; the HMR rows run on ``villin-pme-hmr``, whose System OpenMM's ForceField built with
+heavier hydrogens, and whose replica states were equilibrated with them); ``platform`` NAME or NAME:PRECISION.  A "claim" comparison asks whether ``row`` drifts less than
 ``ref`` (about ``factor`` times less);  a "cost" comparison whether ``row`` (an option switched on: exact momentum,
 the thermostat) drifts more than ``ref`` (switched off).  Both are paired by replica (:mod:`.verdict`).
 """
@@ -35,10 +36,8 @@ def _common(quick: bool) -> dict:
 
 
 def _row(name, scene, label, platform="CPU"):
-    plat, precision = split(platform)
-    row = Row.parse(label)
-    return {"name": name, "scene": scene, "row": row.label, "step_fs": row.step_fs, "platform": plat,
-            "precision": precision}
+    split(platform)  # ValueError for an unknown precision
+    return {"name": name, "scene": scene, "row": Row.parse(label).label, "platform": platform}
 
 
 def hmr(quick: bool = False, control: bool = True) -> dict:

@@ -30,7 +30,8 @@ def summarise(cfg: dict, found: dict, skipped=()) -> dict:
         per_row[row["name"]] = drifts
         est = row_estimate(drifts)
         spec = row_of(row)
-        rows.append(dict(row, replicas_done=len(drifts), failed=failed, drift=_est(est), ensemble=spec.ensemble,
+        rows.append(dict(row, step_fs=spec.step_fs, replicas_done=len(drifts), failed=failed, drift=_est(est),
+                         ensemble=spec.ensemble,
                          exact_momentum=spec.exact_momentum,
                          evals_per_ps=spec.evals_per_ps(),
                          per_replica={str(r): list(v) for r, v in sorted(drifts.items())},
@@ -71,7 +72,7 @@ def format_summary(s: dict) -> str:
            "| row | scene | h (fs) | platform | replicas | drift (kT/ns/DOF) | per replica | s per ps |",
            "|---|---|---|---|---|---|---|---|"]
     for r in s["rows"]:
-        plat = r["platform"] + (f":{r['precision']}" if r.get("precision") else "")
+        plat = r["platform"]
         if r["skipped"]:
             out.append(f"| {r['name']} | {r['scene']} | {r['step_fs']:g} | {plat} | - | platform not available | - | - |")
             continue

@@ -10,8 +10,10 @@ from __future__ import annotations
 
 import os
 
-from ..core import Run, Study, platforms, run_key as hash_key, write_json, write_text
-from ...systems.scenes.replicas import replica_states, state_key
+from ...support.files import content_key
+from ..core import Run, Study, platforms, run_key as row_run_key, write_json, write_text
+from ..core.replicas import scene_replicas, scene_state_key
+from .runs import row_of
 
 __all__ = ["DriftStudy", "run_study", "run_key", "check"]
 
@@ -20,37 +22,37 @@ RUN_VERSION = 1
 _RUN_KEYS = ("length_ps", "sample_ps", "constraint_tolerance", "threads", "temperature")
 
 
-def _row_key(row: dict) -> dict:
-    """What a run's key hashes of its row: the fields of the rows of earlier versions (so their stored runs are
-    found again), and the row's label where it says more than those (a thermostat, multiple time stepping, ...)."""
-    from .runs import row_of
-
-    r = row_of(row)
-    out = {"scene": row["scene"], "integrator": r.who, "step_fs": r.step_fs, "platform": row["platform"],
-           "precision": row.get("precision"), "exact_momentum": r.exact_momentum}
-    if r != type(r)(r.who, r.step_fs, exact_momentum=r.exact_momentum):
-        out["row"] = r.label
-    return out
-
-
-def scene_state_key(cfg: dict, scene: str) -> str:
-    return state_key(scene, cfg["temperature"], cfg["seed"], cfg["decorrelate_ps"])
+def states_key(cfg: dict, scene: str) -> str:
+    return scene_state_key(scene, cfg["temperature"], cfg["seed"], cfg["decorrelate_ps"])
 
 
 def states_of(cfg: dict, scene: str, out: str, log=print) -> dict:
-    """The replica states of ``scene`` for ``cfg``, kept in ``<out>/states`` (:func:`~openmm_symprk.systems.scenes.replicas.replica_states`)."""
-    return replica_states(scene, os.path.join(out, "states"), int(cfg["replicas"]), float(cfg["temperature"]),
+    """The replica states of ``scene`` for ``cfg``, kept in ``<out>/states``
+    (:func:`~..core.replicas.scene_replicas`)."""
+    return scene_replicas(scene, os.path.join(out, "states"), int(cfg["replicas"]), float(cfg["temperature"]),
                           int(cfg["seed"]), float(cfg["decorrelate_ps"]), int(cfg.get("threads", 1)), log)
 
 
 def run_key(cfg: dict, row: dict, replica: int) -> str:
-    return hash_key({"cfg": {k: cfg[k] for k in _RUN_KEYS}, "row": _row_key(row),
-                     "replica": int(replica), "states": scene_state_key(cfg, row["scene"]), "version": RUN_VERSION})
+    return row_run_key(row["row"], replica, {k: cfg[k] for k in _RUN_KEYS}, scene=row["scene"],
+                       platform=row["platform"], states=states_key(cfg, row["scene"]), version=RUN_VERSION)
+
+
+def legacy_key(cfg: dict, row: dict, replica: int) -> str:
+    """The key runs had before rows were keyed by their labels: the integrator, step, platform, precision and exact
+    momentum apart, and the label only where the row says more than those (a thermostat, multiple time stepping...)."""
+    r, (name, precision) = row_of(row), platforms.split(row["platform"])
+    old = {"scene": row["scene"], "integrator": r.who, "step_fs": r.step_fs, "platform": name, "precision": precision,
+           "exact_momentum": r.exact_momentum}
+    if r != type(r)(r.who, r.step_fs, exact_momentum=r.exact_momentum):
+        old["row"] = r.label
+    return content_key({"cfg": {k: cfg[k] for k in _RUN_KEYS}, "row": old, "replica": int(replica),
+                        "states": states_key(cfg, row["scene"]), "version": RUN_VERSION})
 
 
 def check(cfg: dict):
     """ValueError naming the bad value and what is accepted."""
-    from ...systems.scenes.named import SCENES
+    from ..core.scenes import SCENES
 
     if int(cfg["replicas"]) < 1:
         raise ValueError(f"replicas must be >= 1, got {cfg['replicas']!r}")
@@ -65,8 +67,6 @@ def check(cfg: dict):
     for row in cfg["rows"]:
         if row["scene"] not in SCENES:
             raise ValueError(f"row {row['name']}: unknown scene {row['scene']!r}; known: {', '.join(SCENES)}")
-        from .runs import row_of
-
         step = row_of(row).step_fs  # ValueError naming the catalogue and OpenMM's integrators
         n = float(cfg["length_ps"]) * 1e3 / step
         if round(n) < 3:
@@ -121,13 +121,12 @@ class DriftStudy(Study):
         rows = self.rows()
         self.states = {s: states_of(cfg, s, self.out, self.log) for s in dict.fromkeys(r["scene"] for r in rows)}
         runs = []
-        from .runs import row_of
-
         for row in rows:
             cost = float(cfg["length_ps"]) * row_of(row).evals_per_ps() * (10.0 if "pme" in row["scene"] else 1.0)
             for r in range(int(cfg["replicas"])):
                 runs.append(Run(run_key(cfg, row, r), row["scene"], (row, r, cfg),
-                                {"row": row["name"], "replica": r, "scene": row["scene"]}, cost))
+                                {"row": row["name"], "replica": r, "scene": row["scene"]}, cost,
+                                legacy_key(cfg, row, r)))
         return runs
 
     def shared(self, runs) -> dict:

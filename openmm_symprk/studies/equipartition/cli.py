@@ -2,16 +2,15 @@
 from __future__ import annotations
 
 import argparse
-import sys
 
-from ..core.cli import add_study_arguments, run_study_command
+from ..core.options import add_study_arguments, run_study
 from ..core.rows import Row
 from . import presets
 
 
 def _rows(text: str) -> list:
-    """'verlet:0.5,omelyan-2 4 fs' -> the row labels (:meth:`~..core.rows.Row.parse`); a row without a step is
-    refused here, an unknown method when the study is configured."""
+    """'verlet:0.5,omelyan-2 4 fs' -> the rows as written (:meth:`~..core.rows.Row.parse` reads both); a row without
+    a step is refused here, an unknown method when the study is configured."""
     rows = [item.strip() for item in text.split(",") if item.strip()]
     for item in rows:
         try:
@@ -22,8 +21,8 @@ def _rows(text: str) -> list:
     return rows
 
 
-def build_parser():
-    ap = argparse.ArgumentParser(prog="symprk equipartition", description=__doc__)
+def build_parser(prog: str = "symprk equipartition"):
+    ap = argparse.ArgumentParser(prog=prog, description=__doc__)
     add_study_arguments(ap, quick="64 waters, short runs: seconds, large error bars", out="equipartition-results",
                         workers="worker processes (each runs one NVE run at a time)",
                         length="NVE length measured per replica")
@@ -34,8 +33,7 @@ def build_parser():
     return ap
 
 
-def main(argv=None) -> int:
-    args = build_parser().parse_args(argv)
+def run(args):
     cfg = presets.quick() if args.quick else presets.full()
 
     def configure(cfg):
@@ -48,14 +46,9 @@ def main(argv=None) -> int:
             base = presets.full()["models"]
             cfg["models"] = {m: cfg["models"].get(m, base[m]) for m in wanted}
         if args.rows:
-            ref = [cfg["reference"][0], float(cfg["reference"][1])]
-            given = [[r.who, r.step_fs] for r in map(Row.parse, args.rows)]
-            rows = ([ref] if ref not in given else []) + given
+            given = [Row.parse(r).label for r in args.rows]
+            rows = ([cfg["reference"]] if cfg["reference"] not in given else []) + given
             cfg["models"] = {m: rows for m in cfg["models"]}
 
-    return run_study_command("symprk equipartition", args, cfg, configure, "openmm_symprk.studies.equipartition.study",
-                             "openmm_symprk.studies.equipartition.report")
-
-
-if __name__ == "__main__":
-    sys.exit(main())
+    run_study(args, cfg, configure, "openmm_symprk.studies.equipartition.study",
+              "openmm_symprk.studies.equipartition.report")

@@ -1,8 +1,8 @@
 """Settings of the equipartition study (data only).
 
-Rows are [method, step in fs] (the who and step of a :class:`~..core.rows.Row`); ``rigid:<method>`` runs the molecules as rigid bodies
-(:class:`openmm_symprk.rigid.bodies.RigidBodies`, ``rigid:verlet`` = NO_SQUISH); any other name is a
-catalogue method run by :class:`~openmm_symprk.SymplecticIntegrator` with RATTLE/SETTLE.
+Rows are labels of the studies' row type (:class:`~..core.rows.Row`), e.g. ``"verlet 2 fs"``; ``rigid:<method>`` runs
+the molecules as rigid bodies (:class:`openmm_symprk.rigid.bodies.RigidBodies`, ``rigid:verlet`` = NO_SQUISH); any
+other catalogue method runs in :class:`~openmm_symprk.SymplecticIntegrator` with RATTLE/SETTLE.
 """
 from __future__ import annotations
 
@@ -19,12 +19,11 @@ def full() -> dict:
         "n_waters": 216, "cutoff_nm": 0.9, "density_g_cm3": 0.997, "temperature": 300.0, "seed": 2024,
         "equilibrate_ps": 20.0, "spacing_ps": 5.0, "replicas": 4,
         "settle_ps": 2.0, "length_ps": 20.0, "sample_fs": 24.0, "threads": 1,
-        "reference": ["verlet", 0.5],
+        "reference": "verlet 0.5 fs",
         "models": {
-            "spce": [["verlet", 0.5], ["verlet", 1.0], ["verlet", 2.0], ["verlet", 3.0],
-                     ["omelyan-2", 4.0], ["pefrl", 4.0],
-                     ["rigid:verlet", 2.0], ["rigid:verlet", 3.0], ["rigid:omelyan-2", 4.0]],
-            "tip3p": [["verlet", 0.5], ["verlet", 2.0], ["omelyan-2", 4.0]],
+            "spce": ["verlet 0.5 fs", "verlet 1 fs", "verlet 2 fs", "verlet 3 fs", "omelyan-2 4 fs", "pefrl 4 fs",
+                     "rigid:verlet 2 fs", "rigid:verlet 3 fs", "rigid:omelyan-2 4 fs"],
+            "tip3p": ["verlet 0.5 fs", "verlet 2 fs", "omelyan-2 4 fs"],
         },
     }
 
@@ -34,5 +33,5 @@ def quick() -> dict:
     cfg = copy.deepcopy(full())
     cfg.update(n_waters=64, cutoff_nm=0.55, equilibrate_ps=1.0, spacing_ps=0.2, replicas=2, settle_ps=0.05,
                length_ps=0.3, sample_fs=12.0)
-    cfg["models"] = {"spce": [["verlet", 0.5], ["verlet", 2.0], ["omelyan-2", 4.0], ["rigid:verlet", 2.0]]}
+    cfg["models"] = {"spce": ["verlet 0.5 fs", "verlet 2 fs", "omelyan-2 4 fs", "rigid:verlet 2 fs"]}
     return cfg

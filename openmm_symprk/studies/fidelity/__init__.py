@@ -5,10 +5,10 @@ temperatures) are the package's analysis kernels, :mod:`openmm_symprk.analysis`,
 keeps in memory; the same kernels run on any trajectory through :mod:`openmm_symprk.analysis.universe`.
 
 The study (``symprk fidelity``, docs/fidelity.md) is built on them and on the study skeleton: :mod:`.presets`
-(its settings and rows, data), :mod:`.rowspec` (a row's description), :mod:`.extrapolation` (an observable
-extrapolated to step size h -> 0, fit a + b h^2), :mod:`.simulation` (a row made into a running OpenMM
-integrator, one run's frames, the replica states shared with the equipartition study), :mod:`.report` (tables,
-pairing, the extrapolated reference, verdicts, chart) and :mod:`.cli`.  Only the pure modules are imported here.
+(its settings and rows, data), :mod:`.rowspec` (a row's description), :mod:`.observables` (every observable of one
+run from its frames), :mod:`.extrapolation` (an observable extrapolated to step size h -> 0, fit a + b h^2),
+:mod:`.simulation` (one run's frames from a replica state, the study), :mod:`.report` (tables, pairing, the
+extrapolated reference, verdicts, chart) and :mod:`.cli`.  Only the pure modules are imported here.
 """
 from . import extrapolation, presets
 

@@ -4,14 +4,13 @@ and against Verlet extrapolated to h -> 0."""
 from __future__ import annotations
 
 import argparse
-import sys
 
-from ..core.cli import add_study_arguments, run_study_command
+from ..core.options import add_study_arguments, run_study
 from . import presets
 
 
-def build_parser():
-    ap = argparse.ArgumentParser(prog="symprk fidelity", description=__doc__)
+def build_parser(prog: str = "symprk fidelity"):
+    ap = argparse.ArgumentParser(prog=prog, description=__doc__)
     add_study_arguments(ap, quick="64 waters, 0.6-ps runs, 2 replicas: seconds, large errors", out="fidelity-results",
                         workers="worker processes (each runs one run at a time)",
                         length="measured length per run (frames every sample_fs)")
@@ -49,8 +48,7 @@ def select_rows(cfg: dict, text: str) -> list:
     return [r for r, lab in zip(cfg["rows"], labels) if lab in keep]
 
 
-def main(argv=None) -> int:
-    args = build_parser().parse_args(argv)
+def run(args):
     cfg = presets.quick() if args.quick else presets.full()
 
     def configure(cfg):
@@ -59,9 +57,4 @@ def main(argv=None) -> int:
         if args.rows:
             cfg["rows"] = select_rows(cfg, args.rows)
 
-    return run_study_command("symprk fidelity", args, cfg, configure, "openmm_symprk.studies.fidelity.simulation",
-                             "openmm_symprk.studies.fidelity.report")
-
-
-if __name__ == "__main__":
-    sys.exit(main())
+    run_study(args, cfg, configure, "openmm_symprk.studies.fidelity.simulation", "openmm_symprk.studies.fidelity.report")

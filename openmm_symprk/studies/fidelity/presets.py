@@ -1,4 +1,4 @@
-"""Settings and rows of the fidelity study (data only; :mod:`.simulation.engines` builds them).
+"""Settings and rows of the fidelity study (data only; :mod:`.simulation` runs them).
 
 A row is one label of the studies' row type (:class:`openmm_symprk.studies.core.rows.Row`; the grammar is in
 that module's docstring), e.g. ``"verlet 2 fs"``, ``"omelyan-2 4 fs SVR 0.1 ps"`` (the package's stochastic velocity
@@ -12,9 +12,7 @@ The references (:data:`REFERENCES`) are rows too, always run: Verlet at 0.5 fs N
 """
 from __future__ import annotations
 
-import copy
-
-__all__ = ["ROWS", "QUICK_ROWS", "REFERENCES", "NVT_TAU_PS", "full", "quick", "first"]
+__all__ = ["ROWS", "QUICK_ROWS", "REFERENCES", "NVT_TAU_PS", "DECIDING", "full", "quick"]
 
 #: Collision time of the package's thermostat in the NVT reference and the new NVT rows (issue 26).
 NVT_TAU_PS = 0.1

@@ -1,6 +1,6 @@
 """Summary, verdicts and chart of the fidelity study (numpy; matplotlib for the chart only).
 
-Per row and observable (:data:`openmm_symprk.analysis.observe.OBSERVABLES`): the mean over replicas with the larger of the within- and
+Per row and observable (:data:`.observables.OBSERVABLES`): the mean over replicas with the larger of the within- and
 between-replica standard errors (:func:`openmm_symprk.stats.combine`); the bias against the reference row
 (Verlet 0.5 fs NVE), replica by replica (:func:`openmm_symprk.stats.paired`: every row starts from the same
 replica states); and the bias against a second reference, Verlet extrapolated to h -> 0: for each replica and
@@ -18,7 +18,7 @@ from ...stats import combine, paired
 from ...support import require
 from ...analysis.diffusion import VISCOSITY_MPAS, yeh_hummer
 from .extrapolation import extrapolate_h2
-from ...analysis.observe import OBSERVABLES
+from .observables import OBSERVABLES
 from .rowspec import describe, is_verlet_limit, to_row
 
 __all__ = ["K_SE", "MATCHED", "TARGETS", "summarise", "format_summary", "markdown_table", "chart", "claim",
@@ -120,14 +120,14 @@ def resolution_needed(n: int, se: float | None, target: float) -> int | None:
     return max(int(n), int(np.ceil(n * (se / target) ** 2)))
 
 
-def summarise(cfg: dict, rows: list, grouped: dict, timings: dict | None = None, unavailable: dict | None = None,
-              box_nm: float | None = None, references: dict | None = None) -> dict:
+def summarise(cfg: dict, rows: list, grouped: dict, timings: dict | None = None, box_nm: float | None = None,
+              references: dict | None = None) -> dict:
     """The study's results from its finished runs (``grouped``: {row label: [(arrays, info) per replica]}),
-    timings ({label: wall seconds per simulated ps}), unavailable rows ({label: why}) and the references
+    timings ({label: wall seconds per simulated ps}) and the references
     ({ensemble: label}; default: the first row for NVE, and the NVT rows against it too).  NVT rows are paired
     with the NVT reference where there is one, NVE rows with the NVE reference; each ensemble's rows also with
     its Verlet rows extrapolated to h -> 0."""
-    timings, unavailable = timings or {}, unavailable or {}
+    timings = timings or {}
     refs = {ens: describe(lab)["label"] for ens, lab in (references or {"NVE": rows[0]}).items()}
     ref_label = refs["NVE"]
     yh = yeh_hummer(box_nm, cfg["temperature"], VISCOSITY_MPAS[cfg["model"]]) if box_nm else None
@@ -138,10 +138,8 @@ def summarise(cfg: dict, rows: list, grouped: dict, timings: dict | None = None,
         entry = {"label": lab, "row": lab, "ensemble": d["ensemble"], "family": d["family"], "hmr": d["hmr"],
                  "reference": refs.get(d["ensemble"], ref_label), "is_reference": lab in refs.values(),
                  "evals_per_ps": d["evals_per_step"] * 1000.0 / d["step_fs"], "s_per_ps": timings.get(lab),
-                 "status": unavailable.get(lab, "ok"), "replicas": 0, "failed": []}
+                 "status": "ok", "replicas": 0, "failed": []}
         table.append(entry)
-        if lab in unavailable:
-            continue
         reps = grouped.get(lab, [])
         good = [(a, i) for a, i in reps if i.get("status") == "ok"]
         entry["failed"] = [str(i["status"]).replace("blew up", "unstable") for _, i in reps if i.get("status") != "ok"]

@@ -1,5 +1,5 @@
 """What a row of the fidelity study is: a label of the studies' one row type, :class:`~..core.rows.Row` (the rows
-are one line each in :mod:`.presets`; :mod:`.simulation.engines` runs them).  A row is stored, and hashed into its
+are one line each in :mod:`.presets`; :mod:`.simulation` runs them).  A row is stored, and hashed into its
 runs' keys, as its canonical label (what :attr:`Row.label` writes back).
 
 :func:`check_row` validates a row and names what is wrong; :func:`label` names it; :func:`to_row` reads it;
@@ -10,10 +10,7 @@ from __future__ import annotations
 
 from ..core.rows import Row
 
-__all__ = ["UNAVAILABLE_THERMOSTAT", "check_row", "describe", "label", "to_row", "is_verlet_limit"]
-
-#: What the output says for a thermostat row this installation cannot run.
-UNAVAILABLE_THERMOSTAT = "unavailable: needs the thermostat"
+__all__ = ["check_row", "describe", "label", "to_row", "is_verlet_limit"]
 
 
 def to_row(row, temperature: float = 300.0) -> Row:

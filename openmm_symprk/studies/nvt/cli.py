@@ -9,10 +9,9 @@
 from __future__ import annotations
 
 import argparse
-import sys
 
 from ...support.files import write_json
-from ..core.cli import positive, run_command
+from ..core.options import positive
 
 
 def _scenes(text):
@@ -23,8 +22,8 @@ def _scenes(text):
     return names
 
 
-def build_parser():
-    p = argparse.ArgumentParser(prog="symprk nvt", description="measurements of the NVT thermostat")
+def build_parser(prog: str = "symprk nvt"):
+    p = argparse.ArgumentParser(prog=prog, description="measurements of the NVT thermostat")
     sub = p.add_subparsers(dest="what", required=True)
     c = sub.add_parser("cost", help="time per step against OpenMM's LangevinMiddleIntegrator (CPU platform)")
     c.add_argument("--quick", action="store_true", help="small water box, few steps (seconds)")
@@ -46,16 +45,8 @@ def build_parser():
     return p
 
 
-def main(argv=None) -> int:
-    argv = list(sys.argv[1:] if argv is None else argv)
-    if argv[:1] == ["drift"]:  # the drift study's nvt preset, under its earlier name
-        from ..drift.cli import main as drift_main
-
-        return drift_main(["nvt", *argv[1:]], prog="symprk nvt drift")
-    args = build_parser().parse_args(argv)
-    if args.what == "known":
-        return run_command("symprk nvt known", lambda: _known(args))
-    return run_command("symprk nvt cost", lambda: _cost(args))
+def run(args):
+    return _known(args) if args.what == "known" else _cost(args)
 
 
 def _known(args):
@@ -75,7 +66,3 @@ def _cost(args):
     if args.json:
         write_json(args.json, tables)
         print(f"wrote {args.json}")
-
-
-if __name__ == "__main__":
-    raise SystemExit(main())

@@ -1,6 +1,6 @@
 """Time per step of NVT integrators against OpenMM's LangevinMiddleIntegrator, in the same run (``symprk nvt cost``).
 
-Every row is timed with :func:`openmm_symprk.studies.timing.interleaved` (the rows take turns in blocks of about
+Every row is timed with :func:`openmm_symprk.studies.core.timing.time_rows` (the rows take turns in blocks of about
 the same duration, round after round), on the CPU platform with a fixed thread count (or another platform: ``--platform OpenCL``), from one shared state.  The
 ratio of a row is the median over rounds of its time per step over LangevinMiddleIntegrator's (2 fs) in the same
 round, with the quartiles (blocks run moments apart share the machine's load); rows that replace another OpenMM
@@ -22,22 +22,17 @@ import os
 import numpy as np
 import openmm as mm
 
-from ..timing import interleaved
+from ..core.engine import RowEngine
+from ..core.timing import time_rows
 from .rows import cost_rows
 
 BASELINE = "LangevinMiddle"
 
 
-def default_rows() -> list:
-    """The rows of the cost table (:data:`.rows.COST_ROWS`): OpenMM's thermostats, ours at interval 1 and 10, NVE for
-    reference, MTS; (name, Row, peer) each."""
-    return cost_rows()
-
-
 def scene(name: str, quick: bool):
     """(title, system, positions, velocities) of a cost scene; ``quick``: a small water box / short equilibration."""
     from ...systems.forcegroups import split_forces
-    from ...systems.scenes import named
+    from ..core import scenes as named
 
     if name == "water":
         sc = named.water_box_pme(box_nm=2.2 if quick else 3.9)
@@ -51,34 +46,14 @@ def scene(name: str, quick: bool):
 
 def measure(system, positions, velocities, rows, steps, rounds: int, threads: int = 2,
             platform: str = "CPU") -> dict:
-    """{row name: (seconds per step of the fastest block, force evaluations per step)}; rows take turns.
-    ``steps``: steps per block (an int), or a float number of seconds: each row's block is sized to last about
-    that long (from a timed warm-up block), so a 17x slower row does not take 17x the run's time and every row
-    gets equally many short blocks, the likelier to catch a quiet moment of a shared machine."""
-    plat = mm.Platform.getPlatformByName(platform)
-    props = {"Threads": str(threads)} if platform == "CPU" else {}
-    contexts, evals = {}, {}
-    for name, row, _ in rows:
-        ig, evals[name] = row.build(system), row.evals_per_step(system.getNumConstraints() > 0)
-        ctx = mm.Context(system, ig, plat, props)
-        ctx.setPositions(positions)
-        ctx.setVelocities(velocities)
-        ig.step(3)  # warm-up: neighbour lists, kernels, caches
-        contexts[name] = (ctx, ig)
-    if isinstance(steps, float):
-        per_step = interleaved({k: lambda n, ig=ig: ig.step(n) for k, (_, ig) in contexts.items()}, 2, rounds=1)
-        steps = {k: int(min(400, max(2, round(steps / t.best)))) for k, t in per_step.items()}
-
-    def stepper(ctx, ig):
-        def advance(n):
-            ig.step(n)
-            # the work is done: an empty State is no sync on OpenCL/CUDA (a step there only queues kernels), the
-            # positions are (one download per block, the same for every row)
-            ctx.getState(getPositions=platform != "CPU")
-        return advance
-
-    timings = interleaved({k: stepper(*v) for k, v in contexts.items()}, steps, rounds=rounds)
-    return {k: (t, evals[k]) for k, t in timings.items()}
+    """{row name: (Timing, force evaluations per step)}; rows take turns (:func:`..core.timing.time_rows`, 3 steps
+    of warm-up).  ``steps``: steps per block (an int), or a float number of seconds: each row's block is sized to
+    last about that long, so that every row gets equally many short blocks, the likelier to catch a quiet moment of
+    a shared machine."""
+    engines = {name: RowEngine(row, system, positions, velocities, platform=platform, threads=threads, start=False)
+               for name, row, _ in rows}
+    evals = {name: row.evals_per_step(system.getNumConstraints() > 0) for name, row, _ in rows}
+    return {k: (t, evals[k]) for k, t in time_rows(engines, steps, rounds, warmup=3).items()}
 
 
 def paired_ratio(row, base) -> tuple:
@@ -139,11 +114,11 @@ def run(scenes=("water", "villin"), quick: bool = False, steps=None, rounds: int
     from ... import plugin
 
     if not plugin.available():
-        raise RuntimeError(f"the native backend is unavailable: {plugin.unavailable_reason()}")
+        raise plugin.NativeUnavailableError(f"the native backend is unavailable: {plugin.unavailable_reason()}")
     where = f"platform CPU, {threads} threads" if platform == "CPU" else f"platform {platform}"
     log(f"openmm {mm.version.full_version}, {where}, load average before "
         f"{os.getloadavg()[0]:.2f} (other processes slow some blocks; each row keeps its fastest)")
-    rows = [r for r in default_rows() if not (no_forces and r[1].mts)]  # no forces, no groups
+    rows = [r for r in cost_rows() if not (no_forces and r[1].mts)]  # no forces, no groups
     out = {}
     for name in scenes:
         title, system, x, v = scene(name, quick)

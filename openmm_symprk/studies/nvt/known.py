@@ -12,41 +12,22 @@ The test-suite asserts the same numbers (tests/integrators/test_thermostat_known
 from __future__ import annotations
 
 import math
-import warnings
 from dataclasses import dataclass
 
 import numpy as np
-import openmm as mm
 import openmm.unit as unit
 
 from ...integrators.noise import sample_thermostat_noise
+from ..core.platforms import names
+from ...systems.scenes import harmonic_oscillators
 from ...physics.temperature import R_KJ
 from ...stats import SeriesStats, series_stats
 
-__all__ = ["OSCILLATORS", "harmonic_oscillators", "stationary_temperatures", "exact_temperatures", "noise_draws",
-           "run"]
+__all__ = ["OSCILLATORS", "stationary_temperatures", "exact_temperatures", "noise_draws", "run"]
 
 #: the oscillators' case: count, temperature (K), step (ps), h w, collision time (ps; c = exp(-h/tau) = 0.018, so the
 #: kinetic energy at the thermostat point is nearly fresh every step)
 OSCILLATORS = dict(n=1000, temperature=300.0, step=0.002, h_omega=0.5, collision_time=0.0005)
-
-
-def harmonic_oscillators(n: int, k: float, temperature: float, seed: int = 2024):
-    """(System, x, v): ``n`` oscillators of mass 1 Da and force constant ``k`` (kJ/mol/nm^2) about the origin,
-    canonical positions and velocities at ``temperature`` with the centre of mass at rest at the origin, where it
-    stays (the thermostat keeps its velocity; the 3 n - 3 other degrees of freedom are the thermostatted ones)."""
-    system = mm.System()
-    force = mm.CustomExternalForce("0.5*k*(x*x + y*y + z*z)")
-    force.addGlobalParameter("k", k)
-    for i in range(n):
-        system.addParticle(1.0)
-        force.addParticle(i, [])
-    system.addForce(force)
-    rng = np.random.default_rng(seed)
-    kT = R_KJ * temperature
-    x = rng.normal(0.0, math.sqrt(kT / k), (n, 3))
-    v = rng.normal(0.0, math.sqrt(kT), (n, 3))
-    return system, x - x.mean(0), v - v.mean(0)
 
 
 def exact_temperatures(position: str, h_omega: float = OSCILLATORS["h_omega"]) -> tuple:
@@ -65,30 +46,26 @@ class Stationary:
 
 def stationary_temperatures(backend: str, platform: str, position: str, samples: int, seed: int = 17,
                             properties: dict | None = None) -> Stationary:
-    """The oscillators of :data:`OSCILLATORS` after 300 steps, sampled every step ``samples`` times."""
-    from ...integrators import SymplecticIntegrator
-    from ...systems.checks import ConservationWarning
+    """The oscillators of :data:`OSCILLATORS` after 300 steps, sampled every step ``samples`` times (``properties``:
+    the platform's, e.g. {"Precision": "double"})."""
+    from ..core.engine import RowEngine
+    from ..core.rows import Row
 
     case = OSCILLATORS
     k = (case["h_omega"] / case["step"]) ** 2
     system, x, v = harmonic_oscillators(case["n"], k, case["temperature"])
-    with warnings.catch_warnings():  # (the oscillators' external field breaks momentum conservation: known)
-        warnings.simplefilter("ignore", ConservationWarning)
-        ig = SymplecticIntegrator(case["step"], "verlet", system=system, backend=backend,
-                                  temperature=case["temperature"], collision_time=case["collision_time"],
-                                  random_seed=seed, thermostat_position=position)
-    ctx = mm.Context(system, ig, mm.Platform.getPlatformByName(platform), dict(properties or {}))
-    ctx.setPositions(x)
-    ctx.setVelocities(v)
-    ig.step(300)
+    precision = (properties or {}).get("Precision")
+    row = Row("verlet", case["step"] * 1e3, tau_ps=case["collision_time"], position=position,
+              temperature=case["temperature"], backend=backend, seed=seed)
+    eng = RowEngine(row, system, x, v, platform=f"{platform}:{precision}" if precision else platform, threads=None)
+    eng.step(300)
     dof_kT = (3 * case["n"] - 3) * R_KJ * case["temperature"]
     q, kin = np.empty(samples), np.empty(samples)
-    kj = unit.kilojoule_per_mole
     for i in range(samples):
-        ig.step(1)
-        q[i] = 2 * ctx.getState(getEnergy=True).getPotentialEnergy().value_in_unit(kj) / dof_kT
-        kin[i] = 2 * ig.thermostat_kinetic_energy().value_in_unit(kj) / dof_kT
-    del ctx
+        eng.step(1)
+        q[i] = 2 * eng.sample(positions=False, velocities=False).pe / dof_kT
+        kin[i] = 2 * eng.integrator.thermostat_kinetic_energy().value_in_unit(unit.kilojoule_per_mole) / dof_kT
+    del eng
     return Stationary(backend, platform, position, series_stats(q), series_stats(kin))
 
 
@@ -97,15 +74,11 @@ def noise_draws(k: int, resolution: float = 0.0005) -> int:
     return math.ceil(2.0 / (k * resolution ** 2))
 
 
-def _platforms() -> list:
-    return [mm.Platform.getPlatform(i).getName() for i in range(mm.Platform.getNumPlatforms())]
-
-
 def run(quick: bool = False, platforms=None, log=print) -> dict:
     """Print both tables and return them as {"noise": [...], "oscillators": [...]} (plain numbers)."""
     from ... import plugin
 
-    platforms = [p for p in (platforms or ["Reference", "CPU", "OpenCL"]) if p in _platforms()]
+    platforms = [p for p in (platforms or ["Reference", "CPU", "OpenCL"]) if p in names()]
     native = set(plugin.platforms()) if plugin.available() else set()
     double = {"OpenCL": {"Precision": "double"}, "CUDA": {"Precision": "double"}}
     out = {"noise": [], "oscillators": []}

@@ -8,6 +8,8 @@
   forces in a handful of atoms, the smallest OpenMM system that measures convergence orders.
 
 * :func:`water_box` -- the periodic box of rigid water (PME) that the studies and the bench measure on.
+* :func:`harmonic_oscillators` -- independent 3-d harmonic oscillators about the origin in a canonical state: the
+  thermostat's known answers (exact stationary temperatures).
 
 Every scene returns a :class:`~.scene.Scene` (system, positions, velocities, topology) built from a seed, so
 all runs of a study start from one shared state.
@@ -243,3 +245,23 @@ def _scale_to_density(topology, positions, density_g_cm3):
         out[idx] += (scale - 1.0) * com
     topology.setUnitCellDimensions(mm.Vec3(edge, edge, edge) * unit.nanometer)
     return out
+
+
+def harmonic_oscillators(n: int, k: float, temperature: float, seed: int = 2024):
+    """(System, x, v): ``n`` oscillators of mass 1 Da and force constant ``k`` (kJ/mol/nm^2) about the origin,
+    canonical positions and velocities at ``temperature`` with the centre of mass at rest at the origin, where it
+    stays (the thermostat keeps its velocity; the 3 n - 3 other degrees of freedom are the thermostatted ones)."""
+    from ...physics.temperature import R_KJ
+
+    system = mm.System()
+    force = mm.CustomExternalForce("0.5*k*(x*x + y*y + z*z)")
+    force.addGlobalParameter("k", k)
+    for i in range(n):
+        system.addParticle(1.0)
+        force.addParticle(i, [])
+    system.addForce(force)
+    rng = np.random.default_rng(seed)
+    kT = R_KJ * temperature
+    x = rng.normal(0.0, np.sqrt(kT / k), (n, 3))
+    v = rng.normal(0.0, np.sqrt(kT), (n, 3))
+    return system, x - x.mean(0), v - v.mean(0)

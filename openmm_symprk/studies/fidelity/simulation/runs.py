@@ -6,7 +6,9 @@ then samples every ``sample_fs`` for ``length_ps``: the kinetic temperatures (:m
 3 N - 3 translational degrees of freedom when the row keeps the total momentum), potential and effective energy
 (total + heat bath), the molecules' centres of mass, dipole and H-H unit vectors, and every ``rdf_every``-th
 frame's oxygen positions.  Frames are reduced in the worker; what is kept is each observable with its error
-(:mod:`openmm_symprk.analysis.observe`), the time series of the equipartition study (t, T_trans, T_rot, pe, etot) and the curves.
+(:mod:`..observables`), the time series of the equipartition study (t, T_trans, T_rot, pe, etot) and the curves.
+The row runs in :class:`~...core.engine.RowEngine` (a leapfrog integrator from v(-h/2): the positions of velocity
+Verlet from the replica state, so OpenMM's NVE rows keep the replica's energy).
 """
 from __future__ import annotations
 
@@ -18,13 +20,12 @@ import openmm.unit as unit
 
 from ....analysis.angular import angular_velocities
 from ....analysis.molecules import centre_of_mass_trajectory
-from ....analysis.observe import observables
 from ....analysis.reorientation import atom_vectors, dipole_vectors
 from ....physics.momenta import kinetic_energy
 from ....physics.temperature import kinetic_temperatures
-from ...equipartition.runs import steps_per_sample
-from ..rowspec import describe
-from .engines import Engine
+from ...core.engine import RowEngine
+from ..observables import observables
+from ..rowspec import describe, to_row
 
 __all__ = ["run_row", "replica_seed", "charges", "unstable", "UNSTABLE"]
 
@@ -65,7 +66,8 @@ def run_row(scene, x, v, row: dict, cfg: dict, replica: int):
     """One run of ``row`` from the replica state (x, v) of ``scene``; returns (arrays, info).  info: status
     ("ok" or "unstable at step S", :func:`unstable`), wall_s, steps, force_evals, obs {key: [value, se] or None}, notes."""
     t0 = time.perf_counter()
-    eng = Engine(scene, x, v, row, float(cfg["temperature"]), replica_seed(cfg, replica), cfg.get("threads", 1))
+    spec = to_row(row, cfg["temperature"])
+    eng = RowEngine(spec, scene, x, v, threads=cfg.get("threads", 1), seed=replica_seed(cfg, replica))
     info = describe(row)
     h = info["step_fs"]
     mols, m, q = scene.molecules, eng.masses, charges(scene.system)
@@ -88,8 +90,7 @@ def run_row(scene, x, v, row: dict, cfg: dict, replica: int):
             raise Unstable() from None
         steps += n
 
-    every_w = steps_per_sample(h, cfg["omega_fs"])
-    every = steps_per_sample(h, cfg["sample_fs"])
+    every_w, every = spec.steps_for(cfg["omega_fs"]), spec.steps_for(cfg["sample_fs"])
     n = int(round(cfg["length_ps"] * 1000.0 / (every * h))) + 1
     keys = ("t", "T_trans", "T_rot", "pe", "etot")
     out = {k: np.full(n, np.nan) for k in keys}
@@ -99,7 +100,7 @@ def run_row(scene, x, v, row: dict, cfg: dict, replica: int):
         for i in range(int(round(cfg["omega_ps"] * 1000.0 / (every_w * h))) + 1):
             if i:
                 advance(every_w)
-            xw, vw, _ = eng.sample(energy=False)
+            xw, vw, _, _ = eng.sample(energy=False)
             xs_w.append(xw)
             vs_w.append(vw)
     except Unstable:
@@ -115,7 +116,7 @@ def run_row(scene, x, v, row: dict, cfg: dict, replica: int):
                 advance(every)
             except Unstable:
                 break
-        xs, vs, pe = eng.sample()
+        xs, vs, pe, _ = eng.sample()
         kt = kinetic_temperatures(xs, vs, m, mols, info["keeps_momentum"], n_constraints)
         bath = eng.heat_bath()
         etot = pe + kinetic_energy(vs, m) + (bath or 0.0)

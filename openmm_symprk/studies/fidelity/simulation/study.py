@@ -1,15 +1,14 @@
-"""Run the fidelity study: the equipartition study's replica states, one run per (row, replica), kept on disk.
+"""Run the fidelity study: the rigid-water box's replica states, one run per (row, replica), kept on disk.
 
     from openmm_symprk.studies.fidelity import presets
     from openmm_symprk.studies.fidelity.simulation import run_study
     summary = run_study(presets.quick(), "fidelity-quick", workers=2)
 
-``<out>/states/<model>-<key>.npz`` holds the replica states (the same file, key and states as
-``symprk equipartition`` makes for the same box and equilibration settings), ``<out>/runs/<key>.json`` (+ .npz)
-one finished run each; a key hashes everything a run depends on (box, states, row, replica, lengths, the
-observables' settings), so a second call reuses every finished run and a changed setting never reuses a stale
-one.  Rows this installation cannot run (the package's thermostat rows before the thermostat exists) are planned
-no runs and reported "unavailable: ..."; nothing of theirs is stored, so they run once the thermostat is there.
+``<out>/states/<model>-<key>.npz`` holds the replica states (:func:`~...core.replicas.water_box_replicas`: the same
+file, key and states as ``symprk equipartition`` makes for the same box and equilibration settings),
+``<out>/runs/<key>.json`` (+ .npz) one finished run each; a key (:func:`~...core.store.run_key`) hashes everything a
+run depends on (box, states, row label, replica, lengths, the observables' settings), so a second call reuses every
+finished run and a changed setting never reuses a stale one.
 """
 from __future__ import annotations
 
@@ -17,16 +16,15 @@ import os
 import warnings
 
 from ....systems.checks import ConservationWarning
-from ...core import Run, Study, run_key as hash_key, write_json, write_text
-from ...equipartition.study import STATE_KEYS, STATE_VERSION, replica_state_set
-from ..rowspec import check_row, describe, to_row
-from .engines import availability
+from ...core import Run, Study, run_key as row_run_key, write_json, write_text
+from ...core.replicas import BOX_STATE_KEYS, BOX_STATE_VERSION, water_box_replicas, water_box_scene
+from ..rowspec import check_row, to_row
 
 __all__ = ["FidelityStudy", "run_study", "run_key", "temperature_view", "RUN_KEYS", "RUN_VERSION"]
 
 #: What a run depends on besides its row and replica (the observables are computed in the run: their settings too).
-RUN_KEYS = STATE_KEYS + ("model", "settle_ps", "omega_ps", "omega_fs", "omega_max_lag_ps", "length_ps",
-                         "sample_fs", "rdf_every", "msd_window_ps", "tau_fit", "rdf_r_min_nm")
+RUN_KEYS = BOX_STATE_KEYS + ("model", "settle_ps", "omega_ps", "omega_fs", "omega_max_lag_ps", "length_ps",
+                             "sample_fs", "rdf_every", "msd_window_ps", "tau_fit", "rdf_r_min_nm")
 #: Version of what a run stores; a run stored by another version is never reused (2: rows stored as their labels;
 #: leapfrog integrators started from v(-h/2); blow-ups recorded as "unstable at step N").
 RUN_VERSION = 2
@@ -36,8 +34,8 @@ TIMINGS = "timings.json"
 
 
 def run_key(cfg: dict, row, replica: int) -> str:
-    return hash_key({"cfg": {k: cfg[k] for k in RUN_KEYS}, "row": check_row(row), "replica": int(replica),
-                     "states": STATE_VERSION, "version": RUN_VERSION})
+    return row_run_key(check_row(row), replica, {k: cfg[k] for k in RUN_KEYS}, states=BOX_STATE_VERSION,
+                       version=RUN_VERSION)
 
 
 def references(cfg: dict, rows: list) -> dict:
@@ -65,13 +63,12 @@ _boxes: dict = {}
 
 def work(shared: dict, row: dict, replica: int):
     """One run in whatever process executes it (the box is built once per process)."""
-    from ...equipartition.runs import build_box
     from .runs import run_row
 
     cfg = shared["cfg"]
     key = (cfg["model"], cfg["n_waters"], cfg["cutoff_nm"], cfg["density_g_cm3"])
     if key not in _boxes:
-        _boxes[key] = build_box(cfg, cfg["model"])
+        _boxes[key] = water_box_scene(cfg, cfg["model"])
     return run_row(_boxes[key], shared["x"][replica], shared["v"][replica], row, cfg, replica)
 
 
@@ -100,7 +97,7 @@ def check(cfg: dict) -> list:
 
 
 class FidelityStudy(Study):
-    """One run per (available row, replica) from the replica states of the model's box."""
+    """One run per (row, replica) from the replica states of the model's box."""
 
     command = "symprk fidelity"
     work = work
@@ -110,7 +107,7 @@ class FidelityStudy(Study):
         self.rows = check(cfg)
         super().__init__(out, workers, scheduler, progress, log)
         self.cfg, self.timing, self.report_only = cfg, timing, False
-        self.states, self.unavailable, self.box = None, {}, None
+        self.states, self.box = None, None
 
     def plan(self) -> list:
         with warnings.catch_warnings():  # the periodic box's angular-momentum warning: expected here
@@ -118,23 +115,14 @@ class FidelityStudy(Study):
             return self._plan()
 
     def _plan(self) -> list:
-        from ...equipartition.runs import build_box
-
         cfg = self.cfg
-        self.states = replica_state_set(cfg, cfg["model"], self.out, self.log)
-        self.box = build_box(cfg, cfg["model"])
+        self.states = water_box_replicas(cfg, cfg["model"], self.out, self.log)
+        self.box = water_box_scene(cfg, cfg["model"])
         runs = []
-        for row in self.rows:
-            lab = describe(row)["label"]
-            why = availability(row, self.box, float(cfg["temperature"]))
-            if why:
-                self.unavailable[lab] = why
-                self.log(f"{lab}: {why}")
-                continue
-            for r in range(int(cfg["replicas"])):
-                cost = describe(row)["evals_per_step"] * (cfg["settle_ps"] + cfg["omega_ps"] + cfg["length_ps"]) \
-                    / to_row(row).step_fs
-                runs.append(Run(run_key(cfg, row, r), "box", (row, r), {"row": lab, "replica": r}, cost))
+        for row in map(to_row, self.rows):
+            cost = row.evals_per_ps(True) * (cfg["settle_ps"] + cfg["omega_ps"] + cfg["length_ps"])
+            runs += [Run(run_key(cfg, row.label, r), "box", (row.label, r), {"row": row.label, "replica": r}, cost)
+                     for r in range(int(cfg["replicas"]))]
         return runs
 
     def shared(self, runs) -> dict:
@@ -152,7 +140,7 @@ class FidelityStudy(Study):
             warnings.simplefilter("ignore", ConservationWarning)
             timings = self.stored_timings() if self.report_only or not self.timing else self.timings()
         grouped = {k[0]: v for k, v in self.results(runs, ("row",)).items()}
-        summary = summarise(self.cfg, self.rows, grouped, timings, self.unavailable, self.box_edge(),
+        summary = summarise(self.cfg, self.rows, grouped, timings, self.box_edge(),
                             references(self.cfg, self.rows))
         # the temperature view needs each run's time series (<key>.npz), which a committed data set leaves out
         with_series = {lab: [rep for rep in reps if len(rep[0].get("t", ()))] for lab, reps in grouped.items()}
@@ -160,10 +148,10 @@ class FidelityStudy(Study):
         write_text(os.path.join(self.out, "summary.txt"), format_summary(summary) + "\n")
         write_text(os.path.join(self.out, "table.md"), markdown_table(summary) + "\n")
         if summary["temperature_view"]:
-            from ...equipartition.report import format_summary as equipartition_summary
+            from ...core.temperatures import format_summary as temperature_table
 
             write_text(os.path.join(self.out, "equipartition.txt"),
-                       equipartition_summary(summary["temperature_view"]) + "\n")
+                       temperature_table(summary["temperature_view"]) + "\n")
         write_json(os.path.join(self.out, "results.json"), summary)
         try:
             chart(summary, os.path.join(self.out, "fidelity.png"))
@@ -189,24 +177,16 @@ class FidelityStudy(Study):
             return {}
 
     def timings(self) -> dict:
-        """Seconds per simulated ps of each available row on replica 0, measured in turns
-        (:func:`openmm_symprk.studies.timing.interleaved`), so the ratios hold under the machine's load."""
-        from ...timing import interleaved
-        from .engines import Engine
+        """Seconds per simulated ps of each available row on replica 0, timed in turns
+        (:func:`openmm_symprk.studies.core.timing.time_rows`), so the ratios hold under the machine's load."""
+        from ...core.timing import seconds_per_ps
         from .runs import replica_seed
 
         x, v = self.states
-        engines = {}
-        for row in self.rows:
-            lab = describe(row)["label"]
-            if lab not in self.unavailable:
-                engines[lab] = (to_row(row).step_fs, Engine(self.box, x[0], v[0], row, float(self.cfg["temperature"]),
-                                                       replica_seed(self.cfg, 0), self.cfg.get("threads", 1)))
-        block = float(self.cfg.get("timing_fs", 50.0))
-        steps = {k: max(1, int(round(block / h))) for k, (h, _) in engines.items()}
-        res = interleaved({k: e.step for k, (_, e) in engines.items()}, steps, rounds=3)
-        self.log(f"timed {len(engines)} rows in turns")
-        out = {k: tm.best / (engines[k][0] * 1e-3) for k, tm in res.items()}
+        rows = {r.label: r for r in (to_row(row, self.cfg["temperature"]) for row in self.rows)}
+        out = seconds_per_ps(rows, self.box, x[0], v[0], float(self.cfg.get("timing_fs", 50.0)),
+                             self.cfg.get("threads", 1), replica_seed(self.cfg, 0))
+        self.log(f"timed {len(rows)} rows in turns")
         import platform
         import time
 
@@ -216,29 +196,27 @@ class FidelityStudy(Study):
             "s_per_ps": out, "when": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()),
             "machine": f"{platform.machine()} {os.cpu_count()} cores, OpenMM {mm.__version__} CPU platform, "
                        f"{self.cfg.get('threads', 1)} thread(s) per run",
-            "how": "each row on replica 0, in turns (studies.timing.interleaved), best of 3 rounds"})
+            "how": "each row on replica 0, in turns (studies.core.timing), best of 3 rounds"})
         return out
 
 
 def temperature_view(cfg: dict, rows: list, grouped: dict, timings: dict) -> dict | None:
-    """The equipartition study's summary (:func:`openmm_symprk.studies.equipartition.report.summarise`: T_rot -
+    """The equipartition study's table (:func:`openmm_symprk.studies.core.temperatures.summarise`: T_rot -
     T_trans, T_trans, PE per molecule, drift, the published Verlet trend, the cheapest match) of this study's
     stored runs of the package's NVE rows without HMR: every such run keeps the equipartition study's time
     series (t, T_trans, T_rot, pe, etot), so the view needs no run of its own.  None without such rows."""
-    from ...equipartition.report import summarise as equipartition_summarise
+    from ...core.temperatures import summarise
 
     nve = [to_row(r) for r in rows]
-    nve = [r for r in nve if r.is_ours and r.ensemble == "NVE" and r.hmr_da is None and not r.mts]
-    if not nve or not any(grouped.get(r.label) for r in nve):
+    nve = [r.label for r in nve if r.is_ours and r.ensemble == "NVE" and r.hmr_da is None and not r.mts]
+    if not nve or not any(grouped.get(lab) for lab in nve):
         return None
     model = cfg["model"]
-    eq_cfg = {k: cfg[k] for k in ("n_waters", "cutoff_nm", "density_g_cm3", "temperature", "settle_ps",
-                                  "length_ps", "sample_fs")}
-    eq_cfg.update(reference=[nve[0].method, nve[0].step_fs],
-                  models={model: [[r.method, r.step_fs] for r in nve]})
-    runs = {(model, r.method, r.step_fs): grouped.get(r.label, []) for r in nve}
-    eq_timings = {(model, r.method, r.step_fs): timings[r.label] for r in nve if r.label in timings}
-    return equipartition_summarise(eq_cfg, runs, eq_timings)
+    view = {k: cfg[k] for k in ("n_waters", "cutoff_nm", "density_g_cm3", "temperature", "settle_ps", "length_ps",
+                                "sample_fs")}
+    view.update(reference=nve[0], models={model: nve})
+    return summarise(view, {(model, lab): grouped.get(lab, []) for lab in nve},
+                     {(model, lab): timings[lab] for lab in nve if lab in timings})
 
 
 def run_study(cfg: dict, out: str, workers: int = 2, timing: bool = True, progress: bool = True, log=print,

@@ -1,7 +1,7 @@
 """Benchmark of the native backend against OpenMM's VerletIntegrator and the CustomIntegrator path.
 
-    python -m openmm_symprk.studies.native_speed            # CPU platform, both systems (a few minutes)
-    python -m openmm_symprk.studies.native_speed --quick    # fewer steps
+    symprk speed            # CPU platform, both systems (a few minutes)
+    symprk speed --quick    # fewer steps
 
 Prints, per system, the time per step of OpenMM's VerletIntegrator and, for each method, of the native
 integrator and of the CustomIntegrator (``openmm_symprk.SymplecticIntegrator``), with the ratios
@@ -20,22 +20,26 @@ import argparse
 
 import openmm as mm
 
-from .core.rows import Row
-from .timing import interleaved
+from ..core.engine import RowEngine
+from ..core.rows import Row
+from ..core.timing import time_rows
 
 DEFAULT_METHODS = ("verlet", "omelyan-2", "yoshida-4", "blanes-moan-srkn6b-4", "kahan-li-6")
 
 
 def water_cluster_system(n_waters: int):
-    from ..systems.scenes import water_cluster
+    """(title, System, positions, velocities): a rigid water cluster in vacuum, minimised."""
+    from ...systems.scenes import water_cluster
 
     sc = water_cluster(n_waters, minimize=True)
     return f"rigid water cluster, vacuum, {sc.n_atoms} atoms", sc.system, sc.positions, sc.velocities
 
 
-def water_box_system(box_nm: float):
-    from ..systems.prepare import maxwell_boltzmann, minimise
-    from ..systems.scenes import water_box
+def water_box_system(box_nm: float = 3.9):
+    """(title, System, positions, velocities): a periodic rigid TIP3P box (about 6,000 atoms at 3.9 nm; Modeller's
+    water, PME, 1 nm cutoff), minimised, velocities at 300 K."""
+    from ...systems.prepare import maxwell_boltzmann, minimise
+    from ...systems.scenes import water_box
 
     system, _, x = water_box("tip3p", box_nm=box_nm, cutoff_nm=1.0)
     pos = minimise(system, x, "CPU", tolerance=10.0, max_iterations=200)
@@ -43,37 +47,17 @@ def water_box_system(box_nm: float):
     return f"rigid TIP3P water box, PME 1 nm, {system.getNumParticles()} atoms", system, pos, vel
 
 
-def _contexts(system, pos, vel, platform, properties, entries):
-    out = {}
-    for key, make in entries:
-        ig = make()
-        ctx = mm.Context(system, ig, mm.Platform.getPlatformByName(platform), properties)
-        ctx.setPositions(pos)
-        ctx.setVelocities(vel)
-        ig.step(3)  # warm-up: kernels compiled, forces cached
-        out[key] = (ctx, ig)
-    return out
-
-
-def measure(system, pos, vel, methods, platform="CPU", properties=None, steps=100, repeats=3, dt_fs=2.0,
-            custom=True, log=print) -> dict:
-    """Seconds per step for every integrator; keys 'openmm-verlet', 'native:<m>', 'custom:<m>'."""
-    from ..integrators import native_available
+def measure(system, pos, vel, methods, platform="CPU", steps=100, repeats=3, dt_fs=2.0, custom=True) -> dict:
+    """Seconds per step (fastest block, rows in turns: :func:`..core.timing.time_rows`) of every integrator; keys
+    'openmm-verlet', 'native:<m>', 'custom:<m>'.  ``platform``: NAME or NAME:PRECISION."""
+    from ...integrators import native_available
 
     backends = (["native"] if native_available() else []) + (["custom"] if custom else [])
     rows = {"openmm-verlet": Row("openmm-verlet", dt_fs)}
     rows.update({f"{b}:{m}": Row(m, dt_fs, backend=b) for m in methods for b in backends})
-    entries = [(key, lambda row=row: row.build(system, quiet=False)) for key, row in rows.items()]
-    ctxs = _contexts(system, pos, vel, platform, properties or {}, entries)
-
-    def stepper(ctx, ig):
-        def advance(n):
-            ig.step(n)
-            ctx.getState(getPositions=True)  # finish queued work (OpenCL)
-        return advance
-
-    timings = interleaved({k: stepper(ctx, ig) for k, (ctx, ig) in ctxs.items()}, steps, rounds=repeats)
-    return {k: t.best for k, t in timings.items()}
+    engines = {k: RowEngine(row, system, pos, vel, platform=platform, threads=None, start=False, quiet=False)
+               for k, row in rows.items()}
+    return {k: t.best for k, t in time_rows(engines, steps, repeats, warmup=3).items()}
 
 
 def format_table(title, best, methods, constraints: bool = True) -> str:
@@ -92,9 +76,8 @@ def format_table(title, best, methods, constraints: bool = True) -> str:
     return "\n".join(lines)
 
 
-def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m openmm_symprk.studies.native_speed",
-                                 description=__doc__.split("\n\n")[0])
+def build_parser(prog: str = "symprk speed"):
+    ap = argparse.ArgumentParser(prog=prog, description=__doc__.split("\n\n")[0])
     ap.add_argument("--platform", default="CPU")
     ap.add_argument("--precision", default=None, help="OpenCL/CUDA precision property (single, mixed, double)")
     ap.add_argument("--methods", default=",".join(DEFAULT_METHODS))
@@ -107,21 +90,22 @@ def main(argv=None) -> int:
     ap.add_argument("--quick", action="store_true", help="fewer steps and repeats (a rough look)")
     ap.add_argument("--no-forces", action="store_true",
                     help="remove every force (constraints stay): times the integrators' own work alone")
-    args = ap.parse_args(argv)
-    from .. import plugin
+    return ap
+
+
+def run(args):
+    from ... import plugin
 
     if not plugin.available():
-        print(f"native backend unavailable: {plugin.unavailable_reason()}")
-        return 1
+        raise plugin.NativeUnavailableError(f"the native backend is unavailable: {plugin.unavailable_reason()}")
     if args.platform not in plugin.platforms():
-        print(f"no native kernel for platform {args.platform} (have: {', '.join(plugin.platforms())})")
-        return 1
+        raise ValueError(f"--platform {args.platform}: no native kernel for it (have: {', '.join(plugin.platforms())})")
     methods = [m.strip() for m in args.methods.split(",") if m.strip()]
-    props = {"Precision": args.precision} if args.precision else {}
+    platform = f"{args.platform}:{args.precision}" if args.precision else args.platform
     import os
 
     print(f"load average before: {os.getloadavg()[0]:.2f} (other processes on this machine skew every timing)")
-    print(f"openmm {mm.version.full_version}, platform {args.platform} {props or ''}, "
+    print(f"openmm {mm.version.full_version}, platform {platform}, "
           f"threads: {mm.Platform.getPlatformByName(args.platform).getPropertyDefaultValue('Threads') if args.platform == 'CPU' else '-'}")
     for which in args.systems.split(","):
         if which == "cluster":
@@ -131,18 +115,13 @@ def main(argv=None) -> int:
             title, system, pos, vel = water_box_system(args.box_nm)
             steps = args.steps or (20 if args.quick else 100)
         else:
-            raise SystemExit(f"unknown system {which!r} (cluster, box)")
+            raise ValueError(f"--systems: unknown system {which!r}; known: cluster, box")
         if args.no_forces:
             while system.getNumForces():
                 system.removeForce(0)
             title += ", no forces (integrator work only)"
-        best = measure(system, pos, vel, methods, args.platform, props, steps=steps,
-                       repeats=1 if args.quick else args.repeats, custom=not args.no_custom)
+        best = measure(system, pos, vel, methods, platform, steps=steps, repeats=1 if args.quick else args.repeats,
+                       custom=not args.no_custom)
         print(format_table(f"{title}: {steps} steps x best of {1 if args.quick else args.repeats}", best, methods,
                            system.getNumConstraints() > 0))
     print(f"load average after: {os.getloadavg()[0]:.2f}")
-    return 0
-
-
-if __name__ == "__main__":
-    raise SystemExit(main())

@@ -3,9 +3,9 @@ of this replica, or None with the reason in ``notes``.  Units: nm, ps, K, kJ/mol
 
 The list :data:`OBSERVABLES` (key, what, unit) is the order of the study's tables.  Per replica:
 
-* ``D`` -- :func:`.diffusion.self_diffusion` of the molecules' centres of mass over ``msd_window_ps``, the
+* ``D`` -- :func:`openmm_symprk.analysis.diffusion.self_diffusion` of the molecules' centres of mass over ``msd_window_ps``, the
   common centre's motion taken out (molecules' error); uncorrected (the Yeh-Hummer value is added in the report);
-* ``tau1_dip`` ... ``tau2_hh`` -- :func:`.reorientation.reorientation_time` of the dipole and H-H unit vectors,
+* ``tau1_dip`` ... ``tau2_hh`` -- :func:`openmm_symprk.analysis.reorientation.reorientation_time` of the dipole and H-H unit vectors,
   C_l fitted over ``tau_fit`` = (c_cut, c_fit) (jackknife over molecules);
 * ``w_zero``, ``w_min``, ``w_int`` -- the angular-velocity autocorrelation (space frame, from the frames of the
   short window): first zero (fs), value at the first minimum, integral to ``omega_max_lag_ps`` (fs);
@@ -19,9 +19,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..physics.temperature import R_KJ
-from ..stats import drift, series_stats
-from . import angular, diffusion, reorientation, structure
+from ...analysis import angular, diffusion, reorientation, structure
+from ...physics.temperature import R_KJ
+from ...stats import drift, series_stats
 
 __all__ = ["OBSERVABLES", "observables"]
 

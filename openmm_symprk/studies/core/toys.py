@@ -23,7 +23,7 @@ import openmm as mm
 from ...physics.temperature import R_KJ
 from ...support import require
 
-special = require("scipy.special", "studies", "openmm_symprk.systems.scenes.toys")
+special = require("scipy.special", "studies", "openmm_symprk.studies.core.toys")
 ellipj, ellipkinc = special.ellipj, special.ellipkinc
 
 #: kT at 300 K in kJ/mol: the toys hold about this much energy per degree of freedom.
@@ -118,7 +118,7 @@ def duffing_exact(a, b, amp, u0, t: float):
 
 
 def exact_state(meta: dict, t: float):
-    """Exact (x, v) of a toy scene at time t from its metadata (see :mod:`.named`)."""
+    """Exact (x, v) of a toy scene at time t from its metadata (see :mod:`openmm_symprk.studies.core.scenes`)."""
     if meta["toy"] == "harmonic":
         return harmonic_exact(np.array(meta["omega"]), np.array(meta["x0"]), np.array(meta["v0"]), t)
     if meta["toy"] == "duffing":

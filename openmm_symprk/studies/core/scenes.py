@@ -1,11 +1,12 @@
 """The named scenes of the bench and the studies: each models no more than the question it answers.
 
-A scene (:class:`.scene.Scene`, the package's one scene type) is a System plus one shared initial state (positions
-and velocities, nm and nm/ps) and what may be measured on it: which quantities are invariants, whether an exact
-solution exists, whether it is for accuracy, speed or production-shaped runs.  A study builds its scenes once,
-stores them in its output folder (:func:`.scene.save_scene`, or with their replica states,
-:func:`.replicas.replica_states`) and ships them to the workers as a :meth:`~.scene.Scene.payload`, so every run
-(and every run of a resumed study) starts from bit-identical coordinates.
+A scene (:class:`openmm_symprk.systems.scenes.Scene`, the package's one scene type) is a System plus one shared
+initial state (positions and velocities, nm and nm/ps) and what may be measured on it: which quantities are
+invariants, whether an exact solution exists, whether it is for accuracy, speed or production-shaped runs.  A study
+builds its scenes once, stores them in its output folder (:func:`~openmm_symprk.systems.scenes.save_scene`, or with
+their replica states, :mod:`.replicas`) and ships them to the workers as a
+:meth:`~openmm_symprk.systems.scenes.Scene.payload`, so every run (and every run of a resumed study) starts from
+bit-identical coordinates.
 
 ``SCENES`` maps the names to their builders; each builder's docstring says why its model is enough for its
 question and no more.  :func:`user_scene` wraps a System of your own.
@@ -19,11 +20,13 @@ import openmm as mm
 import openmm.app as app
 import openmm.unit as unit
 
-from ..forcegroups import split_forces
-from ..prepare import equilibrate, maxwell_boltzmann, minimise
-from ..repartition import repartition_hydrogen_mass
-from .builders import openmm_data, protein_vacuum, water_box, water_cluster
-from .scene import Scene
+from ...systems.forcegroups import split_forces
+from ...systems.prepare import equilibrate, maxwell_boltzmann, minimise
+from ...systems.repartition import repartition_hydrogen_mass
+from ...systems.scenes import Scene, openmm_data, protein_vacuum, water_box, water_cluster
+
+__all__ = ["SCENES", "build", "user_scene"]
+
 
 def _why(fn) -> str:
     return " ".join((fn.__doc__ or "").split())
@@ -202,7 +205,7 @@ def build(name: str, **params) -> Scene:
 
 # -- helpers and user scenes ---------------------------------------------------------------------
 def _invariants_of(system) -> tuple:
-    from ..checks import conservation_issues
+    from ...systems.checks import conservation_issues
 
     keys = {k for k, _ in conservation_issues(system)}
     inv = []

@@ -1,8 +1,7 @@
 """Conservation study: platform x method x exact-momentum projection, as a markdown table.
 
-    python -m openmm_symprk.studies.conservation_table            # full table (a few minutes)
-    python -m openmm_symprk.studies.conservation_table --quick    # 8 waters, 500 steps, verlet
-    symprk conservation [options]                         # same, through the CLI
+    symprk conservation            # full table (a few minutes)
+    symprk conservation --quick    # 8 waters, 500 steps, verlet
 
 For every scene, platform and method, two integrators run side by side from the same state: the
 method as compiled without projection ("off") and the complete exact-momentum program ("on":
@@ -23,28 +22,20 @@ import warnings
 import numpy as np
 import openmm as mm
 
-from ..conservation.diagnostics import angular_momentum, linear_momentum
-from ..support.files import write_text
-from .core import platforms
-from .core.rows import Row
-from .timing import interleaved
+from ...conservation.diagnostics import angular_momentum, linear_momentum
+from ...support.files import write_text
+from ..core import platforms
+from ..core.engine import RowEngine
+from ..core.rows import Row
+from ..core.timing import time_rows
 
 DEFAULT_PLATFORMS = ("Reference", "CPU", "OpenCL:single", "OpenCL:mixed", "OpenCL:double")
 DEFAULT_METHODS = ("verlet", "yoshida-4")
 DEFAULT_SCENES = ("water", "protein")
 
 
-def _platform(spec):
-    name, precision = platforms.split(spec)
-    return name, platforms.properties(name, precision=precision)
-
-
-def available(spec) -> bool:
-    return platforms.available(spec)
-
-
 def _scene(name, n_waters):
-    from ..systems import scenes
+    from ...systems import scenes
 
     if name == "water":
         return scenes.water_cluster(n_waters)
@@ -61,65 +52,57 @@ def _momenta(ctx):
 
 def compare(scene, spec, method, steps, step_size=0.002, chunk=None, backend="auto"):
     """Run off and on side by side (``steps`` rounded down to whole chunks); return a dict of figures."""
-    name, props = _platform(spec)
-    if name == "OpenCL" and scene.n_atoms < 2:
+    if platforms.split(spec)[0] == "OpenCL" and scene.n_atoms < 2:
         raise ValueError("PoCL crashes on 1-particle systems")
     row = Row(method, step_size * 1e3, backend=backend)
-    igs = {"off": row.build(scene.system, quiet=False),
-           "on": row.replace(exact_momentum=True).build(scene.system, quiet=False)}
-    ctxs = {k: scene.context(ig, name, props) for k, ig in igs.items()}
+    engines = {k: RowEngine(r, scene, platform=spec, threads=None, quiet=False)
+               for k, r in (("off", row), ("on", row.replace(exact_momentum=True)))}
     start = {}
-    for k, ig in igs.items():
-        ig.step(1)  # warm-up: kernels compiled, forces cached
-        start[k] = _momenta(ctxs[k])
+    for k, eng in engines.items():
+        eng.step(1)  # warm-up: kernels compiled, forces cached
+        start[k] = _momenta(eng.context)
     chunk = chunk or max(1, min(100, steps // 10))
-    timings = interleaved({k: ig.step for k, ig in igs.items()}, chunk, rounds=max(1, steps // chunk))
+    timings = time_rows(engines, chunk, rounds=max(1, steps // chunk))
     out = {"scene": scene.name, "atoms": scene.n_atoms, "platform": spec, "method": method, "steps": steps,
-           "backend": igs["off"].backend}
-    for k in ("off", "on"):
-        L1, P1 = _momenta(ctxs[k])
-        L0, P0 = start[k]
+           "backend": engines["off"].integrator.backend}
+    for k, eng in engines.items():
+        (L1, P1), (L0, P0) = _momenta(eng.context), start[k]
         out[f"dL_{k}"] = float(np.linalg.norm(L1 - L0) / np.linalg.norm(L0))
         out[f"dP_{k}"] = float(np.linalg.norm(P1 - P0))
         out[f"ms_{k}"] = timings[k].best * 1e3
     out["ratio"] = out["ms_on"] / out["ms_off"]
-    for c in ctxs.values():
-        del c
     return out
 
 
 def failure_cases(steps=500):
     """Reference-platform runs where momentum is not conserved, for the second table."""
-    from ..systems import scenes
+    from ...systems import scenes
 
     rows = []
     morse = scenes.morse_molecule()
     water = scenes.water_cluster(8)
 
-    def drift(scene, ig, about="com", system=None, velocities=None):
-        ctx = mm.Context(system or scene.system, ig, mm.Platform.getPlatformByName("Reference"))
-        ctx.setPositions(scene.positions)
-        ctx.setVelocities(scene.velocities if velocities is None else velocities)
-        L0, P0 = angular_momentum(ctx, about=about), linear_momentum(ctx)
-        ig.step(steps)
-        L1, P1 = angular_momentum(ctx, about=about), linear_momentum(ctx)
+    def drift(scene, label, about="com", system=None, velocities=None):
+        eng = RowEngine(Row.parse(label), system or scene.system, scene.positions,
+                        scene.velocities if velocities is None else velocities, platform="Reference", start=False,
+                        quiet=False)
+        L0, P0 = angular_momentum(eng.context, about=about), linear_momentum(eng.context)
+        eng.step(steps)
+        L1, P1 = angular_momentum(eng.context, about=about), linear_momentum(eng.context)
         return float(np.linalg.norm(L1 - L0) / np.linalg.norm(L0)), float(np.linalg.norm(P1 - P0))
 
-    for em in (False, True):
-        ig = Row("rk4", 1.0, exact_momentum=em).build(morse.system, quiet=False)
+    for em in ("", " exact-momentum"):
         rows.append(("rk4 (not symplectic), Morse molecule" + (", projected" if em else ""), "com",
-                     *drift(morse, ig), "method error: projection cannot help"))
-    ig = Row("verlet", 1.0).build(morse.system, quiet=False)
-    rows.append(("verlet, Morse molecule (reference)", "com", *drift(morse, ig), "round-off"))
-    ig = Row.parse("langevin 2 fs friction 1/ps T 150 K").build(water.system, quiet=False)
-    rows.append(("LangevinMiddleIntegrator, 8 waters", "com", *drift(water, ig), "thermostat"))
+                     *drift(morse, f"rk4 1 fs{em}"), "method error: projection cannot help"))
+    rows.append(("verlet, Morse molecule (reference)", "com", *drift(morse, "verlet 1 fs"), "round-off"))
+    rows.append(("LangevinMiddleIntegrator, 8 waters", "com", *drift(water, "langevin 2 fs friction 1/ps T 150 K"),
+                 "thermostat"))
     system = mm.XmlSerializer.clone(water.system)
     system.addForce(mm.CMMotionRemover(1))
     v = water.velocities + np.array([0.3, -0.2, 0.1])
     for about in ("com", "origin"):
-        ig = Row("verlet", 2.0).build(system, quiet=False)
         rows.append(("verlet + CMMotionRemover, 8 waters drifting", about,
-                     *drift(water, ig, about=about, system=system, velocities=v),
+                     *drift(water, "verlet 2 fs", about=about, system=system, velocities=v),
                      "L about the centre of mass kept" if about == "com" else "L about the origin changes"))
     return rows
 
@@ -147,8 +130,8 @@ def failure_table(rows) -> str:
     return "\n".join(lines)
 
 
-def build_parser():
-    p = argparse.ArgumentParser(prog="symprk conservation", description=__doc__.split("\n\n")[0],
+def build_parser(prog: str = "symprk conservation"):
+    p = argparse.ArgumentParser(prog=prog, description=__doc__.split("\n\n")[0],
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--steps", type=int, default=2000, help="steps per run (default 2000)")
     p.add_argument("--platforms", default=",".join(DEFAULT_PLATFORMS),
@@ -166,13 +149,12 @@ def build_parser():
     return p
 
 
-def main(argv=None) -> int:
-    args = build_parser().parse_args(argv)
+def run(args):
     if args.quick:
         args.steps, args.waters, args.methods, args.scenes = 500, 8, "verlet", "water"
     warnings.simplefilter("ignore")  # conservation warnings are the subject here, not news
     specs = [s for s in args.platforms.split(",") if s]
-    missing = [s for s in specs if not available(s)]
+    missing = [s for s in specs if not platforms.available(s)]
     specs = [s for s in specs if s not in missing]
     rows = []
     for scene_name in args.scenes.split(","):
@@ -183,8 +165,7 @@ def main(argv=None) -> int:
                 rows.append(r)
                 print(f"  {scene.name} {spec} {method}: dL/L off {_fmt(r['dL_off'])} on {_fmt(r['dL_on'])}, "
                       f"cost x{r['ratio']:.2f}", file=sys.stderr, flush=True)
-    cmd = "symprk conservation " + " ".join(argv if argv is not None else sys.argv[1:])
-    parts = [f"Command: `{cmd.strip()}` ({args.steps} steps of {args.step_size * 1000:g} fs; OpenMM "
+    parts = [f"Command: `{' '.join([args.prog, *args.argv])}` ({args.steps} steps of {args.step_size * 1000:g} fs; OpenMM "
              f"{mm.Platform.getOpenMMVersion()})", "", table(rows)]
     if missing:
         parts += ["", f"Platforms not available here: {', '.join(missing)}"]
@@ -194,8 +175,3 @@ def main(argv=None) -> int:
     print(text)
     if args.out:
         write_text(args.out, text + "\n")
-    return 0
-
-
-if __name__ == "__main__":
-    sys.exit(main())
