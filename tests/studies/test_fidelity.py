@@ -459,3 +459,37 @@ def test_the_committed_results_load_and_report_as_committed(tmp_path, monkeypatc
             with open(os.path.join(committed, name), "rb") as a, open(os.path.join(copy_, name), "rb") as b:
                 assert a.read() == b.read(), (command, name)
     assert "report only" not in capsys.readouterr().err
+
+
+def test_the_frontier_preset_pairs_its_nvt_rows_on_one_event_grid():
+    """issue 35's rows: every NVT row of the package thermostats every EVENT_FS fs with the reference's seed (its
+    draws are the reference's, event for event), every family has two steps or more, and the tolerances name the
+    observables the report fits."""
+    from openmm_symprk.studies.core.rows import Row
+    from openmm_symprk.studies.fidelity import presets
+    from openmm_symprk.studies.fidelity.frontier import family_of
+    from openmm_symprk.studies.fidelity.simulation.study import check
+
+    cfg = presets.frontier()
+    rows = check(cfg)
+    assert cfg["run_version"] == 3 and cfg["equilibrator"] == "svr" and "frozen" not in cfg
+    ours_nvt = [Row.parse(r) for r in rows if Row.parse(r).ensemble == "NVT" and Row.parse(r).is_ours]
+    assert ours_nvt and all(r.every * r.step_fs == presets.EVENT_FS and r.position == "ends" and r.seed == 1
+                            for r in ours_nvt)
+    families = {}
+    for r in rows:
+        if r not in cfg["references"].values():
+            families.setdefault(family_of(r), set()).add(Row.parse(r).step_fs)
+    assert all(len(steps) >= 2 for steps in families.values()), families
+    assert family_of("omelyan-2 4 fs SVR 0.1 ps every 3") == family_of("omelyan-2 6 fs SVR 0.1 ps every 2")
+    keys = {k.removesuffix("_rel") for level in cfg["tolerances"].values() for k in level}
+    from openmm_symprk.studies.fidelity.observables import OBSERVABLES
+    assert keys <= {k for k, _, _ in OBSERVABLES}
+
+
+def test_the_issue_26_study_is_kept_as_it_ran(tmp_path):
+    from openmm_symprk.studies.fidelity import presets
+    from openmm_symprk.studies.fidelity.simulation import run_study
+
+    with pytest.raises(ValueError, match="issue 26 study is kept as it ran.*--report-only.*--preset frontier"):
+        run_study(presets.full(), str(tmp_path))

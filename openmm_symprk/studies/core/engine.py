@@ -7,7 +7,10 @@ row's velocities carried over to its masses
 (:func:`~openmm_symprk.systems.repartition.rigid_velocities_for_masses`), and OpenMM's leapfrog integrators
 (VerletIntegrator, LangevinMiddleIntegrator, DPDIntegrator: :attr:`~.rows.Row.leapfrog`, their State velocities
 lag half a step) from v(-h/2) = v - (h/2) F(x)/m, constrained, which gives them the positions of velocity Verlet
-from (x, v).  :meth:`RowEngine.sample` is the one sampler of positions, velocities and energies.
+from (x, v).  :meth:`RowEngine.sample` is the one sampler of positions, velocities and energies; with
+``on_step=True`` a leapfrog row's velocities are brought to the positions' time, v + (h/2) F(x)/m constrained
+(what OpenMM's own kinetic energy of these integrators shifts them by), so that an observable made of positions and
+velocities together (angular velocities, temperatures) reads one time, as for the package's integrators.
 """
 from __future__ import annotations
 
@@ -93,16 +96,37 @@ class RowEngine:
         e = self.integrator.computeHeatBathEnergy()
         return float(e.value_in_unit(KJ) if unit.is_quantity(e) else e)
 
-    def sample(self, positions: bool = True, velocities: bool = True, energy: bool = True) -> Sample:
-        """The state now, in float64, from one State."""
+    def sample(self, positions: bool = True, velocities: bool = True, energy: bool = True,
+               on_step: bool = False) -> Sample:
+        """The state now, in float64, from one State; ``on_step``: a leapfrog row's velocities at the positions' time
+        (:meth:`on_step_velocities`; the State's, half a step behind, otherwise)."""
         if self.rigid is not None:
             v = self.rigid.velocities()
             return Sample(self.rigid.positions() if positions else None, v if velocities else None,
                           self.rigid.potential_energy() if energy else None,
                           kinetic_energy(v, self.masses) if energy else None)
-        st = self.context.getState(getPositions=positions, getVelocities=velocities, getEnergy=energy)
-        return Sample(np.array(st.getPositions(asNumpy=True).value_in_unit(unit.nanometer)) if positions else None,
-                      np.array(st.getVelocities(asNumpy=True).value_in_unit(unit.nanometer / unit.picosecond))
-                      if velocities else None,
+        shift = on_step and velocities and self.row.leapfrog
+        st = self.context.getState(getPositions=positions, getVelocities=velocities, getEnergy=energy,
+                                   getForces=shift)
+        v = np.array(st.getVelocities(asNumpy=True).value_in_unit(unit.nanometer / unit.picosecond)) \
+            if velocities else None
+        if shift:
+            v = self.on_step_velocities(v, st.getForces(asNumpy=True).value_in_unit(KJ / unit.nanometer))
+        return Sample(np.array(st.getPositions(asNumpy=True).value_in_unit(unit.nanometer)) if positions else None, v,
                       st.getPotentialEnergy().value_in_unit(KJ) if energy else None,
                       st.getKineticEnergy().value_in_unit(KJ) if energy else None)
+
+    def on_step_velocities(self, v, forces, tolerance: float = 1e-10) -> np.ndarray:
+        """A leapfrog row's State velocities ``v`` (half a step behind the positions) brought to the positions' time:
+        v + (h/2) F(x)/m, the velocity velocity Verlet has there (the mean of the half-step velocities on either side),
+        projected onto the constraints (through the Context, whose velocities are set back as they were)."""
+        inv = np.where(self.masses > 0, 1.0 / np.where(self.masses > 0, self.masses, 1.0), 0.0)
+        shifted = v + 0.5 * self.row.h_ps * np.asarray(forces) * inv[:, None]
+        if not self.system.getNumConstraints():
+            return shifted
+        self.context.setVelocities(shifted)
+        self.context.applyVelocityConstraints(tolerance)
+        out = np.array(self.context.getState(getVelocities=True).getVelocities(asNumpy=True)
+                       .value_in_unit(unit.nanometer / unit.picosecond))
+        self.context.setVelocities(v)
+        return out

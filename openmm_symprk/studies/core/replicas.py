@@ -26,7 +26,7 @@ from ...systems.prepare import equilibrate, minimise, without_net_momentum
 from ...systems.scenes import WATER_DENSITY_G_CM3, Scene, load_states, save_states, water_box
 
 __all__ = ["scene_replicas", "scene_state_key", "water_box_scene", "water_box_replicas", "box_state_key",
-           "BOX_STATE_KEYS", "BOX_STATE_VERSION"]
+           "BOX_STATE_KEYS", "BOX_STATE_VERSION", "EQUILIBRATORS"]
 
 #: Version of a named scene's stored replica states (a change never reuses stale ones).
 SCENE_STATE_VERSION = 1
@@ -84,8 +84,39 @@ def water_box_scene(cfg: dict, model: str) -> Scene:
 
 
 def box_state_key(cfg: dict) -> str:
-    """The key of a water box's replica states: what they depend on (not their number)."""
-    return content_key({"cfg": {k: cfg[k] for k in BOX_STATE_KEYS}, "version": BOX_STATE_VERSION})
+    """The key of a water box's replica states: what they depend on (not their number; the equilibrator only where a
+    study names one, so the states made before it was a setting keep their key)."""
+    keys = BOX_STATE_KEYS + (("equilibrator",) if "equilibrator" in cfg else ())
+    return content_key({"cfg": {k: cfg[k] for k in keys}, "version": BOX_STATE_VERSION})
+
+
+#: The equilibrators of a water box's replica states: OpenMM's LangevinMiddleIntegrator at 2 fs (the default, and what
+#: issue 26's states were made with: its State velocities are the mid-step ones) or, "svr", the package's velocity
+#: Verlet at 1 fs with stochastic velocity rescaling at the ends of the step (collision time 0.1 ps), whose on-step
+#: velocities and positions are both canonical.
+EQUILIBRATORS = ("langevin", "svr")
+
+
+def _equilibrate(cfg, system, x, picoseconds, seed, props):
+    how = cfg.get("equilibrator", "langevin")
+    if how not in EQUILIBRATORS:
+        raise ValueError(f"equilibrator {how!r}; known: {', '.join(EQUILIBRATORS)}")
+    if how == "langevin":
+        return equilibrate(system, x, cfg["temperature"], picoseconds, seed, platform="CPU", properties=props)
+    from ...integrators import SymplecticIntegrator
+    from ...systems.prepare import maxwell_boltzmann
+
+    ig = SymplecticIntegrator(0.001, "verlet", system=system, temperature=float(cfg["temperature"]),
+                              collision_time=0.1, random_seed=int(seed), thermostat_position="ends")
+    ctx = mm.Context(system, ig, mm.Platform.getPlatformByName("CPU"), props)
+    try:
+        ctx.setPositions(x)
+        ctx.setVelocities(maxwell_boltzmann(system, x, cfg["temperature"], seed))
+        ig.step(int(round(picoseconds * 1000.0)))
+        st = ctx.getState(getPositions=True, getVelocities=True)
+        return (np.array(st.getPositions(asNumpy=True)._value), np.array(st.getVelocities(asNumpy=True)._value))
+    finally:
+        del ctx
 
 
 def water_box_replicas(cfg: dict, model: str, out: str, log=print):
@@ -102,16 +133,15 @@ def water_box_replicas(cfg: dict, model: str, out: str, log=print):
     props, seed, n_old, t0 = {"Threads": str(cfg.get("threads", 1))}, int(cfg["seed"]), len(xs), time.perf_counter()
     if not xs:
         x = minimise(box.system, box.positions, platform="CPU", properties=props, max_iterations=500)
-        x, v = equilibrate(box.system, x, cfg["temperature"], cfg["equilibrate_ps"], seed, platform="CPU",
-                           properties=props)
+        x, v = _equilibrate(cfg, box.system, x, cfg["equilibrate_ps"], seed, props)
         xs, vs = [x], [without_net_momentum(v, box.masses())]
     for r in range(len(xs), int(cfg["replicas"])):
-        x, v = equilibrate(box.system, xs[-1], cfg["temperature"], cfg["spacing_ps"], seed + r, platform="CPU",
-                           properties=props)
+        x, v = _equilibrate(cfg, box.system, xs[-1], cfg["spacing_ps"], seed + r, props)
         xs.append(x)
         vs.append(without_net_momentum(v, box.masses()))
+    how = "Langevin" if cfg.get("equilibrator", "langevin") == "langevin" else "velocity-rescaling"
     log(f"{model}: {len(box.molecules)} waters, {len(xs)} replica states ({cfg['equilibrate_ps']} + "
-        f"{cfg['spacing_ps']} ps apart of Langevin dynamics; {len(xs) - n_old} new, "
+        f"{cfg['spacing_ps']} ps apart of {how} dynamics; {len(xs) - n_old} new, "
         f"{time.perf_counter() - t0:.0f} s)")
     os.makedirs(os.path.dirname(path), exist_ok=True)
     write_npz(path, {"x": np.array(xs), "v": np.array(vs)})

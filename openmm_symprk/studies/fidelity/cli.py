@@ -20,6 +20,9 @@ def build_parser(prog: str = "symprk fidelity"):
                          "default: all")
     ap.add_argument("--model", choices=("spce", "tip3p"), default=None,
                     help="water model (default spce); its replica states and runs are kept apart")
+    ap.add_argument("--preset", choices=sorted(presets.PRESETS), default="issue26",
+                    help="the study: issue26 (kept as it ran: --report-only remakes its report) or frontier (issue "
+                         "35: equal-accuracy costs with intervals, NVT rows paired by common random numbers)")
     return ap
 
 
@@ -49,7 +52,7 @@ def select_rows(cfg: dict, text: str) -> list:
 
 
 def run(args):
-    cfg = presets.quick() if args.quick else presets.full()
+    cfg = presets.quick() if args.quick else presets.PRESETS[args.preset]()
 
     def configure(cfg):
         if args.model:

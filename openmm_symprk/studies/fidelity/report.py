@@ -201,10 +201,15 @@ def summarise(cfg: dict, rows: list, grouped: dict, timings: dict | None = None,
     for k, _, _ in OBSERVABLES:
         ses = [e["vs_ref"][k]["se"] for e in table if e.get("vs_ref", {}).get(k)]
         resolution[k] = K_SE * float(np.median(ses)) if ses else None
-    return {"config": cfg, "reference": ref_label, "references": refs, "rows": table, "extrapolated": fits,
-            "extrapolated_nvt": extrap["NVT"][1] if "NVT" in extrap else {}, "yeh_hummer": yh,
-            "box_nm": box_nm, "cheapest": cheapest, "claims": claims, "resolution": resolution, "k_se": K_SE,
-            "targets": dict(TARGETS), "to_resolve": _to_resolve(cfg, table, grouped)}
+    out = {"config": cfg, "reference": ref_label, "references": refs, "rows": table, "extrapolated": fits,
+           "extrapolated_nvt": extrap["NVT"][1] if "NVT" in extrap else {}, "yeh_hummer": yh,
+           "box_nm": box_nm, "cheapest": cheapest, "claims": claims, "resolution": resolution, "k_se": K_SE,
+           "targets": dict(TARGETS), "to_resolve": _to_resolve(cfg, table, grouped)}
+    if cfg.get("tolerances"):  # issue 35's frontier (the 3-SE table above stays as a secondary view)
+        from .frontier import frontier_summary
+
+        out["frontier"] = frontier_summary([e["label"] for e in table], per, refs, cfg["tolerances"], timings)
+    return out
 
 
 def _resolution(entry: dict, ref: dict | None) -> dict:
@@ -360,6 +365,11 @@ def format_summary(summary: dict) -> str:
     for k, (why, where) in notes.items():
         lines.append(f"{_SHORT[k]} not measured in {len(where)} row(s) ({', '.join(where[:3])}"
                      f"{', ...' if len(where) > 3 else ''}), e.g.: {why}")
+    if summary.get("frontier"):
+        from .frontier import format_frontier
+
+        lines += ["", "Frontier: the cost of each family at equal accuracy (tolerances declared in the presets)", "",
+                  format_frontier(summary["frontier"])]
     return "\n".join(lines)
 
 

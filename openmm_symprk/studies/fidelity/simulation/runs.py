@@ -100,7 +100,7 @@ def run_row(scene, x, v, row: dict, cfg: dict, replica: int):
         for i in range(int(round(cfg["omega_ps"] * 1000.0 / (every_w * h))) + 1):
             if i:
                 advance(every_w)
-            xw, vw, _, _ = eng.sample(energy=False)
+            xw, vw, _, _ = eng.sample(energy=False, on_step=True)
             xs_w.append(xw)
             vs_w.append(vw)
     except Unstable:
@@ -116,7 +116,7 @@ def run_row(scene, x, v, row: dict, cfg: dict, replica: int):
                 advance(every)
             except Unstable:
                 break
-        xs, vs, pe, _ = eng.sample()
+        xs, vs, pe, _ = eng.sample(on_step=True)
         kt = kinetic_temperatures(xs, vs, m, mols, info["keeps_momentum"], n_constraints)
         bath = eng.heat_bath()
         etot = pe + kinetic_energy(vs, m) + (bath or 0.0)
@@ -141,4 +141,6 @@ def run_row(scene, x, v, row: dict, cfg: dict, replica: int):
                   omega=angular_velocities(xs_w, vs_w, m, mols, frame="space"), dt_omega=every_w * h * 1e-3)
     obs, curves, notes = observables(series, cfg, len(mols), box, describe(row)["effective_energy"])
     info.update(obs=obs, notes=notes, wall_s=time.perf_counter() - t0)
+    if "omega_acf" in curves:  # the curve the features are read from (a reduced result: a few hundred numbers)
+        info.update(omega_acf=[round(float(c), 7) for c in curves["omega_acf"]], omega_acf_dt_ps=every_w * h * 1e-3)
     return dict({k: out[k] for k in keys}, **curves), info

@@ -26,16 +26,20 @@ __all__ = ["FidelityStudy", "run_study", "run_key", "temperature_view", "RUN_KEY
 RUN_KEYS = BOX_STATE_KEYS + ("model", "settle_ps", "omega_ps", "omega_fs", "omega_max_lag_ps", "length_ps",
                              "sample_fs", "rdf_every", "msd_window_ps", "tau_fit", "rdf_r_min_nm")
 #: Version of what a run stores; a run stored by another version is never reused (2: rows stored as their labels;
-#: leapfrog integrators started from v(-h/2); blow-ups recorded as "unstable at step N").
-RUN_VERSION = 2
+#: leapfrog integrators started from v(-h/2); blow-ups recorded as "unstable at step N"; 3: leapfrog rows' velocities
+#: brought to the positions' time in every velocity-based observable, the omega ACF's zero and minimum read between
+#: its samples, its curve kept in the run).  A preset names the version its runs have (``run_version``: issue 26's
+#: stored runs are version 2).
+RUN_VERSION = 3
 #: The file of the rows' wall time per simulated ps, timed in turns (kept so that --report-only remakes the cost
 #: columns on any machine; a run that times again replaces it).
 TIMINGS = "timings.json"
 
 
 def run_key(cfg: dict, row, replica: int) -> str:
-    return row_run_key(check_row(row), replica, {k: cfg[k] for k in RUN_KEYS}, states=BOX_STATE_VERSION,
-                       version=RUN_VERSION)
+    keys = RUN_KEYS + (("equilibrator",) if "equilibrator" in cfg else ())
+    return row_run_key(check_row(row), replica, {k: cfg[k] for k in keys}, states=BOX_STATE_VERSION,
+                       version=int(cfg.get("run_version", RUN_VERSION)))
 
 
 def references(cfg: dict, rows: list) -> dict:
@@ -224,6 +228,13 @@ def run_study(cfg: dict, out: str, workers: int = 2, timing: bool = True, progre
     """Run (or finish, or only re-summarise: ``report_only``, see :meth:`~openmm_symprk.studies.core.study.Study.run`) the study in ``out``; returns the summary (:func:`..report.summarise`)
     and writes ``summary.txt``, ``equipartition.txt`` (:func:`temperature_view`), ``results.json``, ``fidelity.png`` (bias against force evaluations per ps) and,
     with timing, ``fidelity-wall.png`` (against wall time per simulated ps) there."""
+    if cfg.get("frozen") and not report_only:
+        raise ValueError(f"the {cfg['frozen']} study is kept as it ran (its runs are of version "
+                         f"{cfg.get('run_version')}, made by earlier code): remake its report with --report-only; new "
+                         f"measurements run with --preset frontier")
+    if int(cfg.get("run_version", RUN_VERSION)) != RUN_VERSION and not report_only:
+        raise ValueError(f"runs of version {cfg.get('run_version')} cannot be made any more (this code makes version "
+                         f"{RUN_VERSION}): use --report-only")
     study = FidelityStudy(cfg, out, workers, timing, progress, log, scheduler)
     study.report_only = bool(report_only)
     return study.run(report_only)

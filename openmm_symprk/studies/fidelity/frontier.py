@@ -1,0 +1,174 @@
+"""The fidelity study's frontier: the cost of every integrator family at equal accuracy, with intervals.
+
+A family is the rows of one integrator and thermostat that differ only in the step (and, on the common event grid,
+in the thermostat interval that keeps the events at the same simulated times).  Per ensemble, observable and family
+the paired biases against the ensemble's reference (replica by replica) are fitted as c h^p
+(:mod:`openmm_symprk.stats.frontier`: weights 1/SE^2, replicas resampled jointly across families), and at each
+tolerance level (:data:`.presets.TOLERANCES`, declared before the runs) each family gets its equal-accuracy step
+(the smallest over the observables, at most the largest step it ran), its cost per simulated ps (force evaluations,
+and wall seconds from the rows' timings), the step at which every observable stays inside its tolerance with 95 %
+confidence, and the package's cheapest family is compared with OpenMM's cheapest: a ratio of costs with a 95 %
+bootstrap interval.  Relative tolerances (D, tau2, the g(r) peak height) are taken of the reference's mean.
+"""
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+from ...stats.frontier import Family, bootstrap, compare, fit_c, frontier
+from ..core.rows import OPENMM_KINDS
+from .rowspec import to_row
+
+__all__ = ["family_of", "families", "frontier_summary", "format_frontier", "N_BOOT"]
+
+#: Bootstrap resamples of the replicas.
+N_BOOT = 2000
+
+
+def family_of(label: str) -> str:
+    """The family of a row: its label with the step (and the thermostat interval that follows it) left out."""
+    row = to_row(label)
+    return dataclasses.replace(row, step_fs=1.0, every=1).label.replace(" 1 fs", "", 1)
+
+
+def _absolute(tolerances: dict, ref_means: dict) -> dict:
+    """Tolerances in the observables' own units: a key ending in ``_rel`` is a fraction of the reference's mean."""
+    out = {}
+    for key, eps in tolerances.items():
+        if key.endswith("_rel"):
+            obs = key[:-len("_rel")]
+            if ref_means.get(obs) is None:
+                continue
+            out[obs] = float(eps) * abs(ref_means[obs])
+        else:
+            out[key] = float(eps)
+    return out
+
+
+def families(rows, per: dict, reference: str, ensemble: str, observables) -> list:
+    """The families of ``ensemble`` among ``rows`` (labels) with their paired biases against ``reference``
+    (``per``: {label: {observable: {replica: (value, se)}}}), each row's replicas as columns (NaN where missing)."""
+    ref = per.get(reference)
+    if ref is None:
+        return []
+    groups: dict = {}
+    for lab in rows:
+        r = to_row(lab)
+        if lab == reference or r.ensemble != ensemble or lab not in per:
+            continue
+        groups.setdefault(family_of(lab), []).append(lab)
+    n = 1 + max((rep for lab in list(rows) + [reference] if lab in per for k in observables
+                 for rep in per[lab].get(k, {})), default=0)
+    out = []
+    for name, labels in groups.items():
+        labels = sorted(labels, key=lambda lab: to_row(lab).step_fs)
+        bias = {}
+        for k in observables:
+            b = np.full((len(labels), n), np.nan)
+            for i, lab in enumerate(labels):
+                for rep, (value, _) in per[lab].get(k, {}).items():
+                    if rep in ref.get(k, {}):
+                        b[i, rep] = value - ref[k][rep][0]
+            bias[k] = b
+        rows_ = [to_row(lab) for lab in labels]
+        out.append((Family(name, tuple(r.step_fs for r in rows_), bias, order=2,
+                           cost_per_step=float(np.mean([r.evals_per_step() for r in rows_]))), labels))
+    return out
+
+
+def frontier_summary(rows, per: dict, references: dict, tolerances: dict, timings: dict | None = None,
+                     n_boot: int = N_BOOT) -> dict:
+    """{ensemble: {"families": [...], "levels": {level: {...}}}} (see the module docstring)."""
+    timings = timings or {}
+    out = {}
+    for ensemble, reference in references.items():
+        keys = sorted({k[:-len("_rel")] if k.endswith("_rel") else k for t in tolerances.values() for k in t})
+        # a family on the frontier has two steps or more (one step fixes c but not that the bias goes as h^2), each
+        # with two replicas or more of every observable
+        found = families(rows, per, reference, ensemble, keys)
+        fams = [(f, labs) for f, labs in found if len(set(f.steps)) >= 2
+                and all(np.isfinite(f.bias[k]).sum(axis=1).min() >= 2 for k in keys)]
+        if not fams:
+            continue
+        ref_means = {k: float(np.mean([v for v, _ in per[reference][k].values()])) if per[reference].get(k) else None
+                     for k in keys}
+        boot = bootstrap([f for f, _ in fams], keys, n_boot=n_boot)
+        wall = {f.name: _wall_per_step(labs, timings) for f, labs in fams}
+        entry = {"reference": reference, "families": [], "levels": {},
+                 "left_out": sorted(f.name for f, _ in found if all(f.name != g.name for g, _ in fams))}
+        for f, labs in fams:
+            entry["families"].append({
+                "family": f.name, "rows": labs, "steps_fs": list(f.steps), "evals_per_step": f.cost_per_step,
+                "s_per_step": wall[f.name], "openmm": to_row(labs[0]).who in OPENMM_KINDS,
+                "c": {k: fit_c(f.steps, f.bias[k], f.order) for k in keys},
+                "c_interval": {k: [float(np.nanquantile(boot[f.name][k], q)) for q in (0.025, 0.975)] for k in keys}})
+        for level, tol in tolerances.items():
+            eps = _absolute(tol, ref_means)
+            points = {f.name: frontier(f, eps, boot[f.name]) for f, _ in fams}
+            level_entry = {"tolerances": eps, "families": {}}
+            for f, _ in fams:
+                p = points[f.name]
+                level_entry["families"][f.name] = {
+                    "step_fs": p.step, "evals_per_ps": 1000.0 * p.cost, "safe_step_fs": p.safe_step,
+                    "limited_by": p.limited_by,
+                    "s_per_ps": 1000.0 * wall[f.name] / p.step if wall[f.name] else None}
+            for unit, cost_of in (("evals", lambda name: next(f.cost_per_step for f, _ in fams if f.name == name)),
+                                  ("wall", lambda name: wall[name])):
+                ours = [f.name for f, labs in fams if to_row(labs[0]).who not in OPENMM_KINDS and cost_of(f.name)]
+                theirs = [f.name for f, labs in fams if to_row(labs[0]).who in OPENMM_KINDS and cost_of(f.name)]
+                if not ours or not theirs:
+                    continue
+                best_ours = min(ours, key=lambda n: cost_of(n) / points[n].step)
+                best_theirs = min(theirs, key=lambda n: cost_of(n) / points[n].step)
+                a = dataclasses.replace(points[best_ours], cost=cost_of(best_ours) / points[best_ours].step)
+                b = dataclasses.replace(points[best_theirs], cost=cost_of(best_theirs) / points[best_theirs].step)
+                ratio, low, high = compare(a, b, cost_of(best_ours), cost_of(best_theirs))
+                level_entry[f"ratio_{unit}"] = {"ours": best_ours, "theirs": best_theirs, "ratio": ratio,
+                                                "low": low, "high": high}
+            entry["levels"][level] = level_entry
+        out[ensemble] = entry
+    return out
+
+
+def _wall_per_step(labels, timings: dict) -> float | None:
+    """Wall seconds per step of a family: its rows' seconds per simulated ps times their steps, averaged."""
+    per_step = [timings[lab] * to_row(lab).step_fs / 1000.0 for lab in labels if timings.get(lab)]
+    return float(np.mean(per_step)) if per_step else None
+
+
+def format_frontier(summary: dict) -> str:
+    """The frontier as text: per ensemble, the fitted c of each family, then per tolerance level each family's
+    equal-accuracy step, what limits it, its cost, its 95 %-safe step, and the package's cheapest family against
+    OpenMM's with the 95 % interval."""
+    lines = []
+    for ensemble, entry in summary.items():
+        lines.append(f"{ensemble}: biases against {entry['reference']} fitted as c h^2 (h in fs), 95 % intervals "
+                     f"from {N_BOOT} resamples of the replicas")
+        keys = sorted(entry["families"][0]["c"]) if entry["families"] else []
+        lines.append("  " + "family".ljust(34) + "steps fs".ljust(16) + "".join(f"c[{k}]".rjust(24) for k in keys))
+        for fam in entry["families"]:
+            cs = "".join(f"{fam['c'][k]:+.2e} [{fam['c_interval'][k][0]:+.1e},{fam['c_interval'][k][1]:+.1e}]"
+                         .rjust(24) for k in keys)
+            lines.append("  " + fam["family"][:33].ljust(34) + ",".join(f"{h:g}" for h in fam["steps_fs"]).ljust(16)
+                         + cs)
+        if entry.get("left_out"):
+            lines.append(f"  not on the frontier (fewer than two steps, or fewer than two replicas of an observable): "
+                         f"{'; '.join(entry['left_out'])}")
+        for level, le in entry["levels"].items():
+            tol = ", ".join(f"{k} {v:.3g}" for k, v in le["tolerances"].items())
+            lines.append(f"  tolerance '{level}': {tol}")
+            lines.append("    " + "family".ljust(34) + "h_eps fs".rjust(9) + "limited by".rjust(14) + "f/ps".rjust(8)
+                         + "s/ps".rjust(8) + "95%-safe h".rjust(12))
+            for name, fe in le["families"].items():
+                wall = f"{fe['s_per_ps']:.2f}" if fe["s_per_ps"] else "-"
+                lines.append("    " + name[:33].ljust(34) + f"{fe['step_fs']:9.2f}" + fe["limited_by"].rjust(14)
+                             + f"{fe['evals_per_ps']:8.0f}" + wall.rjust(8) + f"{fe['safe_step_fs']:12.2f}")
+            for unit in ("evals", "wall"):
+                r = le.get(f"ratio_{unit}")
+                if r:
+                    what = "force evaluations" if unit == "evals" else "wall time"
+                    lines.append(f"    {r['ours']} against {r['theirs']}: {r['ratio']:.2f}x less {what} per "
+                                 f"simulated ps (95 % interval {r['low']:.2f}-{r['high']:.2f})")
+        lines.append("")
+    return "\n".join(lines).rstrip()
