@@ -102,3 +102,26 @@ def test_multiple_time_stepping_centre_is_a_fast_kick():
         q2, _ = harmonic_sampling(with_thermostat(steps, position), 1.0, 0.5, forced=fast)
         assert q2 == pytest.approx(1 / (1 - 0.25 / 4), rel=1e-12)
     assert best_position(steps, forced=fast) == "ends"
+
+
+def test_an_event_every_n_steps_keeps_each_placements_known_answer():
+    """One event every n steps (thermostat_interval n, what the frontier study's common event grid uses): Verlet with
+    the event in the middle of the interval's centre step still samples the oscillator's configurations exactly, at
+    every step boundary of the interval, and the ends placement's half events around the interval still give
+    1/(1 - h^2 w^2/4): the interval moves neither known answer (h w = 0.5; n = 1, 2, 3, 6)."""
+    from openmm_symprk.methods.placement import THERMOSTAT, harmonic_sampling
+
+    verlet = [("kick", 0.5), ("drift", 1.0), ("kick", 0.5)]
+    for n in (1, 2, 3, 6):
+        for where, exact in (("middle", 1.0), ("ends", 1 / (1 - 0.25 / 4))):
+            steps = []
+            for i in range(n):
+                step = list(verlet)
+                if where == "middle" and i == (n - 1) // 2:
+                    step = [("kick", 0.5), ("drift", 0.5), (THERMOSTAT, float(n)), ("drift", 0.5), ("kick", 0.5)]
+                if where == "ends":
+                    step = ([(THERMOSTAT, n / 2)] if i == 0 else []) + step + ([(THERMOSTAT, n / 2)] if i == n - 1 else [])
+                steps.append(step)
+            for r in range(n):  # read at each step boundary of the interval
+                q2, _ = harmonic_sampling(sum(steps[r + 1:] + steps[:r + 1], []), 0.5, decay=0.5)
+                assert q2 == pytest.approx(exact, rel=1e-9), (where, n, r)

@@ -116,8 +116,9 @@ TOLERANCES = {
 EVENT_FS = 12.0
 #: The frontier's rows: the references, then per family its steps up to where it stops paying.  NVE: OpenMM's
 #: VerletIntegrator (1-3 fs), omelyan-2, BCSS-2 and the three-stage Predescu scheme; NVT on the event grid:
-#: the package's thermostat on omelyan-2, BCSS-2 and Verlet, and OpenMM's LangevinMiddleIntegrator (1-3 fs; it
-#: cannot share the draws: its family is resolved by the pooled fit over its steps).
+#: the package's thermostat on omelyan-2, BCSS-2 and Verlet (at the ends and in the middle), and OpenMM's
+#: LangevinMiddleIntegrator (1-3 fs; it cannot share the draws: its family is resolved by the pooled fit over its
+#: steps).
 FRONTIER_ROWS = [
     "verlet 0.5 fs", "verlet 0.5 fs SVR 0.1 ps every 24",
     "openmm-verlet 1 fs", "openmm-verlet 2 fs", "openmm-verlet 3 fs",
@@ -125,6 +126,9 @@ FRONTIER_ROWS = [
     "omelyan-2 4 fs SVR 0.1 ps every 3", "omelyan-2 6 fs SVR 0.1 ps every 2", "bcss-2 4 fs SVR 0.1 ps every 3",
     "bcss-2 6 fs SVR 0.1 ps every 2",
     "verlet 2 fs SVR 0.1 ps every 6", "verlet 3 fs SVR 0.1 ps every 4",
+    # the placement question (issue 35): Verlet with the event in the middle of the interval's centre step (the same
+    # draws as the reference, 5-4.5 fs off its event times), against the ends rows above
+    "verlet 2 fs SVR 0.1 ps every 6 middle", "verlet 3 fs SVR 0.1 ps every 4 middle",
     "langevin 1 fs friction 0.1/ps", "langevin 2 fs friction 0.1/ps", "langevin 3 fs friction 0.1/ps",
 ]
 
