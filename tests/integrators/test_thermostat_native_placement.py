@@ -22,6 +22,7 @@ from helpers import positions_velocities
 from openmm_symprk import SymplecticIntegrator, plugin
 from openmm_symprk.physics.temperature import R_KJ
 from openmm_symprk.systems.properties import masses
+from openmm_symprk.systems.scenes.builders import harmonic_oscillators
 
 pytestmark = [pytest.mark.skipif(not plugin.available(), reason=f"native plugin unavailable: {plugin.unavailable_reason()}"),
               pytest.mark.filterwarnings("ignore::openmm_symprk.systems.checks.ConservationWarning")]
@@ -55,18 +56,7 @@ def _oscillators(seed=1):
     at rest at the origin (the thermostat keeps the centre-of-mass velocity, so it stays there).  One frequency: a
     global thermostat moves energy between oscillators of different frequencies only slowly, which a run of this
     length would not sample."""
-    system = mm.System()
-    force = mm.CustomExternalForce("0.5*k*(x*x + y*y + z*z)")
-    force.addGlobalParameter("k", OMEGA ** 2)
-    for i in range(N_OSC):
-        system.addParticle(1.0)
-        force.addParticle(i, [])
-    system.addForce(force)
-    rng = np.random.default_rng(seed)
-    kT = R_KJ * TEMPERATURE
-    x = rng.normal(0.0, np.sqrt(kT) / OMEGA, (N_OSC, 3))
-    v = rng.normal(0.0, np.sqrt(kT), (N_OSC, 3))
-    return system, x - x.mean(0), v - v.mean(0)
+    return harmonic_oscillators(N_OSC, OMEGA ** 2, TEMPERATURE, seed)
 
 
 def _blocks(series, n=20):

@@ -27,6 +27,7 @@ from openmm_symprk.stats import drift
 from openmm_symprk.systems.prepare import equilibrate, maxwell_boltzmann
 from openmm_symprk.systems.properties import masses
 from openmm_symprk.systems.scenes import water_cluster
+from openmm_symprk.systems.scenes.builders import harmonic_oscillators
 
 REF = "Reference"
 pytestmark = pytest.mark.filterwarnings("ignore::openmm_symprk.systems.checks.ConservationWarning")
@@ -173,18 +174,7 @@ def oscillators(k: float, seed: int = 1):
     """N_OSC independent 3-d harmonic oscillators of mass 1 and force constant k, started canonical with the
     centre of mass at rest at the origin (the thermostat keeps the centre-of-mass velocity, so it stays there and
     the 3 N - 3 other degrees of freedom are the thermostatted ones)."""
-    system = mm.System()
-    force = mm.CustomExternalForce("0.5*k*(x*x + y*y + z*z)")
-    force.addGlobalParameter("k", k)
-    for i in range(N_OSC):
-        system.addParticle(1.0)
-        force.addParticle(i, [])
-    system.addForce(force)
-    rng = np.random.default_rng(seed)
-    kT = R_KJ * TEMPERATURE
-    x = rng.normal(0.0, np.sqrt(kT / k), (N_OSC, 3))
-    v = rng.normal(0.0, np.sqrt(kT), (N_OSC, 3))
-    return system, x - x.mean(0), v - v.mean(0)
+    return harmonic_oscillators(N_OSC, k, TEMPERATURE, seed)
 
 
 def _blocks(series, n=20):
