@@ -20,7 +20,7 @@ from ...stats.frontier import Family, bootstrap, compare, fit_c, frontier
 from ..core.rows import OPENMM_KINDS
 from .rowspec import to_row
 
-__all__ = ["family_of", "families", "frontier_summary", "format_frontier", "N_BOOT"]
+__all__ = ["family_of", "families", "frontier_summary", "format_frontier", "frontier_chart", "N_BOOT"]
 
 #: Bootstrap resamples of the replicas.
 N_BOOT = 2000
@@ -172,3 +172,61 @@ def format_frontier(summary: dict) -> str:
                                  f"simulated ps (95 % interval {r['low']:.2f}-{r['high']:.2f})")
         lines.append("")
     return "\n".join(lines).rstrip()
+
+
+def frontier_chart(summary: dict, path: str):
+    """The frontier as a work-precision chart: per ensemble (a row of panels) and observable, each row's paired bias
+    (± 2 SE) against its force evaluations per simulated ps, coloured by family, with the family's fit c h^2 drawn
+    as the bias it predicts at each cost (h = evaluations per step / cost), and the standard tolerance as a band;
+    a last panel per ensemble: the ratio of the package's cheapest family to OpenMM's per tolerance level, with its
+    95 % interval (1: equal cost)."""
+    from ...support import require
+
+    require("matplotlib", "studies", "the frontier chart").use("Agg")
+    plt = require("matplotlib.pyplot", "studies", "the frontier chart")
+    fr = summary.get("frontier") or {}
+    ensembles = list(fr)
+    if not ensembles:
+        return
+    keys = sorted(fr[ensembles[0]]["families"][0]["c"])
+    fig, axes = plt.subplots(len(ensembles), len(keys) + 1, figsize=(3.2 * (len(keys) + 1), 3.3 * len(ensembles)),
+                             squeeze=False)
+    colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    for row_axes, ens in zip(axes, ensembles):
+        entry = fr[ens]
+        fams = entry["families"]
+        colour = {f["family"]: colours[i % len(colours)] for i, f in enumerate(fams)}
+        standard = entry["levels"].get("standard", next(iter(entry["levels"].values())))["tolerances"]
+        for ax, k in zip(row_axes, keys):
+            for f in fams:
+                for lab in f["rows"]:
+                    e = next((r for r in summary["rows"] if r["label"] == lab), None)
+                    d = (e or {}).get("vs_ref", {}).get(k)
+                    if d:
+                        ax.errorbar([e["evals_per_ps"]], [d["mean"]], [2 * d["se"]], marker="o", ms=4, capsize=2,
+                                    color=colour[f["family"]], linestyle="none")
+                cost = np.geomspace(min(f["steps_fs"]) * 0.8, max(f["steps_fs"]) * 1.2, 30)  # steps (fs)
+                ax.plot(1000.0 * f["evals_per_step"] / cost, f["c"][k] * cost ** 2, color=colour[f["family"]],
+                        lw=1, label=f["family"])
+            if k in standard:
+                ax.axhspan(-standard[k], standard[k], color="grey", alpha=0.15, lw=0)
+            ax.axhline(0.0, color="grey", lw=0.6)
+            ax.set_xscale("log")
+            ax.set_title(f"{ens}: {k}", fontsize=9)
+            ax.set_xlabel("force evaluations per ps", fontsize=8)
+            ax.tick_params(labelsize=7)
+        ax = row_axes[-1]
+        levels = list(entry["levels"])
+        for i, level in enumerate(levels):
+            r = entry["levels"][level].get("ratio_evals")
+            if r:
+                ax.errorbar([i], [r["ratio"]], [[r["ratio"] - r["low"]], [r["high"] - r["ratio"]]], marker="s",
+                            capsize=4, color="black")
+        ax.axhline(1.0, color="grey", lw=0.6)
+        ax.set_xticks(range(len(levels)), levels, fontsize=8)
+        ax.set_title(f"{ens}: OpenMM's cost / the package's (95 %)", fontsize=9)
+        row_axes[0].legend(fontsize=6)
+    fig.suptitle("Frontier: paired bias against cost, fits c h^2 (lines), the standard tolerance (band)", fontsize=10)
+    fig.tight_layout()
+    fig.savefig(path, dpi=80)
+    plt.close(fig)

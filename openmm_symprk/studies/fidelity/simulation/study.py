@@ -161,6 +161,10 @@ class FidelityStudy(Study):
             chart(summary, os.path.join(self.out, "fidelity.png"))
             if timings:
                 chart(summary, os.path.join(self.out, "fidelity-wall.png"), x="s_per_ps")
+            if summary.get("frontier"):
+                from ..frontier import frontier_chart
+
+                frontier_chart(summary, os.path.join(self.out, "frontier.png"))
         except ImportError as exc:  # MissingDependencyError says which extra installs matplotlib
             self.log(f"no chart: {exc}")
         return summary
