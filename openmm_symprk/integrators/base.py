@@ -71,6 +71,9 @@ def _restore(cls, xml: str, state: dict):
     """Rebuild an integrator of ``cls`` from its XML and Python state (pickle, copy, :func:`restore`)."""
     obj = object.__new__(cls)
     obj._adopt(mm.XmlSerializer.deserialize(xml))
+    state = dict(state)
+    if "thermostat" in state:  # a pickle of 0.2.0, whose settings were the attribute itself
+        state["_thermostat"] = state.pop("thermostat")
     obj.__dict__.update(state)
     obj._reset_binding()
     obj._forget_run_state()

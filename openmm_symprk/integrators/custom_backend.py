@@ -160,11 +160,27 @@ class PRKIntegrator(IntegratorBase, mm.CustomIntegrator):
             self._keep_thermostat_settings()
 
     def _start_new_run_if_reinitialized(self):
-        """Context.reinitialize() (its step count back at 0): a new run, as on the native backend, whose kernel is made
-        anew (heat bath, step counter, thermostat counters and first-step probe as a fresh integrator has them; the
-        random stream starts again from the seed).  Idempotent until the next step."""
-        if self._bound_context().getStepCount() == 0:
+        """Context.reinitialize() (its step count back at 0, and the per-DOF values set while bound dropped): a new run,
+        as on the native backend, whose kernel is made anew (heat bath, step counter, thermostat counters and
+        first-step probe as a fresh integrator has them; the random stream starts again from the seed).  A step count
+        set to 0 alone (``Simulation.currentStep = 0``) keeps the run, as on the native backend.  Idempotent until the
+        next step."""
+        if self._bound_context().getStepCount() == 0 and not self._bound_values_intact():
             self._forget_run_state(per_dof=False)
+
+    def _bound_values_intact(self) -> bool:
+        """Whether the per-DOF values set while bound are still in the Context (a reinitialized one drops them): the
+        thermostat's mask with its dof - 1 ones, exact momentum's masses not all zero."""
+        if self.thermostat is not None:
+            mask = self.getPerDofVariableByName(thermostat_program.MASK_VAR)
+            if sum(sum(vec) for vec in mask) != self.thermostat.dof - 1:
+                return False
+        if self.options.exact_momentum:
+            from .projection import MASS_VAR
+
+            if not any(vec[0] for vec in self.getPerDofVariableByName(MASS_VAR)):
+                return False
+        return True
 
     def _sync_run_state(self):
         """Between steps, what the native backend reports at once: after Context.reinitialize() the values of a new run

@@ -107,6 +107,13 @@ class NativeSymplecticIntegrator(SymplecticIntegrator, _PluginIntegrator, backen
     def _raw_steps_taken(self) -> int:
         return int(self.getStepsTaken())
 
+    def _reset_binding(self):
+        """A copy of a 0.2.0 pickle carried no settings of its own (the plugin held them): read them from the plugin."""
+        if self.__dict__.get("_thermostat") is None and self.hasThermostat() and self.resolved is not None:
+            asked = self.options.thermostat if self.options is not None else None
+            self._thermostat = self.plugin_thermostat_settings(
+                asked.position if asked is not None else (self.resolved.thermostat_position or "ends"))
+
     def _adopt(self, other):
         """Take over a deserialized SymPRKIntegrator (XmlSerializer gives it as a base openmm.Integrator)."""
         typed = _swig.SymPRKIntegrator.cast(other)

@@ -108,6 +108,10 @@ def _g(name: str) -> str:
     return PREFIX + name
 
 
+#: The per-DOF variable holding the System's masses (set while bound: :func:`set_masses`).
+MASS_VAR = _g("mass")
+
+
 def _names(integrator):
     out = {integrator.getGlobalVariableName(i) for i in range(integrator.getNumGlobalVariables())}
     out |= {integrator.getPerDofVariableName(i) for i in range(integrator.getNumPerDofVariables())}

@@ -112,12 +112,14 @@ def bootstrap(families, observables, n_boot: int = 2000, seed: int = 1) -> dict:
 
 
 def equal_accuracy_step(cs: dict, tolerances: dict, order: int, cap: float) -> np.ndarray:
-    """h_eps = min over observables of (eps / |c|)^(1/p), at most ``cap``; ``cs`` {observable: c or array of c}."""
+    """h_eps = min over observables of (eps / |c|)^(1/p), at most ``cap``; ``cs`` {observable: c or array of c}; NaN
+    where some c is NaN (a bootstrap resample that left a row without data says nothing of the step)."""
     h = np.asarray(cap, dtype=float)
     for obs, eps in tolerances.items():
         c = np.abs(np.asarray(cs[obs], dtype=float))
         with np.errstate(divide="ignore"):
-            h = np.minimum(h, np.where(c > 0, (eps / np.where(c > 0, c, 1.0)) ** (1.0 / order), np.inf))
+            step = np.where(c > 0, (eps / np.where(c > 0, c, 1.0)) ** (1.0 / order), np.inf)
+        h = np.where(np.isnan(c), np.nan, np.minimum(h, step))  # no c (a resample without data): no step
     return h
 
 
@@ -153,12 +155,15 @@ def frontier(family: Family, tolerances: dict, boot: dict, level: float = 0.95) 
 def compare(ours: FrontierPoint, theirs: FrontierPoint, cost_ours: float, cost_theirs: float,
             level: float = 0.95) -> tuple:
     """(ratio, low, high): how many times less ``ours`` costs per unit of simulated time than ``theirs`` at equal
-    accuracy, cost_theirs/h_theirs over cost_ours/h_ours, with the bootstrap's central ``level`` interval (the two
-    families' samples come from the same resampled replicas, in the same order)."""
-    ratio = theirs.cost / ours.cost
+    accuracy, cost_theirs/h_theirs over cost_ours/h_ours (the costs per step given: force evaluations or wall time),
+    with the bootstrap's central ``level`` interval (the two families' samples come from the same resampled replicas,
+    in the same order; nans where no resample gives both)."""
     if len(ours.samples) != len(theirs.samples):
         raise ValueError("the two families' bootstrap samples must come from the same resamples (one bootstrap call)")
+    ratio = (cost_theirs / theirs.step) / (cost_ours / ours.step)
     boot = (cost_theirs / theirs.samples) / (cost_ours / ours.samples)
     boot = boot[np.isfinite(boot)]
+    if not len(boot):
+        return float(ratio), float("nan"), float("nan")
     tail = (1.0 - level) / 2
     return float(ratio), float(np.quantile(boot, tail)), float(np.quantile(boot, 1.0 - tail))

@@ -249,3 +249,23 @@ def test_native_refuses_custom_only_options_and_general_tableaux(water8):
         SymplecticIntegrator(0.001, "verlet", backend="native", tolerance=1e-6)
     with pytest.raises(NativeMethodError, match="'gauss-2' is a general .implicit. PRK tableau"):
         NativeSymplecticIntegrator(0.001, "gauss-2", system=water8.system)
+
+
+@needs_native
+def test_the_signature_leaves_out_only_the_ends_placements_two_events():
+    """The program signature leaves out a half event flagged FirstOfInterval as the first sub-step and one flagged
+    LastOfInterval as the last (what the ends placement is, and what format-4 checkpoints had implied); an event
+    anywhere else, or of another fraction, is part of the program (review: sequences differing there shared one)."""
+    cls = plugin.swig_module().SymPRKIntegrator
+    K, D, T = cls.Kick, cls.Drift, cls.Thermostat
+    C, FIRST, LAST = cls.ForcesCached, cls.FirstOfInterval, cls.LastOfInterval
+
+    def signature(kinds, coefficients, flags):
+        ig = cls(0.001, kinds, coefficients, [-1] * len(kinds), flags)
+        ig.setThermostat(300.0, 0.1, 2, 10, False)
+        return ig.getProgramSignature()
+
+    plain = signature([K, D, K], [0.5, 1.0, 0.5], [C, 0, 0])
+    assert signature([T, K, D, K, T], [0.5, 0.5, 1.0, 0.5, 0.5], [FIRST, C, 0, 0, LAST]) == plain
+    assert signature([K, T, D, K, T], [0.5, 0.5, 1.0, 0.5, 0.5], [C, FIRST, 0, 0, LAST]) != plain  # moved
+    assert signature([T, K, D, K, T], [0.25, 0.5, 1.0, 0.5, 0.5], [FIRST, C, 0, 0, LAST]) != plain  # other fraction

@@ -290,3 +290,34 @@ def test_loaded_checkpoint_reports_its_run_and_the_integrators_temperature(backe
     ctx.loadCheckpoint(chk)
     assert (ig.computeHeatBathEnergy(), ig.thermostat_kinetic_energy()) == saved
     assert ig.getTemperature() == 350 * unit.kelvin and ig.steps_taken == 20
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_a_step_count_set_to_zero_keeps_the_run(backend, cluster):
+    """Simulation.currentStep = 0 (Context.setStepCount(0)) is not a reinitialize: the heat bath and the step counter
+    that places the interval's events go on, on both backends (the custom backend took it for a new run)."""
+    ig = SymplecticIntegrator(0.002, "verlet", system=cluster.system, backend=backend, temperature=300, random_seed=3,
+                              thermostat_interval=2)
+    ctx = context(cluster.system, ig, cluster.positions, cluster.velocities)
+    ig.step(5)
+    before = (ig.computeHeatBathEnergy(), ig.steps_taken)
+    ctx.setStepCount(0)
+    assert (ig.computeHeatBathEnergy(), ig.steps_taken) == before
+    ig.step(1)
+    assert ig.steps_taken == 6
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_a_pickle_of_0_2_keeps_its_thermostat(backend, cluster):
+    """0.2.0 pickled the settings as the attribute ``thermostat`` (custom) or not at all (native: the plugin held
+    them); such a pickle still restores an NVT integrator with its current settings."""
+
+    ig = SymplecticIntegrator(0.002, "verlet", system=cluster.system, backend=backend, temperature=300, random_seed=3)
+    ig.setTemperature(320)
+    func, (cls, xml, state) = ig.__reduce__()
+    old = dict(state)
+    settings = old.pop("_thermostat")
+    if backend == "custom":
+        old["thermostat"] = settings
+    back = func(cls, xml, old)
+    assert back.thermostat == settings and back.getTemperature() == 320 * unit.kelvin

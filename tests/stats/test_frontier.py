@@ -84,3 +84,10 @@ def test_bad_families_are_refused():
         Family("x", (1, 2, 3), {"pe": np.zeros((2, 3))})
     with pytest.raises(ValueError, match="at least two replicas"):
         fit_c([1, 2], np.full((2, 1), 0.1), 2)
+
+
+def test_a_resample_without_data_gives_no_step():
+    """A resample that left a row without data has no c (NaN): it says nothing of the step, so it is not counted as
+    safe at the largest step (review of the frontier: it was the cap)."""
+    h = equal_accuracy_step({"a": np.array([np.nan, 0.01])}, {"a": 0.04}, 2, 3.0)
+    assert np.isnan(h[0]) and h[1] == pytest.approx(2.0)

@@ -266,11 +266,14 @@ long long SymPRKIntegrator::getProgramSignature() const {
             hash *= 1099511628211ULL;
         }
     };
-    // The ends placement's events (FirstOfInterval, LastOfInterval) are left out: their place follows from the
-    // thermostat's settings hashed below, and so a checkpoint written before they were sub-steps (format 4, an ends
-    // placement run without them in the sequence) keeps its signature.
+    // The ends placement's two events (a half event flagged FirstOfInterval first, one flagged LastOfInterval last) are
+    // left out: with a thermostat they are what an ends placement is, and so a checkpoint written before they were
+    // sub-steps (format 4, the ends placement implied) keeps its signature.  Any other event is hashed.
+    const size_t last = kinds.size()-1;
     for (size_t i = 0; i < kinds.size(); i++) {
-        if (kinds[i] == Thermostat && (flags[i] & (FirstOfInterval | LastOfInterval)) != 0)
+        const bool endsEvent = (kinds[i] == Thermostat && coefficients[i] == 0.5 &&
+                                ((i == 0 && flags[i] == FirstOfInterval) || (i == last && flags[i] == LastOfInterval)));
+        if (endsEvent)
             continue;
         int32_t kind = kinds[i], group = groups[i], flag = flags[i];
         mix(&kind, sizeof(kind));
