@@ -276,7 +276,9 @@ class IntegratorBase:
         this method instead of computing one from the State's kinetic energy and its own count of degrees of freedom.
 
         With a thermostat it is the temperature the thermostat samples: 2 K' / (N_f R) from the peculiar kinetic energy
-        K' just after the last event and the thermostat's degrees of freedom N_f (:attr:`thermostat_dof`).  With the
+        K' just after the last event and the thermostat's degrees of freedom N_f (:attr:`thermostat_dof`); with
+        ``thermostat_interval`` n > 1 that event may lie up to n - 1 steps back, and reports more frequent than every n
+        steps repeat it.  With the
         thermostat in the middle of the step the on-step velocities are not the canonical ones (a stiff mode of angular
         frequency w reads T (1 - h^2 w^2/4) there), so a temperature computed from a State reads low; this one does
         not.  Without a thermostat, and before the first event, it is the kinetic temperature of the Context's current
