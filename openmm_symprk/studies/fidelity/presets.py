@@ -122,7 +122,8 @@ EVENT_FS = 12.0
 FRONTIER_ROWS = [
     "verlet 0.5 fs", "verlet 0.5 fs SVR 0.1 ps every 24",
     "openmm-verlet 1 fs", "openmm-verlet 2 fs", "openmm-verlet 3 fs",
-    "omelyan-2 4 fs", "omelyan-2 6 fs", "bcss-2 4 fs", "bcss-2 6 fs", "predescu-3 6 fs", "predescu-3 9 fs",
+    "omelyan-2 4 fs", "omelyan-2 6 fs", "omelyan-2 7 fs", "bcss-2 4 fs", "bcss-2 6 fs", "bcss-2 7 fs",
+    "predescu-3 6 fs", "predescu-3 9 fs", "predescu-3 12 fs",
     "omelyan-2 4 fs SVR 0.1 ps every 3", "omelyan-2 6 fs SVR 0.1 ps every 2", "bcss-2 4 fs SVR 0.1 ps every 3",
     "bcss-2 6 fs SVR 0.1 ps every 2",
     "verlet 2 fs SVR 0.1 ps every 6", "verlet 3 fs SVR 0.1 ps every 4",
@@ -134,14 +135,14 @@ FRONTIER_ROWS = [
 
 
 def frontier() -> dict:
-    """Issue 35's study: the box, lengths and observables of :func:`full`, 8 replicas (more with --replicas), replica
+    """Issue 35's study: the box, lengths and observables of :func:`full`, 12 replicas (more with --replicas), replica
     states from the package's thermostat (velocity Verlet at 1 fs with stochastic velocity rescaling at the ends of
     the step: on-step velocities and positions both canonical at 300 K; ``equilibrator``), runs of version 3
     (leapfrog rows' velocities brought to the positions' time, the omega ACF's features read between its samples and
     its curve kept), the references Verlet at 0.5 fs NVE and on the event grid NVT, and :data:`TOLERANCES`."""
     cfg = full()
     del cfg["frozen"]
-    cfg.update(rows=list(FRONTIER_ROWS), replicas=8, run_version=3, equilibrator="svr",
+    cfg.update(rows=list(FRONTIER_ROWS), replicas=12, run_version=3, equilibrator="svr",
                references={"NVE": "verlet 0.5 fs", "NVT": "verlet 0.5 fs SVR 0.1 ps every 24"},
                tolerances=TOLERANCES)
     return cfg
