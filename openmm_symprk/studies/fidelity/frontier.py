@@ -34,7 +34,7 @@ def family_of(label: str) -> str:
 
 def bias_order(label: str) -> int:
     """The power p of the family's bias c h^p: the method's order under constraints (RATTLE keeps a composition's
-    fourth order, not a fourth-order splitting's: :attr:`~openmm_symprk.methods.ResolvedMethod.constrained_order`) for
+    fourth order, not a fourth-order splitting's: the resolved method's ``constrained_order``) for
     the package's NVE rows; 2 for OpenMM's integrators and for every thermostat row (the thermostat's splitting is
     second order whatever the method)."""
     row = to_row(label)
