@@ -112,6 +112,25 @@ def test_a_second_call_reuses_every_run(quick):
     assert {r["label"]: r.get("values") for r in jsonable(again)["rows"]} == first  # the same runs, summarised again
 
 
+def test_a_run_of_some_rows_times_them_in_turns_with_the_rows_timed_before(quick, tmp_path):
+    """--rows on a folder with timings: the file keeps every row, all timed again in the same turns (a subset's own
+    timings beside the earlier ones would compare two sessions' loads)."""
+    import shutil
+
+    _, out, _ = quick
+    copy_ = str(tmp_path / "copy")
+    shutil.copytree(out, copy_, ignore=shutil.ignore_patterns(".lock"))
+    with open(os.path.join(copy_, "timings.json")) as fh:
+        before = json.load(fh)
+    cfg = presets.quick()
+    cfg["rows"] = cfg["rows"][:2] + ["verlet 2 fs"]  # the references and one row, as --rows selects them
+    run_study(cfg, copy_, workers=1, timing=True, progress=False, log=lambda *a: None)
+    with open(os.path.join(copy_, "timings.json")) as fh:
+        after = json.load(fh)
+    assert set(after["s_per_ps"]) == set(before["s_per_ps"]) and len(after["s_per_ps"]) > 1
+    assert after["s_per_ps"] != before["s_per_ps"] and all(v > 0 for v in after["s_per_ps"].values())
+
+
 def test_an_interrupted_study_runs_only_what_is_missing(quick, tmp_path):
     """A copy of the finished study with one run lost (as if interrupted before it was stored): a call runs that
     one alone and stores it under the same key."""

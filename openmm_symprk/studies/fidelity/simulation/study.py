@@ -18,7 +18,7 @@ import warnings
 from ....systems.checks import ConservationWarning
 from ...core import Run, Study, run_key as row_run_key, write_json, write_text
 from ...core.replicas import BOX_STATE_KEYS, BOX_STATE_VERSION, water_box_replicas, water_box_scene
-from ..rowspec import check_row, to_row
+from ..rowspec import check_row, label, to_row
 
 __all__ = ["FidelityStudy", "run_study", "run_key", "temperature_view", "RUN_KEYS", "RUN_VERSION"]
 
@@ -186,12 +186,16 @@ class FidelityStudy(Study):
 
     def timings(self) -> dict:
         """Seconds per simulated ps of each available row on replica 0, timed in turns
-        (:func:`openmm_symprk.studies.core.timing.time_rows`), so the ratios hold under the machine's load."""
+        (:func:`openmm_symprk.studies.core.timing.time_rows`), so the ratios hold under the machine's load.  The rows
+        timed before in this folder are timed again with them (a run of some rows, ``--rows``, keeps one timings file
+        whose rows were all timed in the same turns)."""
         from ...core.timing import seconds_per_ps
         from .runs import replica_seed
 
         x, v = self.states
-        rows = {r.label: r for r in (to_row(row, self.cfg["temperature"]) for row in self.rows)}
+        chosen = {label(row) for row in self.rows}
+        labels = list(self.rows) + [lab for lab in self.stored_timings() if lab not in chosen]
+        rows = {r.label: r for r in (to_row(row, self.cfg["temperature"]) for row in labels)}
         out = seconds_per_ps(rows, self.box, x[0], v[0], float(self.cfg.get("timing_fs", 50.0)),
                              self.cfg.get("threads", 1), replica_seed(self.cfg, 0))
         self.log(f"timed {len(rows)} rows in turns")
