@@ -134,8 +134,9 @@ FRONTIER_ROWS = [
     "langevin 1 fs friction 0.1/ps", "langevin 2 fs friction 0.1/ps", "langevin 3 fs friction 0.1/ps",
     # fourth order where it might survive constraints (issue 35): the compositions over RATTLE keep it (fitted as
     # c h^4), PEFRL falls to second order; each up to about its stability limit in water (the catalogue's interval
-    # over Verlet's, times Verlet's 4-5 fs)
+    # over Verlet's, times Verlet's 4-5 fs), then one step beyond, to find where each fails
     "yoshida-4 3 fs", "yoshida-4 4 fs", "suzuki-4 6 fs", "suzuki-4 8 fs", "pefrl 6 fs", "pefrl 8 fs",
+    "yoshida-4 5 fs", "suzuki-4 10 fs", "pefrl 10 fs",
 ]
 #: The frontier's deciding rows (``--rows deciding``; what TIP3P runs, ``--model tip3p``): those that decide the
 #: answer in SPC/E (the references, OpenMM's families, omelyan-2 in both ensembles) and the placement question's rows.
