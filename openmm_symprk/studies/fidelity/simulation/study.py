@@ -140,10 +140,15 @@ class FidelityStudy(Study):
     def summarise(self, runs) -> dict:
         from ..report import chart, format_summary, markdown_table, summarise
 
+        grouped = {k[0]: v for k, v in self.results(runs, ("row",)).items()}
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", ConservationWarning)
-            timings = self.stored_timings() if self.report_only or not self.timing else self.timings()
-        grouped = {k[0]: v for k, v in self.results(runs, ("row",)).items()}
+            if self.report_only or not self.timing:
+                timings = self.stored_timings()
+            else:  # a row that blew up on the replica state the timing starts from has no wall time to measure
+                stable = {lab for lab, reps in grouped.items()
+                          if any(i.get("replica") == 0 and i.get("status") == "ok" for _, i in reps)}
+                timings = self.timings(stable)
         summary = summarise(self.cfg, self.rows, grouped, timings, self.box_edge(),
                             references(self.cfg, self.rows))
         # the temperature view needs each run's time series (<key>.npz), which a committed data set leaves out
@@ -184,18 +189,20 @@ class FidelityStudy(Study):
         except (FileNotFoundError, json.JSONDecodeError, KeyError):
             return {}
 
-    def timings(self) -> dict:
+    def timings(self, stable=None) -> dict:
         """Seconds per simulated ps of each available row on replica 0, timed in turns
         (:func:`openmm_symprk.studies.core.timing.time_rows`), so the ratios hold under the machine's load.  The rows
         timed before in this folder are timed again with them (a run of some rows, ``--rows``, keeps one timings file
-        whose rows were all timed in the same turns)."""
+        whose rows were all timed in the same turns).  ``stable``: the labels whose run from replica 0 finished (this
+        call's other rows, unstable there, are not timed); None: every row."""
         from ...core.timing import seconds_per_ps
         from .runs import replica_seed
 
         x, v = self.states
         chosen = {label(row) for row in self.rows}
         labels = list(self.rows) + [lab for lab in self.stored_timings() if lab not in chosen]
-        rows = {r.label: r for r in (to_row(row, self.cfg["temperature"]) for row in labels)}
+        rows = {r.label: r for r in (to_row(row, self.cfg["temperature"]) for row in labels)
+                if stable is None or r.label in stable or r.label not in chosen}  # timed before: ran then
         out = seconds_per_ps(rows, self.box, x[0], v[0], float(self.cfg.get("timing_fs", 50.0)),
                              self.cfg.get("threads", 1), replica_seed(self.cfg, 0))
         self.log(f"timed {len(rows)} rows in turns")
