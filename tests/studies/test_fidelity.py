@@ -131,6 +131,24 @@ def test_a_run_of_some_rows_times_them_in_turns_with_the_rows_timed_before(quick
     assert after["s_per_ps"] != before["s_per_ps"] and all(v > 0 for v in after["s_per_ps"].values())
 
 
+def test_a_row_that_blows_up_is_reported_and_left_out_of_the_timing(quick, tmp_path):
+    """yoshida-4 at 8 fs (stability interval 1.57 for three evaluations) blows up on rigid water: its runs say at which
+    step, the study finishes, and the timing in turns leaves the row out instead of stopping at it."""
+    import shutil
+
+    _, out, _ = quick
+    copy_ = str(tmp_path / "copy")
+    shutil.copytree(out, copy_, ignore=shutil.ignore_patterns(".lock"))
+    cfg = presets.quick()
+    cfg["rows"] = cfg["rows"][:2] + ["yoshida-4 8 fs"]
+    summary = run_study(cfg, copy_, workers=1, timing=True, progress=False, log=lambda *a: None)
+    (row,) = [r for r in summary["rows"] if r["label"] == "yoshida-4 8 fs"]
+    assert row["replicas"] == 0 and row["failed"] and all(f.startswith("unstable at step") for f in row["failed"])
+    with open(os.path.join(copy_, "timings.json")) as fh:
+        timed = json.load(fh)["s_per_ps"]
+    assert "yoshida-4 8 fs" not in timed and "verlet 0.5 fs" in timed
+
+
 def test_an_interrupted_study_runs_only_what_is_missing(quick, tmp_path):
     """A copy of the finished study with one run lost (as if interrupted before it was stored): a call runs that
     one alone and stores it under the same key."""
