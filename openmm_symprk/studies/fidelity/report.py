@@ -15,8 +15,8 @@ from __future__ import annotations
 import numpy as np
 
 from ...stats import combine, paired
-from ...support import require
 from ...analysis.diffusion import VISCOSITY_MPAS, yeh_hummer
+from ..core.charts import pyplot, save
 from .extrapolation import extrapolate_h2
 from .observables import OBSERVABLES
 from .rowspec import describe, is_verlet_limit, to_row
@@ -459,9 +459,7 @@ def chart(summary: dict, path: str, x: str = "evals_per_ps"):
     """One panel per observable: the bias against the reference (paired, error bars ± 3 SE) against the cost
     ``x`` ("evals_per_ps" or "s_per_ps"; rows of equal cost drawn side by side); the package's NVE rows blue, its thermostatted rows green, OpenMM's
     integrators orange, HMR rows hollow."""
-    require("matplotlib", "studies", "openmm_symprk.studies.fidelity.report.chart").use("Agg")
-    plt = require("matplotlib.pyplot", "studies", "openmm_symprk.studies.fidelity.report.chart")
-
+    plt = pyplot("openmm_symprk.studies.fidelity.report.chart")
     fig, axes = plt.subplots(4, 4, figsize=(18, 15))
     axes = axes.ravel()
     markers = "osD^v<>phH*Xd8P"
@@ -490,6 +488,4 @@ def chart(summary: dict, path: str, x: str = "evals_per_ps"):
     refs = summary.get("references") or {"NVE": summary["reference"]}
     against = " and ".join(f"{lab} ({ens} rows)" for ens, lab in refs.items()) if len(refs) > 1 else summary["reference"]
     fig.suptitle(f"Bias against {against} (paired by replica, error bars ± {K_SE:g} SE) against cost")
-    fig.tight_layout()
-    fig.savefig(path, dpi=90)
-    plt.close(fig)
+    save(fig, path, dpi=90)
