@@ -293,6 +293,11 @@ _SHORT = {"D": "D", "tau1_dip": "tau1 dip ps", "tau2_dip": "tau2 dip ps", "tau1_
           "dT": "Trot-Ttr K", "T_trans": "T_trans K", "g_r": "gOO r nm", "g_h": "gOO height", "drift": "drift"}
 
 
+def _why_empty(e) -> str:
+    """Why a row of the tables has no values: its status, its first failed run, or no finished runs."""
+    return e["status"] if e["status"] != "ok" else (e["failed"][0] if e["failed"] else "no finished runs")
+
+
 def _table(summary, field, title, extra=True) -> list:
     w = 18
     head = f"{'row':36s} {'n':>2s} " + " ".join(f"{_SHORT[k]:>{w}s}" for k, _, _ in OBSERVABLES)
@@ -301,8 +306,7 @@ def _table(summary, field, title, extra=True) -> list:
     lines = [title, head]
     for e in summary["rows"]:
         if e["status"] != "ok" or not e["replicas"]:
-            why = e["status"] if e["status"] != "ok" else (e["failed"][0] if e["failed"] else "no finished runs")
-            lines.append(f"{e['label']:36s} {why}")
+            lines.append(f"{e['label']:36s} {_why_empty(e)}")
             continue
         vals = e.get(field) or {}
         line = f"{e['label']:36s} {e['replicas']:2d} " + " ".join(f"{_pm(vals.get(k), FORMAT[k]):>{w}s}"
@@ -432,8 +436,7 @@ def markdown_table(summary: dict, keys=("D", "tau1_dip", "tau2_hh", "w_zero", "w
     lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     for e in summary["rows"]:
         if e["status"] != "ok" or not e["replicas"]:
-            why = e["status"] if e["status"] != "ok" else (e["failed"][0] if e["failed"] else "no finished runs")
-            lines.append(f"| {e['label']} | 0 | {e['evals_per_ps']:.0f} | | {why} |" + " |" * (len(head) - 5))
+            lines.append(f"| {e['label']} | 0 | {e['evals_per_ps']:.0f} | | {_why_empty(e)} |" + " |" * (len(head) - 5))
             continue
         own = e.get("is_reference")
         vals = e.get("values") if own else e.get("vs_ref")
