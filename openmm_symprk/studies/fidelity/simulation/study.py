@@ -90,8 +90,7 @@ def check(cfg: dict) -> list:
     if not rows:
         raise ValueError("no rows")
     references(cfg, rows)
-    labels = rows
-    dup = sorted({x for x in labels if labels.count(x) > 1})
+    dup = sorted({x for x in rows if rows.count(x) > 1})
     if dup:
         raise ValueError(f"rows given twice: {', '.join(dup)}")
     return rows
