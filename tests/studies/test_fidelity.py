@@ -482,9 +482,25 @@ def test_the_frontier_preset_pairs_its_nvt_rows_on_one_event_grid():
             families.setdefault(family_of(r), set()).add(Row.parse(r).step_fs)
     assert all(len(steps) >= 2 for steps in families.values()), families
     assert family_of("omelyan-2 4 fs SVR 0.1 ps every 3") == family_of("omelyan-2 6 fs SVR 0.1 ps every 2")
+    from openmm_symprk.studies.fidelity.cli import select_rows
+
+    deciding = select_rows(cfg, "deciding")
+    assert set(deciding) == set(presets.FRONTIER_DECIDING) and set(deciding) < set(rows)
+    assert all(len({Row.parse(r).step_fs for r in deciding if family_of(r) == f}) >= 2 for f in
+               {family_of(r) for r in deciding if r not in cfg["references"].values()})
     keys = {k.removesuffix("_rel") for level in cfg["tolerances"].values() for k in level}
     from openmm_symprk.studies.fidelity.observables import OBSERVABLES
     assert keys <= {k for k, _, _ in OBSERVABLES}
+
+
+def test_a_family_fits_its_bias_at_the_order_the_method_keeps_under_constraints():
+    """c h^p with p the constrained order: compositions over RATTLE stay fourth order, a fourth-order splitting falls
+    to second (pefrl), and OpenMM's integrators and every thermostat row are fitted at second order."""
+    from openmm_symprk.studies.fidelity.frontier import bias_order
+
+    assert [bias_order(r) for r in ("yoshida-4 3 fs", "suzuki-4 6 fs")] == [4, 4]
+    assert [bias_order(r) for r in ("pefrl 6 fs", "omelyan-2 4 fs", "openmm-verlet 2 fs", "langevin 2 fs friction 0.1/ps",
+                                    "yoshida-4 6 fs SVR 0.1 ps every 2")] == [2, 2, 2, 2, 2]
 
 
 def test_the_issue_26_study_is_kept_as_it_ran(tmp_path):

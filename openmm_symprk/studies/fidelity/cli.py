@@ -28,13 +28,14 @@ def build_parser(prog: str = "symprk fidelity"):
 
 def select_rows(cfg: dict, text: str) -> list:
     """The references and the preset rows named in ``text`` (comma-separated labels, written in any order of the
-    row grammar, or ``deciding``: :data:`.presets.DECIDING`), in the presets' order."""
+    row grammar, or ``deciding``: the preset's rows that decide its answer, ``cfg["deciding"]``, by default
+    :data:`.presets.DECIDING`), in the presets' order."""
     from .rowspec import label
 
     wanted = []
     for w in (w.strip() for w in text.split(",")):
         if w == "deciding":
-            wanted += presets.DECIDING
+            wanted += cfg.get("deciding", presets.DECIDING)
         elif w:
             wanted.append(w)
     labels = [label(r) for r in cfg["rows"]]

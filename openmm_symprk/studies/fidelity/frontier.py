@@ -2,8 +2,8 @@
 
 A family is the rows of one integrator and thermostat that differ only in the step (and, on the common event grid,
 in the thermostat interval that keeps the events at the same simulated times).  Per ensemble, observable and family
-the paired biases against the ensemble's reference (replica by replica) are fitted as c h^p
-(:mod:`openmm_symprk.stats.frontier`: weights 1/SE^2, replicas resampled jointly across families), and at each
+the paired biases against the ensemble's reference (replica by replica) are fitted as c h^p (p: :func:`bias_order`,
+:mod:`openmm_symprk.stats.frontier`: weights 1/SE^2, replicas resampled jointly across families), and at each
 tolerance level (:data:`.presets.TOLERANCES`, declared before the runs) each family gets its equal-accuracy step
 (the smallest over the observables, at most the largest step it ran), its cost per simulated ps (force evaluations,
 and wall seconds from the rows' timings), the step at which every observable stays inside its tolerance with 95 %
@@ -21,7 +21,7 @@ from ..core.charts import pyplot, save
 from ..core.rows import OPENMM_KINDS
 from .rowspec import to_row
 
-__all__ = ["family_of", "families", "frontier_summary", "format_frontier", "frontier_chart", "N_BOOT"]
+__all__ = ["family_of", "bias_order", "families", "frontier_summary", "format_frontier", "frontier_chart", "N_BOOT"]
 
 #: Bootstrap resamples of the replicas.
 N_BOOT = 2000
@@ -31,6 +31,17 @@ def family_of(label: str) -> str:
     """The family of a row: its label with the step (and the thermostat interval that follows it) left out."""
     row = to_row(label)
     return dataclasses.replace(row, step_fs=1.0, every=1).label.replace(" 1 fs", "", 1)
+
+
+def bias_order(label: str) -> int:
+    """The power p of the family's bias c h^p: the method's order under constraints (RATTLE keeps a composition's
+    fourth order, not a fourth-order splitting's: the resolved method's ``constrained_order``) for
+    the package's NVE rows; 2 for OpenMM's integrators and for every thermostat row (the thermostat's splitting is
+    second order whatever the method)."""
+    row = to_row(label)
+    if not row.is_ours or row.ensemble != "NVE":
+        return 2
+    return int(row.resolved(constraints=True).constrained_order or 2)
 
 
 def _absolute(tolerances: dict, ref_means: dict) -> dict:
@@ -73,7 +84,7 @@ def families(rows, per: dict, reference: str, ensemble: str, observables) -> lis
                         b[i, rep] = value - ref[k][rep][0]
             bias[k] = b
         rows_ = [to_row(lab) for lab in labels]
-        out.append((Family(name, tuple(r.step_fs for r in rows_), bias, order=2,
+        out.append((Family(name, tuple(r.step_fs for r in rows_), bias, order=bias_order(labels[0]),
                            cost_per_step=float(np.mean([r.evals_per_step() for r in rows_]))), labels))
     return out
 
