@@ -17,11 +17,11 @@ import os
 import numpy as np
 
 from ...support import require
+from ..core.charts import pyplot, save
 from .aggregate import usable
 from .runs import label
 
-require("matplotlib", "studies", "openmm_symprk.studies.bench.charts").use("Agg")
-plt = require("matplotlib.pyplot", "studies", "openmm_symprk.studies.bench.charts")
+plt = pyplot("openmm_symprk.studies.bench.charts")
 
 
 def _log_axes(ax):
@@ -122,10 +122,7 @@ def work_precision(results, scene, path) -> str | None:
                  f"wall times on {info['platform']}", fontsize=10)
     handles, labels = axes[0, 0].get_legend_handles_labels()
     fig.legend(handles, labels, loc="lower center", ncol=min(5, len(labels)), fontsize=9, frameon=False)
-    fig.tight_layout(rect=(0, 0.06, 1, 0.95))
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return save(fig, path, rect=(0, 0.06, 1, 0.95))
 
 
 def stability_chart(results, path) -> str | None:
@@ -167,10 +164,7 @@ def stability_chart(results, path) -> str | None:
     fig.suptitle("Largest stable step by bisection.  Failure: blow-up, |E - E0| > 0.1 kT per DOF, or a constraint "
                  "error > 1e-3.\nRed ticks: catalogue stability interval h*omega / omega_max (harmonic toy).",
                  fontsize=9)
-    fig.tight_layout(rect=(0, 0, 1, 0.97))
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return save(fig, path, rect=(0, 0, 1, 0.97))
 
 
 def _trace_step(results, scene):
@@ -215,10 +209,7 @@ def energy_chart(results, scene, path) -> str | None:
             ax.set_title("linear scale (Langevin and failed runs may leave the frame)", fontsize=9)
     axes[1].legend(fontsize=8, loc="center left", bbox_to_anchor=(1.01, 0.5), frameon=False)
     fig.suptitle(f"{scene}: energy error at {h:g} fs ({results['scenes'][scene]['description']})", fontsize=10)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return save(fig, path)
 
 
 def speed_chart(results, path) -> str | None:
@@ -255,10 +246,7 @@ def speed_chart(results, path) -> str | None:
     ax.set_title("Cost per step relative to OpenMM's VerletIntegrator (timed in alternation in the same run, median "
                  "over step sizes);\ndashed: cost = force evaluations.  The toys (a few hundred independent particles) "
                  "show CustomIntegrator overhead, not force cost", fontsize=9)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return save(fig, path)
 
 
 def production_chart(results, scene, path) -> str | None:
@@ -292,10 +280,7 @@ def production_chart(results, scene, path) -> str | None:
     fig.suptitle(f"{scene}: {info['description']}\nbaseline (square): {label(base['method'])} at {base['step_fs']:g} fs; "
                  "green: drift and fluctuation no larger than the baseline's; red: larger; black: OpenMM's integrators",
                  fontsize=9)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return path
+    return save(fig, path, dpi=120)
 
 
 def make_charts(results, folder) -> list:

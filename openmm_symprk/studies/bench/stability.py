@@ -191,8 +191,6 @@ def linear_settings(omega_max: float, rel_tol: float = 1e-4) -> dict:
             "omega_max": omega_max}
 
 
-
-
 def run_spec(spec: RunSpec, scene) -> tuple:
     """(record, arrays) of any spec: linear probes here, everything else by :func:`.runs.execute`."""
     if spec.role == "linear-probe":

@@ -140,18 +140,20 @@ def work(payload: dict, spec_dict: dict):
     return run_spec(RunSpec(**spec_dict), _scenes[key])
 
 
-def _run_jobs(jobs, store, executor, fingerprints, progress=True, on_result=None):
-    def key_of(spec):
-        key = run_key(spec, fingerprints[spec.scene])
-        store.adopt(key, legacy_key(spec, fingerprints[spec.scene]))
-        return key
+def _key(store, spec, fingerprints) -> str:
+    """The run key of ``spec``, its run found under its legacy key where only that one is stored."""
+    key = run_key(spec, fingerprints[spec.scene])
+    store.adopt(key, legacy_key(spec, fingerprints[spec.scene]))
+    return key
 
+
+def _run_jobs(jobs, store, executor, fingerprints, progress=True, on_result=None):
     def stored(spec):
-        rec = store.get(key_of(spec))
+        rec = store.get(_key(store, spec, fingerprints))
         return None if rec is None or rec.status == "error" else rec
 
     def finish(spec, fut):
-        key = key_of(spec)
+        key = _key(store, spec, fingerprints)
         rec, arrays = _result(fut, spec)
         store.put(key, rec, arrays)
         return store.get(key)
@@ -211,8 +213,7 @@ def retime_sweep(config: dict, out: str, rounds: int = 3, workers: int = 1, char
             if job.kind != "run":
                 continue
             spec = next(job.gen)
-            key = run_key(spec, fingerprints[spec.scene])
-            store.adopt(key, legacy_key(spec, fingerprints[spec.scene]))
+            key = _key(store, spec, fingerprints)
             rec = store.get(key)
             if rec is not None and rec.wall_per_step and spec.timing_s > 0:
                 todo.append((spec, key, rec))

@@ -38,28 +38,14 @@ def _call(work, name, args):
     return _quietly(work, _shared[name], args)
 
 
-class _Done:
-    """A finished 'future' for the in-process executor."""
-
-    def __init__(self, fn, *args):
-        try:
-            self._result, self._exc = fn(*args), None
-        except BaseException as exc:  # noqa: BLE001 - handed back to the caller like a real future
-            self._result, self._exc = None, exc
-
-    def result(self):
-        if self._exc is not None:
-            raise self._exc
-        return self._result
-
-    def cancel(self):
-        return False
-
-    def cancelled(self):
-        return False
-
-    def done(self):
-        return True
+def _done(fn, *args) -> cf.Future:
+    """A finished future of ``fn(*args)`` (the in-process executor's): its result, or the exception it raised."""
+    fut = cf.Future()
+    try:
+        fut.set_result(fn(*args))
+    except BaseException as exc:  # noqa: BLE001 - handed back to the caller like a real future
+        fut.set_exception(exc)
+    return fut
 
 
 class SerialExecutor:
@@ -71,7 +57,7 @@ class SerialExecutor:
         self.work, self.shared = work, shared
 
     def submit(self, name, *args):
-        return _Done(_quietly, self.work, self.shared[name], args)
+        return _done(_quietly, self.work, self.shared[name], args)
 
     def wait(self, futures):
         return set(futures)

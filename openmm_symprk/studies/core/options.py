@@ -1,5 +1,5 @@
 """The studies' command-line options (the command frame, :func:`openmm_symprk.cli.run_command`, runs them):
-:func:`positive` numbers, the options every replica study shares (:func:`add_study_arguments`) and its run and
+:func:`positive` numbers, a configuration's counts and positive settings checked (:func:`check_settings`), the options every replica study shares (:func:`add_study_arguments`) and its run and
 report (:func:`run_study`: options checked before anything runs)."""
 from __future__ import annotations
 
@@ -7,7 +7,7 @@ import argparse
 import os
 from importlib import import_module
 
-__all__ = ["positive", "add_study_arguments", "run_study"]
+__all__ = ["positive", "check_settings", "add_study_arguments", "run_study"]
 
 
 def positive(kind=float):
@@ -23,6 +23,17 @@ def positive(kind=float):
             raise argparse.ArgumentTypeError(f"must be positive, got {text}")
         return value
     return parse
+
+
+def check_settings(cfg: dict, counts=(), positive=()) -> None:
+    """ValueError naming the first setting of ``cfg`` among ``counts`` that is not a whole number >= 1 (a bool
+    neither), or among ``positive`` that is not a number > 0, and its value."""
+    for k in counts:
+        if isinstance(cfg[k], bool) or int(cfg[k]) < 1:
+            raise ValueError(f"{k} must be >= 1, got {cfg[k]!r}")
+    for k in positive:
+        if not float(cfg[k]) > 0:
+            raise ValueError(f"{k} must be positive, got {cfg[k]!r}")
 
 
 def add_study_arguments(ap, *, quick: str, out: str | None, workers: str, length: str, default_workers: int = 2,

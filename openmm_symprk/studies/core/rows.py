@@ -62,6 +62,9 @@ LEAPFROG = ("openmm-verlet", "langevin", "dpd")
 #: ...and those that do not keep the total momentum (per-particle friction and noise).
 NO_MOMENTUM = ("langevin", "mts-langevin")
 RIGID_PREFIX = "rigid:"
+#: The label's words ``KEY VALUE UNIT``: KEY -> (the field it sets, UNIT).
+_QUANTITIES = {"SVR": ("tau_ps", "ps"), "cutoff": ("cutoff_nm", "nm"), "T": ("temperature", "K"),
+               "HMR": ("hmr_da", "Da")}
 _NUMBER = r"[0-9]*\.?[0-9]+(?:[eE][-+]?[0-9]+)?"
 _OLD_MTS = re.compile(r"^(?P<who>[^/@\s]+)(?:/(?P<inner>[^@\s]+))?@mts(?P<n>[0-9]+)$")
 _OLD_OPENMM_MTS = re.compile(r"^openmm-mts(?P<n>[0-9]+)$")
@@ -321,8 +324,8 @@ class Row:
                     if n:
                         fields["mts"] = int(number(n, "the inner steps"))
                     i += 2
-                elif w == "SVR" and words[i + 2:i + 3] == ["ps"]:
-                    fields["tau_ps"] = number(nxt, "SVR")
+                elif w in _QUANTITIES and words[i + 2:i + 3] == [_QUANTITIES[w][1]]:
+                    fields[_QUANTITIES[w][0]] = number(nxt, w)
                     i += 3
                 elif w in ("friction", "collision") and nxt and nxt.endswith("/ps"):
                     fields["friction_per_ps" if w == "friction" else "collision_per_ps"] = number(nxt[:-3], w)
@@ -330,30 +333,18 @@ class Row:
                 elif w.endswith("/ps") and re.fullmatch(_NUMBER, w[:-3]):
                     fields["collision_per_ps"] = float(w[:-3])
                     i += 1
-                elif w == "cutoff" and words[i + 2:i + 3] == ["nm"]:
-                    fields["cutoff_nm"] = number(nxt, "cutoff")
-                    i += 3
-                elif w == "every" and nxt:
-                    fields["every"] = int(number(nxt, "every"))
+                elif w in ("every", "seed") and nxt:
+                    fields[w] = int(number(nxt, w))
                     i += 2
                 elif w in POSITIONS:
                     fields["position"] = w
                     i += 1
-                elif w == "T" and words[i + 2:i + 3] == ["K"]:
-                    fields["temperature"] = number(nxt, "T")
-                    i += 3
                 elif w == "exact-momentum":
                     fields["exact_momentum"] = True
                     i += 1
-                elif w == "HMR" and words[i + 2:i + 3] == ["Da"]:
-                    fields["hmr_da"] = number(nxt, "HMR")
-                    i += 3
                 elif w in ("native", "custom"):
                     fields["backend"] = w
                     i += 1
-                elif w == "seed" and nxt:
-                    fields["seed"] = int(number(nxt, "seed"))
-                    i += 2
                 else:
                     raise ValueError(f"row {text!r}: {' '.join(words[i:])!r} not understood")
         except ValueError as exc:

@@ -74,6 +74,14 @@ class Study:
     def stored(self, run: Run, info: dict):
         """Called in this process after each run is stored (e.g. to log a failed run)."""
 
+    def chart(self, draw, *args, **kwargs):
+        """``draw(*args, **kwargs)``, a study's chart; without matplotlib the log says so (MissingDependencyError
+        names the extra that installs it) and the study's tables stand without it."""
+        try:
+            draw(*args, **kwargs)
+        except ImportError as exc:
+            self.log(f"no chart: {exc}")
+
     # -- the skeleton ---------------------------------------------------------------------------------------------
     def run(self, report_only: bool = False):
         """Run what is missing and return :meth:`summarise` of every planned run.  ``report_only``: run nothing and

@@ -4,15 +4,13 @@ backend, PNG).  The y axis is symmetric-logarithmic: linear within +-0.01 kT/ns/
 zero shows as such and the sign is kept."""
 from __future__ import annotations
 
-import os
-
 from ...support import require
+from ..core.charts import pyplot, save
 
 
 def work_precision(summary: dict, path: str) -> str:
     """Draw the chart of a summary of the NVT study (:func:`.report.summarise`) into ``path``; returns ``path``."""
-    require("matplotlib", "studies", "openmm_symprk.studies.drift.chart").use("Agg")
-    plt = require("matplotlib.pyplot", "studies", "openmm_symprk.studies.drift.chart")
+    plt = pyplot("openmm_symprk.studies.drift.chart")
     fig, ax = plt.subplots(figsize=(7.0, 4.6))
     colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
     by = {r["name"]: r for r in summary["rows"]}
@@ -44,8 +42,4 @@ def work_precision(summary: dict, path: str) -> str:
                  f"{cfg['length_ps']:g} ps\n{cfg['rows'][0]['scene']}, {cfg['rows'][0]['platform']}", fontsize=9)
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)
-    fig.tight_layout()
-    os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return save(fig, path)

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import shutil
 import sys
 
 from ..core.options import add_study_arguments, run_study
@@ -83,20 +84,10 @@ def run(args):
         args.out = os.path.join("drift-results", args.study + ("-quick" if args.quick else ""))
     run_study(args, {}, lambda cfg: cfg.update(make_config(args)), "openmm_symprk.studies.drift.study",
               "openmm_symprk.studies.drift.report")
-    if args.chart or args.json:
-        import json
-        import shutil
-
-        from ...support.files import write_json
-
-        with open(os.path.join(args.out, "results.json")) as fh:
-            summary = json.load(fh)
-        if args.json:
-            write_json(args.json, summary)
-            print(f"wrote {args.json}")
-        if args.chart and not os.path.exists(os.path.join(args.out, "nvt-drift.png")):
-            print(f"{args.prog}: no chart was drawn (see above), so none is copied to {args.chart}", file=sys.stderr)
-        elif args.chart:
-            os.makedirs(os.path.dirname(os.path.abspath(args.chart)), exist_ok=True)
-            shutil.copyfile(os.path.join(args.out, "nvt-drift.png"), args.chart)
-            print(f"wrote {args.chart}")
+    for copy, name in ((args.json, "results.json"), (args.chart, "nvt-drift.png")):  # results.json is always written
+        if copy and not os.path.exists(os.path.join(args.out, name)):
+            print(f"{args.prog}: no chart was drawn (see above), so none is copied to {copy}", file=sys.stderr)
+        elif copy:
+            os.makedirs(os.path.dirname(os.path.abspath(copy)), exist_ok=True)
+            shutil.copyfile(os.path.join(args.out, name), copy)
+            print(f"wrote {copy}")

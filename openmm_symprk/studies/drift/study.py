@@ -12,6 +12,7 @@ import os
 
 from ...support.files import content_key
 from ..core import Run, Study, platforms, run_key as row_run_key, write_json, write_text
+from ..core.options import check_settings
 from ..core.replicas import scene_replicas, scene_state_key
 from .runs import row_of
 
@@ -54,11 +55,7 @@ def check(cfg: dict):
     """ValueError naming the bad value and what is accepted."""
     from ..core.scenes import SCENES
 
-    if int(cfg["replicas"]) < 1:
-        raise ValueError(f"replicas must be >= 1, got {cfg['replicas']!r}")
-    for k in ("length_ps", "sample_ps", "temperature", "constraint_tolerance"):
-        if not float(cfg[k]) > 0:
-            raise ValueError(f"{k} must be positive, got {cfg[k]!r}")
+    check_settings(cfg, ("replicas",), ("length_ps", "sample_ps", "temperature", "constraint_tolerance"))
     if float(cfg["decorrelate_ps"]) < 0:
         raise ValueError(f"decorrelate_ps must be >= 0, got {cfg['decorrelate_ps']!r}")
     names = [r["name"] for r in cfg["rows"]]
@@ -146,10 +143,7 @@ class DriftStudy(Study):
         if self.cfg.get("study") == "nvt":
             from .chart import work_precision
 
-            try:
-                work_precision(summary, os.path.join(self.out, "nvt-drift.png"))
-            except ImportError as exc:  # MissingDependencyError says which extra installs matplotlib
-                self.log(f"no chart: {exc}")
+            self.chart(work_precision, summary, os.path.join(self.out, "nvt-drift.png"))
         return summary
 
 

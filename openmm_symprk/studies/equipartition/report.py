@@ -2,7 +2,7 @@
 which the fidelity study's temperature view shares."""
 from __future__ import annotations
 
-from ...support import require
+from ..core.charts import pyplot, save
 from ..core.rows import Row
 from ..core.temperatures import format_summary, summarise
 
@@ -13,8 +13,7 @@ def chart(summary: dict, path: str):
     """Three panels, error bars ± 2 SE: T_rot - T_trans against step size with the reference row as a band;
     T_rot - T_trans minus the reference's (replica by replica) against force evaluations per ps; the potential
     energy per molecule minus the reference's against step size."""
-    require("matplotlib", "studies", "openmm_symprk.studies.equipartition.report.chart").use("Agg")
-    plt = require("matplotlib.pyplot", "studies", "openmm_symprk.studies.equipartition.report.chart")
+    plt = pyplot("openmm_symprk.studies.equipartition.report.chart")
 
     fig, axes = plt.subplots(1, 3, figsize=(15, 4.6))
     markers = {"verlet": "o", "omelyan-2": "s", "pefrl": "D"}
@@ -56,6 +55,4 @@ def chart(summary: dict, path: str):
     ref_label = next((res["reference"] for res in summary["models"].values() if res["reference"]), "the reference")
     fig.suptitle(f"Rigid water: equipartition between rotation and translation, against {ref_label} "
                  f"(error bars ± 2 SE)")
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    save(fig, path)

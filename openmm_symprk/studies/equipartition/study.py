@@ -15,6 +15,7 @@ import os
 
 from ...support.files import content_key
 from ..core import Run, RunStore, Study, run_key as row_run_key, write_json, write_text
+from ..core.options import check_settings
 from ..core.replicas import BOX_STATE_KEYS, water_box_replicas, water_box_scene
 from ..core.rows import Row
 from ..core.timing import seconds_per_ps
@@ -78,12 +79,8 @@ def load_runs(cfg: dict, out: str) -> dict:
 
 
 def _check(cfg):
-    for k in ("replicas", "n_waters"):
-        if int(cfg[k]) < 1:
-            raise ValueError(f"{k} must be >= 1, got {cfg[k]!r}")
-    for k in ("length_ps", "sample_fs", "equilibrate_ps", "cutoff_nm", "temperature"):
-        if not float(cfg[k]) > 0:
-            raise ValueError(f"{k} must be positive, got {cfg[k]!r}")
+    check_settings(cfg, ("replicas", "n_waters"), ("length_ps", "sample_fs", "equilibrate_ps", "cutoff_nm",
+                                                   "temperature"))
     for model, labels in cfg["models"].items():
         rows = [Row.parse(lab) for lab in labels]
         for row in rows:
@@ -132,10 +129,7 @@ class EquipartitionStudy(Study):
         summary = summarise(self.cfg, load_runs(self.cfg, self.out), timings)
         write_text(os.path.join(self.out, "summary.txt"), format_summary(summary) + "\n")
         write_json(os.path.join(self.out, "results.json"), summary)
-        try:
-            chart(summary, os.path.join(self.out, "equipartition.png"))
-        except ImportError as exc:  # MissingDependencyError says which extra installs matplotlib
-            self.log(f"no chart: {exc}")
+        self.chart(chart, summary, os.path.join(self.out, "equipartition.png"))
         return summary
 
 

@@ -33,10 +33,6 @@ class H2Fit:
         """The fitted value a + b h^2."""
         return self.a + self.b * np.asarray(h, dtype=np.float64) ** 2
 
-    def __format__(self, spec):
-        spec = spec or ".3f"
-        return f"{format(self.a, spec)} ± {format(self.a_se, spec)}"
-
 
 def extrapolate_h2(h, y, se) -> H2Fit:
     """Weighted least-squares fit y = a + b h^2 of the values ``y`` with standard errors ``se`` (> 0) at step

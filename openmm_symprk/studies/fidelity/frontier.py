@@ -17,6 +17,7 @@ import dataclasses
 import numpy as np
 
 from ...stats.frontier import Family, bootstrap, compare, fit_c, frontier
+from ..core.charts import pyplot, save
 from ..core.rows import OPENMM_KINDS
 from .rowspec import to_row
 
@@ -191,10 +192,7 @@ def frontier_chart(summary: dict, path: str):
     as the bias it predicts at each cost (h = evaluations per step / cost), and the standard tolerance as a band;
     a last panel per ensemble: the ratio of the package's cheapest family to OpenMM's per tolerance level, with its
     95 % interval (1: equal cost)."""
-    from ...support import require
-
-    require("matplotlib", "studies", "the frontier chart").use("Agg")
-    plt = require("matplotlib.pyplot", "studies", "the frontier chart")
+    plt = pyplot("the frontier chart")
     fr = summary.get("frontier") or {}
     ensembles = list(fr)
     if not ensembles:
@@ -238,6 +236,4 @@ def frontier_chart(summary: dict, path: str):
         ax.set_title(f"{ens}: OpenMM's cost / the package's (95 %)", fontsize=9)
         row_axes[0].legend(fontsize=6)
     fig.suptitle("Frontier: paired bias against cost, fits c h^2 (lines), the standard tolerance (band)", fontsize=10)
-    fig.tight_layout()
-    fig.savefig(path, dpi=80)
-    plt.close(fig)
+    save(fig, path, dpi=80)

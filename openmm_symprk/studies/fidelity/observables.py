@@ -20,8 +20,8 @@ from __future__ import annotations
 import numpy as np
 
 from ...analysis import angular, diffusion, reorientation, structure
-from ...physics.temperature import R_KJ
 from ...stats import drift, series_stats
+from ..core.units import kt_per_ns_per_dof
 
 __all__ = ["OBSERVABLES", "observables"]
 
@@ -92,9 +92,7 @@ def observables(series: dict, cfg: dict, n_waters: int, box_nm, has_drift: bool)
     if rdf is not None:
         curves["g_oo"] = rdf.g
     if has_drift:
-        slope, se = drift(t, series["etot"])
-        scale = 1000.0 / (R_KJ * float(cfg["temperature"]) * (6 * n_waters - 3))
-        obs["drift"] = [slope * scale, se * scale]
+        obs["drift"] = [kt_per_ns_per_dof(v, cfg["temperature"], 6 * n_waters - 3) for v in drift(t, series["etot"])]
     else:
         obs["drift"] = None
         notes["drift"] = "not applicable: the thermostat exposes no heat-bath energy"

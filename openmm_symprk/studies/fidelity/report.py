@@ -15,8 +15,8 @@ from __future__ import annotations
 import numpy as np
 
 from ...stats import combine, paired
-from ...support import require
 from ...analysis.diffusion import VISCOSITY_MPAS, yeh_hummer
+from ..core.charts import pyplot, save
 from .extrapolation import extrapolate_h2
 from .observables import OBSERVABLES
 from .rowspec import describe, is_verlet_limit, to_row
@@ -293,6 +293,11 @@ _SHORT = {"D": "D", "tau1_dip": "tau1 dip ps", "tau2_dip": "tau2 dip ps", "tau1_
           "dT": "Trot-Ttr K", "T_trans": "T_trans K", "g_r": "gOO r nm", "g_h": "gOO height", "drift": "drift"}
 
 
+def _why_empty(e) -> str:
+    """Why a row of the tables has no values: its status, its first failed run, or no finished runs."""
+    return e["status"] if e["status"] != "ok" else (e["failed"][0] if e["failed"] else "no finished runs")
+
+
 def _table(summary, field, title, extra=True) -> list:
     w = 18
     head = f"{'row':36s} {'n':>2s} " + " ".join(f"{_SHORT[k]:>{w}s}" for k, _, _ in OBSERVABLES)
@@ -301,8 +306,7 @@ def _table(summary, field, title, extra=True) -> list:
     lines = [title, head]
     for e in summary["rows"]:
         if e["status"] != "ok" or not e["replicas"]:
-            why = e["status"] if e["status"] != "ok" else (e["failed"][0] if e["failed"] else "no finished runs")
-            lines.append(f"{e['label']:36s} {why}")
+            lines.append(f"{e['label']:36s} {_why_empty(e)}")
             continue
         vals = e.get(field) or {}
         line = f"{e['label']:36s} {e['replicas']:2d} " + " ".join(f"{_pm(vals.get(k), FORMAT[k]):>{w}s}"
@@ -432,8 +436,7 @@ def markdown_table(summary: dict, keys=("D", "tau1_dip", "tau2_hh", "w_zero", "w
     lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     for e in summary["rows"]:
         if e["status"] != "ok" or not e["replicas"]:
-            why = e["status"] if e["status"] != "ok" else (e["failed"][0] if e["failed"] else "no finished runs")
-            lines.append(f"| {e['label']} | 0 | {e['evals_per_ps']:.0f} | | {why} |" + " |" * (len(head) - 5))
+            lines.append(f"| {e['label']} | 0 | {e['evals_per_ps']:.0f} | | {_why_empty(e)} |" + " |" * (len(head) - 5))
             continue
         own = e.get("is_reference")
         vals = e.get("values") if own else e.get("vs_ref")
@@ -459,9 +462,7 @@ def chart(summary: dict, path: str, x: str = "evals_per_ps"):
     """One panel per observable: the bias against the reference (paired, error bars ± 3 SE) against the cost
     ``x`` ("evals_per_ps" or "s_per_ps"; rows of equal cost drawn side by side); the package's NVE rows blue, its thermostatted rows green, OpenMM's
     integrators orange, HMR rows hollow."""
-    require("matplotlib", "studies", "openmm_symprk.studies.fidelity.report.chart").use("Agg")
-    plt = require("matplotlib.pyplot", "studies", "openmm_symprk.studies.fidelity.report.chart")
-
+    plt = pyplot("openmm_symprk.studies.fidelity.report.chart")
     fig, axes = plt.subplots(4, 4, figsize=(18, 15))
     axes = axes.ravel()
     markers = "osD^v<>phH*Xd8P"
@@ -490,6 +491,4 @@ def chart(summary: dict, path: str, x: str = "evals_per_ps"):
     refs = summary.get("references") or {"NVE": summary["reference"]}
     against = " and ".join(f"{lab} ({ens} rows)" for ens, lab in refs.items()) if len(refs) > 1 else summary["reference"]
     fig.suptitle(f"Bias against {against} (paired by replica, error bars ± {K_SE:g} SE) against cost")
-    fig.tight_layout()
-    fig.savefig(path, dpi=90)
-    plt.close(fig)
+    save(fig, path, dpi=90)

@@ -37,13 +37,11 @@ DEFAULT_SCENES = ("water", "protein")
 def _scene(name, n_waters):
     from ...systems import scenes
 
-    if name == "water":
-        return scenes.water_cluster(n_waters)
-    if name == "protein":
-        return scenes.protein_vacuum()
-    if name == "flexible-water":
-        return scenes.water_cluster(n_waters, rigid=False)
-    raise ValueError(f"unknown scene {name!r} (water, protein, flexible-water)")
+    builders = {"water": lambda: scenes.water_cluster(n_waters), "protein": scenes.protein_vacuum,
+                "flexible-water": lambda: scenes.water_cluster(n_waters, rigid=False)}
+    if name not in builders:
+        raise ValueError(f"unknown scene {name!r} (water, protein, flexible-water)")
+    return builders[name]()
 
 
 def _momenta(ctx):

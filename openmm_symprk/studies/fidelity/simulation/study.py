@@ -17,6 +17,7 @@ import warnings
 
 from ....systems.checks import ConservationWarning
 from ...core import Run, Study, run_key as row_run_key, write_json, write_text
+from ...core.options import check_settings
 from ...core.replicas import BOX_STATE_KEYS, BOX_STATE_VERSION, water_box_replicas, water_box_scene
 from ..rowspec import check_row, label, to_row
 
@@ -78,12 +79,8 @@ def work(shared: dict, row: dict, replica: int):
 
 def check(cfg: dict) -> list:
     """The config's rows, checked (step sizes as floats); ValueError naming what is wrong."""
-    for k in ("replicas", "n_waters", "rdf_every"):
-        if isinstance(cfg[k], bool) or int(cfg[k]) < 1:
-            raise ValueError(f"{k} must be >= 1, got {cfg[k]!r}")
-    for k in ("length_ps", "sample_fs", "omega_ps", "omega_fs", "equilibrate_ps", "cutoff_nm", "temperature"):
-        if not float(cfg[k]) > 0:
-            raise ValueError(f"{k} must be positive, got {cfg[k]!r}")
+    check_settings(cfg, ("replicas", "n_waters", "rdf_every"),
+                   ("length_ps", "sample_fs", "omega_ps", "omega_fs", "equilibrate_ps", "cutoff_nm", "temperature"))
     if float(cfg["omega_fs"]) > 4.0:
         raise ValueError(f"omega_fs must be <= 4 fs (the angular-velocity correlation falls to zero within "
                          f"~20 fs), got {cfg['omega_fs']}")
@@ -93,8 +90,7 @@ def check(cfg: dict) -> list:
     if not rows:
         raise ValueError("no rows")
     references(cfg, rows)
-    labels = rows
-    dup = sorted({x for x in labels if labels.count(x) > 1})
+    dup = sorted({x for x in rows if rows.count(x) > 1})
     if dup:
         raise ValueError(f"rows given twice: {', '.join(dup)}")
     return rows
@@ -138,7 +134,7 @@ class FidelityStudy(Study):
             self.log(f"{info['row']} replica {info['replica']}: {info['status']}")
 
     def summarise(self, runs) -> dict:
-        from ..report import chart, format_summary, markdown_table, summarise
+        from ..report import format_summary, markdown_table, summarise
 
         grouped = {k[0]: v for k, v in self.results(runs, ("row",)).items()}
         with warnings.catch_warnings():
@@ -162,17 +158,19 @@ class FidelityStudy(Study):
             write_text(os.path.join(self.out, "equipartition.txt"),
                        temperature_table(summary["temperature_view"]) + "\n")
         write_json(os.path.join(self.out, "results.json"), summary)
-        try:
-            chart(summary, os.path.join(self.out, "fidelity.png"))
-            if timings:
-                chart(summary, os.path.join(self.out, "fidelity-wall.png"), x="s_per_ps")
-            if summary.get("frontier"):
-                from ..frontier import frontier_chart
-
-                frontier_chart(summary, os.path.join(self.out, "frontier.png"))
-        except ImportError as exc:  # MissingDependencyError says which extra installs matplotlib
-            self.log(f"no chart: {exc}")
+        self.chart(self.charts, summary, timings)
         return summary
+
+    def charts(self, summary: dict, timings: dict):
+        """``fidelity.png``, with timings ``fidelity-wall.png`` and, for a frontier, ``frontier.png``."""
+        from ..frontier import frontier_chart
+        from ..report import chart
+
+        chart(summary, os.path.join(self.out, "fidelity.png"))
+        if timings:
+            chart(summary, os.path.join(self.out, "fidelity-wall.png"), x="s_per_ps")
+        if summary.get("frontier"):
+            frontier_chart(summary, os.path.join(self.out, "frontier.png"))
 
     def box_edge(self) -> float:
         import openmm.unit as unit
