@@ -480,22 +480,31 @@ def test_the_committed_results_load_and_report_as_committed(tmp_path, monkeypatc
 
     from openmm_symprk.studies.fidelity import report
 
+    from openmm_symprk.studies.fidelity import frontier
+
     docs = os.path.join(os.path.dirname(__file__), "..", "..", "docs")
     with open(os.path.join(docs, "fidelity.md")) as fh:
-        commands = dict.fromkeys(re.findall(r"^symprk fidelity (--out docs/data/fidelity/\S+ .*--report-only)",
-                                            fh.read(), re.M))
-    assert {c.split()[1] for c in commands} == {"docs/data/fidelity/spce", "docs/data/fidelity/tip3p"}, commands
+        commands = dict.fromkeys(re.findall(r"^symprk fidelity ((?:--preset \S+ )?(?:--model \S+ )?--out "
+                                            r"docs/data/fidelity/\S+ .*--report-only)", fh.read(), re.M))
+    outs = {c.split("--out ")[1].split()[0]: c for c in commands}
+    assert set(outs) == {f"docs/data/fidelity/{d}" for d in ("spce", "tip3p", "frontier-spce", "frontier-tip3p")}, commands
     monkeypatch.setattr(report, "chart", lambda *a, **k: None)
-    for command in commands:
+    monkeypatch.setattr(frontier, "frontier_chart", lambda *a, **k: None)
+    for out, command in outs.items():
         argv = shlex.split(command.split("#")[0])
-        committed = os.path.join(docs, "..", argv[1])
-        copy_ = str(tmp_path / os.path.basename(argv[1]))
+        i = argv.index("--out")
+        committed = os.path.join(docs, "..", out)
+        copy_ = str(tmp_path / os.path.basename(out))
         shutil.copytree(committed, copy_)
-        assert main(["--no-progress", *argv[2:], "--out", copy_]) == 0
+        capsys.readouterr()
+        assert main(["--no-progress", *argv[:i], *argv[i + 2:], "--out", copy_]) == 0
         for name in ("summary.txt", "table.md"):
             with open(os.path.join(committed, name), "rb") as a, open(os.path.join(copy_, name), "rb") as b:
                 assert a.read() == b.read(), (command, name)
-    assert "report only" not in capsys.readouterr().err
+        captured = capsys.readouterr()
+        assert "report only" not in captured.err, (command, captured.err)
+        if out.endswith("frontier-spce"):  # the fourth-order rows were run at 8 of the preset's 12 replicas
+            assert "36 of 408 planned runs are not finished" in captured.out, captured.out
 
 
 def test_the_frontier_preset_pairs_its_nvt_rows_on_one_event_grid():
