@@ -19,7 +19,7 @@ from __future__ import annotations
 import os
 from dataclasses import dataclass, field
 
-from ...support import require
+from ...support import MissingDependencyError, require
 from .executors import make_executor
 from .folders import FolderLock
 from .jobs import Job, run_jobs, single
@@ -76,10 +76,11 @@ class Study:
 
     def chart(self, draw, *args, **kwargs):
         """``draw(*args, **kwargs)``, a study's chart; without matplotlib the log says so (MissingDependencyError
-        names the extra that installs it) and the study's tables stand without it."""
+        names the extra that installs it) and the study's tables stand without it.  Any other error, an ImportError
+        of a bug included, keeps its traceback."""
         try:
             draw(*args, **kwargs)
-        except ImportError as exc:
+        except MissingDependencyError as exc:
             self.log(f"no chart: {exc}")
 
     # -- the skeleton ---------------------------------------------------------------------------------------------
