@@ -14,7 +14,7 @@ C++17 compiler, and PyPI (or pip's cache) for the build requirements.  Linux onl
    CUDA headers), with SYMPRK_REQUIRE_NATIVE_BUILD naming every kernel library (``--require``), so that a wheel
    without the plugin or with a kernel left out is an error rather than a warning;
 3. ``auditwheel repair`` to a manylinux tag with OpenMM's libraries excluded from grafting: the plugin links
-   libOpenMM.so (and its OpenCL kernel libOpenMMOpenCL.so), which the openmm wheel provides at run time through the
+   libOpenMM.so and OpenMM's OpenCL and CUDA platforms (libOpenMMOpenCL.so, libOpenMMCUDA.so), which the openmm wheels provide at run time through the
    plugin's $ORIGIN run paths; a grafted copy would put a second OpenMM into the process.  The names excluded are
    read from the wheel's own ELF files (every libOpenMM* a binary needs that the wheel does not hold);
 4. checks the result and stops with a message if a check fails: the manylinux tag, nothing of OpenMM inside, the

@@ -64,18 +64,23 @@ def test_cuda_library_exports_the_plugin_entry_points():
 
 
 def test_cuda_library_links_against_openmms_cuda_platform():
-    """Every symbol the library leaves undefined is defined by a library it names or by OpenMM's CUDA platform
-    library (which it links when the build could see it, and which is loaded before it otherwise)."""
+    """Every symbol the library leaves undefined resolves in the libraries it names (DT_NEEDED, found through its
+    RUNPATH), OpenMM's CUDA platform library among them.  OpenMM loads its platform plugins with dlopen(RTLD_LAZY),
+    so their symbols are not global: a library that only relied on libOpenMMCUDA.so being loaded already failed on
+    its first call on a GPU ("undefined symbol: _ZN6OpenMM12ComputeArrayC1Ev", seen on an H100)."""
     import openmm.version
 
     path = _cuda_library()
     cuda_platform = os.path.join(openmm.version.openmm_library_path, "plugins", "libOpenMMCUDA.so")
+    _, undefined, needed, runpath = _dynamic(path)
+    assert "libOpenMMCUDA.so" in needed, f"the CUDA kernel library does not name OpenMM's CUDA platform: {needed}"
     if not os.path.exists(cuda_platform):
         pytest.skip("OpenMM's CUDA platform is not installed (pip install \"openmm_symprk[cuda12]\")")
-    _, undefined, needed, runpath = _dynamic(path)
+    # a named library is found through the RUNPATH (an installed wheel) or, already loaded by `import openmm`, by its
+    # soname (an editable install, whose RUNPATH points beside the source tree)
     folders = runpath + [openmm.version.openmm_library_path, os.path.dirname(cuda_platform)] + SYSTEM_DIRS
-    provided = set(_dynamic(cuda_platform)[0])
-    missing_libraries = []
+    assert os.path.samefile(_find("libOpenMMCUDA.so", folders), cuda_platform)
+    provided, missing_libraries = set(), []
     for name in needed:
         lib = _find(name, folders)
         if lib is None:

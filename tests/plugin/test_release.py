@@ -173,7 +173,7 @@ def test_the_release_wheel_is_manylinux_and_holds_no_openmm_library(release):
     py = f"cp{sys.version_info.major}{sys.version_info.minor}"
     assert re.fullmatch(rf"{py}-{py}-manylinux_\d+_\d+_x86_64", report["tag"]), report["tag"]
     assert report["wheel"] == f"openmm_symprk-{report['version']}-{report['tag']}.whl"
-    assert report["excluded"] == ["libOpenMM.so", "libOpenMMOpenCL.so"] and report["grafted"] == []
+    assert report["excluded"] == ["libOpenMM.so", "libOpenMMCUDA.so", "libOpenMMOpenCL.so"] and report["grafted"] == []
     with zipfile.ZipFile(out / report["wheel"]) as zf:
         names = zf.namelist()
         wheel_file = zf.read(f"openmm_symprk-{report['version']}.dist-info/WHEEL").decode()
@@ -184,7 +184,7 @@ def test_the_release_wheel_is_manylinux_and_holds_no_openmm_library(release):
     # auditwheel show: only the excluded OpenMM libraries are external (so its overall verdict is linux_x86_64), and
     # the system libraries' symbol versions allow the wheel's manylinux tag
     audit = report["auditwheel"]
-    assert audit["external_libs"] == ["libOpenMM.so", "libOpenMMOpenCL.so"], audit
+    assert audit["external_libs"] == ["libOpenMM.so", "libOpenMMCUDA.so", "libOpenMMOpenCL.so"], audit
     assert audit["sym_tag"] == report["tag"].split("-")[-1] and audit["overall_tag"] == "linux_x86_64"
     assert set(audit["versioned_symbols"]) <= {"libc.so.6", "libm.so.6", "libgcc_s.so.1", "libstdc++.so.6"}
     with open(out / "auditwheel-show.txt") as fh:
