@@ -52,8 +52,13 @@ PROBE_CONSTRAINTS_VAR = "symprk_probe_constraints"
 PROBE_PER_DOF = "symprk_probe"
 NONCONV_VAR = "symprk_nonconverged"
 ITER_VAR = "symprk_iterations"
-#: Squared speed limit used when only NaN and infinity count as a blow-up (inf in single precision too).
-NONFINITE_LIMIT2 = "1e300"
+#: Squared speed limit used when only NaN, infinity and absurd speeds (above 1e15 nm/ps) count as a blow-up.  It must
+#: be a float in single precision too: OpenMM writes the literal as 1e30f there, and CUDA refuses a float literal out
+#: of range (1e300f: "floating constant is out of range"; OpenCL read it as infinity).
+NONFINITE_LIMIT2 = "1e30"
+#: The literal the guard had before (1e300): :func:`program_signature` hashes the guard as written then, so a
+#: checkpoint saved before the change still loads (the state and the step's arithmetic are the same).
+_SIGNED_LIMIT2 = "1e300"
 
 
 @dataclass(frozen=True)
@@ -75,9 +80,10 @@ class ProgramInfo:
 def program_signature(integrator: mm.CustomIntegrator) -> int:
     """A 52-bit hash of the program (every computation and variable name), exact as a float64."""
     h = hashlib.sha1()
+    guard = f"step({NONFINITE_LIMIT2} - v*v)"
     for i in range(integrator.getNumComputations()):
         kind, var, expr = integrator.getComputationStep(i)
-        h.update(f"{kind}|{var}|{expr};".encode())
+        h.update(f"{kind}|{var}|{expr.replace(guard, f'step({_SIGNED_LIMIT2} - v*v)')};".encode())
     for i in range(integrator.getNumGlobalVariables()):
         h.update(f"g:{integrator.getGlobalVariableName(i)};".encode())
     for i in range(integrator.getNumPerDofVariables()):
