@@ -1,4 +1,6 @@
 """Small float64 measurements shared by the OpenMM tests (built on openmm_symprk.conservation)."""
+import os
+
 import numpy as np
 import openmm.app as app
 import pytest
@@ -6,6 +8,10 @@ import openmm.unit as unit
 
 from openmm_symprk.conservation import angular_momentum, linear_momentum
 from openmm_symprk.methods.orders import observed_orders
+
+#: The platform that runs the plugin's Common kernel in the tests: OpenCL (PoCL in CI), or the one named by
+#: SYMPRK_TEST_COMMON_PLATFORM (CUDA on a machine with an NVIDIA GPU), so the same assertions check that kernel there.
+COMMON = os.environ.get("SYMPRK_TEST_COMMON_PLATFORM", "OpenCL")
 
 
 class Counter:

@@ -16,6 +16,7 @@ from openmm_symprk import SymplecticIntegrator, catalogue
 from openmm_symprk import plugin
 from openmm_symprk.integrators import (NativeMethodError, NativeSymplecticIntegrator, NativeUnavailableError,
                                        SimulationBlowUpError, deserialize)
+from helpers import COMMON
 
 needs_native = pytest.mark.skipif(not plugin.available(),
                                   reason=f"native plugin unavailable: {plugin.unavailable_reason()}")
@@ -39,7 +40,7 @@ def _run(scene, integrator, steps, platform="Reference", properties=None):
 
 
 def _opencl_ok():
-    return "OpenCL" in plugin.platforms()
+    return COMMON in plugin.platforms()
 
 
 # -- Reference: the same trajectory as the CustomIntegrator, every explicit method, with and without constraints
@@ -117,41 +118,41 @@ def test_force_evaluations_per_step(name, scene_name, request):
 
 # -- OpenCL (PoCL in CI) ---------------------------------------------------------------------------------------
 @needs_native
-@pytest.mark.skipif(not _opencl_ok(), reason="no native OpenCL kernel here (OpenCL platform or its build missing)")
+@pytest.mark.skipif(not _opencl_ok(), reason=f"no native {COMMON} kernel here ({COMMON} platform or its build missing)")
 @pytest.mark.parametrize("precision,tol", [("double", 1e-5), ("mixed", 1e-5), ("single", 1e-4)])
 def test_opencl_matches_reference(precision, tol, water8, morse, constrained):
     for scene in (water8, morse, constrained):
         for name in ("verlet", "yoshida-4"):
             ref = _run(scene, N(1 * unit.femtoseconds, name, system=scene.system), 100)
-            ocl = _run(scene, N(1 * unit.femtoseconds, name, system=scene.system), 100, "OpenCL",
+            ocl = _run(scene, N(1 * unit.femtoseconds, name, system=scene.system), 100, COMMON,
                        {"Precision": precision})
             assert np.abs(ocl[0] - ref[0]).max() < tol, (scene.name, name)
 
 
 @needs_native
-@pytest.mark.skipif(not _opencl_ok(), reason="no native OpenCL kernel here (OpenCL platform or its build missing)")
+@pytest.mark.skipif(not _opencl_ok(), reason=f"no native {COMMON} kernel here ({COMMON} platform or its build missing)")
 def test_opencl_same_program_as_custom_in_double(morse, constrained):
     for scene in (morse, constrained):
-        a = _run(scene, N(1 * unit.femtoseconds, "yoshida-4", system=scene.system), 100, "OpenCL", {"Precision": "double"})
+        a = _run(scene, N(1 * unit.femtoseconds, "yoshida-4", system=scene.system), 100, COMMON, {"Precision": "double"})
         b = _run(scene, SymplecticIntegrator(1 * unit.femtoseconds, "yoshida-4", system=scene.system, backend="custom"),
-                 100, "OpenCL", {"Precision": "double"})
+                 100, COMMON, {"Precision": "double"})
         assert np.abs(a[0] - b[0]).max() < 1e-9 and np.abs(a[1] - b[1]).max() < 1e-7
 
 
 @needs_native
-@pytest.mark.skipif(not _opencl_ok(), reason="no native OpenCL kernel here (OpenCL platform or its build missing)")
+@pytest.mark.skipif(not _opencl_ok(), reason=f"no native {COMMON} kernel here ({COMMON} platform or its build missing)")
 @pytest.mark.parametrize("precision,plain,exact", [("double", 1e-10, 1e-11), ("mixed", 1e-4, 1e-11)])
 def test_opencl_conservation(precision, plain, exact, water8):
     for em, bound in ((False, plain), (True, exact)):
         ig = N(2 * unit.femtoseconds, "verlet", system=water8.system, exact_momentum=em)
-        ctx = water8.context(ig, "OpenCL", {"Precision": precision})
+        ctx = water8.context(ig, COMMON, {"Precision": precision})
         dp, dl = drift_after(ctx, ig, water8.masses(), 500)
         assert dp <= bound and dl <= bound, (precision, em, dp, dl)
         del ctx
 
 
 @needs_native
-@pytest.mark.skipif(not _opencl_ok(), reason="no native OpenCL kernel here (OpenCL platform or its build missing)")
+@pytest.mark.skipif(not _opencl_ok(), reason=f"no native {COMMON} kernel here ({COMMON} platform or its build missing)")
 def test_opencl_exact_momentum_with_hbond_shake():
     """Villin in vacuum, HBonds: OpenCL's SHAKE clusters use float inverse masses, so their impulses leave a net
     momentum and torque (~1e-7 relative over 300 steps); exact momentum removes them after every drift and
@@ -161,7 +162,7 @@ def test_opencl_exact_momentum_with_hbond_shake():
     scene = protein_vacuum()
     for em, bound in ((False, None), (True, 1e-12)):
         ig = N(2 * unit.femtoseconds, "verlet", system=scene.system, exact_momentum=em)
-        ctx = scene.context(ig, "OpenCL", {"Precision": "mixed"})
+        ctx = scene.context(ig, COMMON, {"Precision": "mixed"})
         dp, dl = drift_after(ctx, ig, scene.masses(), 300)
         if bound is not None:
             assert dp <= bound and dl <= bound, (dp, dl)
@@ -264,9 +265,9 @@ def _run_tip4p(method, platform, properties, blocks):
 
 
 @needs_native
-@pytest.mark.skipif(not _opencl_ok(), reason="no native OpenCL kernel here (OpenCL platform or its build missing)")
+@pytest.mark.skipif(not _opencl_ok(), reason=f"no native {COMMON} kernel here ({COMMON} platform or its build missing)")
 def test_opencl_virtual_sites_and_checkpoint():
-    ig, ctx, energies = _run_tip4p("yoshida-4", "OpenCL", {"Precision": "double"}, 3)
+    ig, ctx, energies = _run_tip4p("yoshida-4", COMMON, {"Precision": "double"}, 3)
     assert max(energies) - min(energies) < 0.05
     chk = ctx.createCheckpoint()
     ig.step(30)

@@ -9,7 +9,7 @@ import openmm.unit as unit
 import pytest
 
 from conftest import platform_available
-from helpers import counted, drift_after, evaluations, measure_order, reference_context
+from helpers import COMMON, counted, drift_after, evaluations, measure_order, reference_context
 from openmm_symprk import SymplecticIntegrator, catalogue, resolve
 
 SYMPLECTIC_SPLITTINGS = [m.name for m in catalogue.splittings()]
@@ -127,8 +127,8 @@ def test_measured_order_under_constraints(name, constrained):
 
 @pytest.mark.parametrize("platform,props", [
     ("CPU", {}),
-    ("OpenCL", {"Precision": "double"}),
-    ("OpenCL", {"Precision": "mixed"}),
+    (COMMON, {"Precision": "double"}),
+    (COMMON, {"Precision": "mixed"}),
 ])
 def test_same_program_runs_on_other_platforms(platform, props, water8):
     if not platform_available(platform):

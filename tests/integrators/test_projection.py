@@ -20,6 +20,7 @@ from openmm_symprk import SymplecticIntegrator
 from openmm_symprk.conservation import angular_momentum, linear_momentum
 from openmm_symprk.integrators.projection import add_projection_variables, emit_projected_acceleration, set_masses
 from openmm_symprk.systems.properties import masses
+from helpers import COMMON
 
 
 def exact_integrator(h, method, system):
@@ -28,7 +29,7 @@ def exact_integrator(h, method, system):
 
 pytestmark = pytest.mark.filterwarnings("ignore::UserWarning")
 
-OPENCL = platform_available("OpenCL")
+OPENCL = platform_available(COMMON)
 
 
 @pytest.fixture(scope="module")
@@ -143,37 +144,37 @@ def test_cpu_water_and_protein_exact(water8, protein):
         assert dl_off > 1e-9, (scene.name, dl_off)  # single-precision force sums
 
 
-@pytest.mark.skipif(not OPENCL, reason="OpenCL platform not available")
+@pytest.mark.skipif(not OPENCL, reason=f"{COMMON} platform not available")
 @pytest.mark.parametrize("which", ["water", "protein"])
 def test_opencl_mixed_exact(which, water8, protein):
     scene = water8 if which == "water" else protein
     props = {"Precision": "mixed"}
-    dl, dp = _run(scene, "OpenCL", props, 2000, True)
+    dl, dp = _run(scene, COMMON, props, 2000, True)
     assert dl <= 1e-10, dl
-    dl_off, _ = _run(scene, "OpenCL", props, 300, False)
+    dl_off, _ = _run(scene, COMMON, props, 300, False)
     assert dl_off > 1e-9, dl_off
 
 
-@pytest.mark.skipif(not OPENCL, reason="OpenCL platform not available")
+@pytest.mark.skipif(not OPENCL, reason=f"{COMMON} platform not available")
 def test_opencl_constraint_impulses_restored_after_every_drift(protein):
     """OpenCL's SHAKE for hydrogen clusters uses float inverse masses: its impulses do not cancel
     (~1e-7 over 300 steps even with projected kicks).  Position Verlet ends its step with a drift,
     whose impulses the compiler's drift restoration removes."""
     props = {"Precision": "mixed"}
-    dl, _ = _run(protein, "OpenCL", props, 300, True, method="position-verlet")
+    dl, _ = _run(protein, COMMON, props, 300, True, method="position-verlet")
     assert dl <= 1e-12, dl
-    dl_off, _ = _run(protein, "OpenCL", props, 300, False, method="position-verlet")
+    dl_off, _ = _run(protein, COMMON, props, 300, False, method="position-verlet")
     assert dl_off > 1e-9, dl_off
 
 
-@pytest.mark.skipif(not OPENCL, reason="OpenCL platform not available")
+@pytest.mark.skipif(not OPENCL, reason=f"{COMMON} platform not available")
 def test_opencl_single_floor(water8):
     """Single precision stores x and v in float32: each step rounds them at ~6e-8 relative, so 1e-10
     is out of reach (measured ~1e-6 after 2,000 steps); the projection still removes the systematic
     force-sum and SETTLE part (without: ~1e-4)."""
     props = {"Precision": "single"}
-    dl, _ = _run(water8, "OpenCL", props, 2000, True)
-    dl_off, _ = _run(water8, "OpenCL", props, 2000, False)
+    dl, _ = _run(water8, COMMON, props, 2000, True)
+    dl_off, _ = _run(water8, COMMON, props, 2000, False)
     assert dl < 2e-5, dl
     assert dl_off > 10 * dl, (dl_off, dl)
 

@@ -10,17 +10,18 @@ import openmm as mm
 import pytest
 
 from openmm_symprk import SymplecticIntegrator, plugin
+from helpers import COMMON
 
 
 def _opencl():
     try:
-        mm.Platform.getPlatformByName("OpenCL")
+        mm.Platform.getPlatformByName(COMMON)
         return True
     except mm.OpenMMException:
         return False
 
 
-pytestmark = [pytest.mark.skipif(not _opencl(), reason="no OpenCL platform"),
+pytestmark = [pytest.mark.skipif(not _opencl(), reason=f"no {COMMON} platform"),
               pytest.mark.filterwarnings("ignore::UserWarning")]
 
 
@@ -37,7 +38,7 @@ def constraints_chain(method, backend, precision):
     v = np.random.default_rng(0).random((n, 3)) - 0.5
     ig = SymplecticIntegrator(0.002, method, system=system, backend=backend)
     ig.setConstraintTolerance(1e-5)
-    ctx = mm.Context(system, ig, mm.Platform.getPlatformByName("OpenCL"), {"Precision": precision})
+    ctx = mm.Context(system, ig, mm.Platform.getPlatformByName(COMMON), {"Precision": precision})
     ctx.setPositions(x)
     ctx.setVelocities(v)
     worst_d = worst_e = 0.0

@@ -28,12 +28,13 @@ import pytest
 from openmm_symprk import SymplecticIntegrator, catalogue, plugin
 from openmm_symprk.methods.resolved import EventPhase, SubstepKind, resolve
 from openmm_symprk.systems.forcegroups import split_forces
+from helpers import COMMON
 
 pytestmark = pytest.mark.skipif(not plugin.available(), reason=f"native plugin unavailable: {plugin.unavailable_reason()}")
 
-needs_opencl = pytest.mark.skipif("OpenCL" not in plugin.platforms(), reason="no native OpenCL kernel here")
+needs_opencl = pytest.mark.skipif(COMMON not in plugin.platforms(), reason=f"no native {COMMON} kernel here")
 PLATFORMS = [("Reference", {}), ("CPU", {}),
-             pytest.param("OpenCL", {"Precision": "double"}, marks=needs_opencl, id="OpenCL")]
+             pytest.param(COMMON, {"Precision": "double"}, marks=needs_opencl, id=COMMON)]
 STEPS = 7
 ALL_GROUPS = -1  # the integration force groups' default mask, 0xffffffff, as an int
 
@@ -181,7 +182,7 @@ def test_platforms_run_the_same_operations(case, request):
     """The plan is the API layer's, so the same on every platform; the kernels run the same operations and make the
     same force evaluations, step for step."""
     runs = [_run(case, platform, props, request) for platform, props in
-            [("Reference", {}), ("CPU", {}), ("OpenCL", {"Precision": "double"})]]
+            [("Reference", {}), ("CPU", {}), (COMMON, {"Precision": "double"})]]
     for _, _, plan, trace in runs[1:]:
         assert plan == runs[0][2]
         np.testing.assert_array_equal(trace, runs[0][3])

@@ -10,7 +10,7 @@ import openmm as mm
 import openmm.unit as unit
 import pytest
 
-from helpers import BACKENDS, context, native_skip_reason
+from helpers import BACKENDS, COMMON, context, native_skip_reason
 from openmm_symprk import SymplecticIntegrator, plugin
 from openmm_symprk.integrators import deserialize
 from openmm_symprk.systems.scenes import water_cluster
@@ -23,14 +23,14 @@ pytestmark = pytest.mark.filterwarnings("ignore::openmm_symprk.systems.checks.Co
 LINEAR_CASES = ["custom", pytest.param("native", marks=pytest.mark.skipif(native_skip_reason() is not None,
                                                                           reason=str(native_skip_reason()))),
                 pytest.param("native-opencl", marks=pytest.mark.skipif(
-                    native_skip_reason() is not None or "OpenCL" not in plugin.platforms(),
-                    reason="no native OpenCL kernel here"))]
+                    native_skip_reason() is not None or COMMON not in plugin.platforms(),
+                    reason=f"no native {COMMON} kernel here"))]
 
 
 def _linear_case(case):
     """(backend, platform, properties) of a LINEAR_CASES entry."""
     if case == "native-opencl":
-        return "native", "OpenCL", {"Precision": "double"}
+        return "native", COMMON, {"Precision": "double"}
     return case, REF, {}
 
 

@@ -20,14 +20,14 @@ import openmm as mm
 import openmm.unit as unit
 import pytest
 
-from helpers import native_skip_reason
+from helpers import COMMON, native_skip_reason
 from openmm_symprk import SymplecticIntegrator, plugin
 from openmm_symprk.integrators.noise import sample_thermostat_noise
 from openmm_symprk.studies.nvt.known import OSCILLATORS, exact_temperatures, noise_draws, stationary_temperatures
 
 pytestmark = pytest.mark.filterwarnings("ignore::openmm_symprk.systems.checks.ConservationWarning")
 
-OPENCL = "OpenCL" in [mm.Platform.getPlatform(i).getName() for i in range(mm.Platform.getNumPlatforms())]
+OPENCL = COMMON in [mm.Platform.getPlatform(i).getName() for i in range(mm.Platform.getNumPlatforms())]
 NATIVE = native_skip_reason() is None
 DOUBLE = {"Precision": "double"}
 
@@ -36,11 +36,11 @@ def _case(backend, platform):
     marks = []
     if backend == "native":
         marks.append(pytest.mark.skipif(not NATIVE, reason=str(native_skip_reason())))
-        if platform == "OpenCL":
-            marks.append(pytest.mark.skipif(not NATIVE or "OpenCL" not in plugin.platforms(),
-                                            reason="no native OpenCL kernel here"))
-    if platform == "OpenCL":
-        marks.append(pytest.mark.skipif(not OPENCL, reason="OpenMM has no OpenCL platform here"))
+        if platform == COMMON:
+            marks.append(pytest.mark.skipif(not NATIVE or COMMON not in plugin.platforms(),
+                                            reason=f"no native {COMMON} kernel here"))
+    if platform == COMMON:
+        marks.append(pytest.mark.skipif(not OPENCL, reason=f"OpenMM has no {COMMON} platform here"))
     return pytest.param(backend, platform, marks=marks, id=f"{backend}-{platform}")
 
 
@@ -49,19 +49,19 @@ def _draws(backend, platform, k):
     (2 / (k 0.0005^2)), but where each event is a CustomIntegrator loop pass on OpenCL (about 0.5 ms here) the
     smallest k is held to 40000 events (0.16 %: a wrong mask, one variate too many or too few, is 5 %)."""
     n = noise_draws(k, 0.0005)
-    if backend == "custom" and platform == "OpenCL":
+    if backend == "custom" and platform == COMMON:
         n = min(n, 40_000)
     return n
 
 
 @pytest.mark.parametrize("backend, platform", [_case("native", "Reference"), _case("native", "CPU"),
-                                               _case("native", "OpenCL"), _case("custom", "Reference"),
-                                               _case("custom", "CPU"), _case("custom", "OpenCL")])
+                                               _case("native", COMMON), _case("custom", "Reference"),
+                                               _case("custom", "CPU"), _case("custom", COMMON)])
 @pytest.mark.parametrize("k", [20, 600, 3000])
 def test_event_noise_has_the_known_moments(backend, platform, k):
     n = _draws(backend, platform, k)
     s = sample_thermostat_noise(backend, k + 1, n, platform, seed=11 + k,
-                                properties=DOUBLE if platform == "OpenCL" else None)
+                                properties=DOUBLE if platform == COMMON else None)
     assert s.n == n and s.dof == k + 1
     resolution = s.chi2.mean_se / k
     assert resolution < (0.0017 if n == 40_000 else 0.00055), resolution  # what the draws resolve
@@ -91,11 +91,11 @@ SAMPLES = 16_000
 
 
 def _stationary(backend, platform, position):
-    st = stationary_temperatures(backend, platform, position, SAMPLES, properties=DOUBLE if platform == "OpenCL" else None)
+    st = stationary_temperatures(backend, platform, position, SAMPLES, properties=DOUBLE if platform == COMMON else None)
     return st.configurational, st.kinetic
 
 
-STATIONARY_CASES = [_case("custom", "Reference"), _case("native", "Reference"), _case("native", "OpenCL")]
+STATIONARY_CASES = [_case("custom", "Reference"), _case("native", "Reference"), _case("native", COMMON)]
 
 
 @pytest.fixture(scope="module")
@@ -137,13 +137,13 @@ def test_native_samples_what_custom_samples(stationary, backend, platform, posit
 
 
 # -- common random numbers: rows on one event grid draw the same numbers ---------------------------------------------
-@pytest.mark.parametrize("backend, platform", [_case("native", "Reference"), _case("native", "OpenCL")])
+@pytest.mark.parametrize("backend, platform", [_case("native", "Reference"), _case("native", COMMON)])
 def test_runs_on_one_event_grid_draw_the_same_numbers(backend, platform, water8):
     """Two runs with events at the same simulated times (2 fs steps every 6 steps, 4 fs steps every 3: every 12 fs)
     and the same seed consume the thermostat's stream event for event: after the same simulated time the next draws
     coincide bit for bit, although the runs took different steps and scaled different kinetic energies (the draws
     do not depend on the state).  This pairs an NVT row with the NVT reference replica by replica, as NVE rows are."""
-    props = DOUBLE if platform == "OpenCL" else {}
+    props = DOUBLE if platform == COMMON else {}
     next_draws = []
     for step_fs, interval in ((2.0, 6), (4.0, 3)):
         ig = SymplecticIntegrator(step_fs * 1e-3, "omelyan-2", system=water8.system, backend=backend, temperature=300,

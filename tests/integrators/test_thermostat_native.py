@@ -17,7 +17,7 @@ import openmm as mm
 import openmm.unit as unit
 import pytest
 
-from helpers import positions_velocities
+from helpers import COMMON, positions_velocities
 from openmm_symprk import SymplecticIntegrator, plugin
 from openmm_symprk.integrators import NativeSymplecticIntegrator as N
 from openmm_symprk.integrators import deserialize
@@ -27,13 +27,13 @@ from openmm_symprk.stats.timeseries import block_stats, series_stats
 
 pytestmark = pytest.mark.skipif(not plugin.available(), reason=f"native plugin unavailable: {plugin.unavailable_reason()}")
 
-OPENCL = "OpenCL" in plugin.platforms()
-needs_opencl = pytest.mark.skipif(not OPENCL, reason="no native OpenCL kernel here (OpenCL platform or its build missing)")
+OPENCL = COMMON in plugin.platforms()
+needs_opencl = pytest.mark.skipif(not OPENCL, reason=f"no native {COMMON} kernel here ({COMMON} platform or its build missing)")
 #: (platform, properties, relative tolerance of one event's arithmetic)
 PLATFORMS = [("Reference", {}, 1e-12), ("CPU", {}, 1e-12),
-             pytest.param("OpenCL", {"Precision": "double"}, 1e-12, marks=needs_opencl, id="OpenCL-double"),
-             pytest.param("OpenCL", {"Precision": "mixed"}, 1e-9, marks=needs_opencl, id="OpenCL-mixed"),
-             pytest.param("OpenCL", {"Precision": "single"}, 3e-6, marks=needs_opencl, id="OpenCL-single")]
+             pytest.param(COMMON, {"Precision": "double"}, 1e-12, marks=needs_opencl, id="OpenCL-double"),
+             pytest.param(COMMON, {"Precision": "mixed"}, 1e-9, marks=needs_opencl, id="OpenCL-mixed"),
+             pytest.param(COMMON, {"Precision": "single"}, 3e-6, marks=needs_opencl, id="OpenCL-single")]
 
 
 def _platform(name):
@@ -161,7 +161,7 @@ def _cutoff_water_box():
 
 @pytest.mark.parametrize("platform,props,bound", [
     ("Reference", {}, 1e-13),
-    pytest.param("OpenCL", {"Precision": "double"}, 1e-12, marks=needs_opencl, id="OpenCL-double")])
+    pytest.param(COMMON, {"Precision": "double"}, 1e-12, marks=needs_opencl, id="OpenCL-double")])
 def test_momentum_to_round_off_in_a_periodic_box(platform, props, bound):
     """Double precision forces (OpenCL sums them in 64-bit fixed point: ~2e-13 of sum m|v| over the run; on CPU
     the single-precision forces alone move P by ~1e-8 of sum m|v| per step;
@@ -204,9 +204,9 @@ def test_npt_with_a_monte_carlo_barostat_keeps_momentum():
 
 @pytest.mark.parametrize("platform,props,exact,bound", [
     ("Reference", {}, False, 1e-11), ("CPU", {}, True, 1e-11),
-    pytest.param("OpenCL", {"Precision": "double"}, False, 1e-11, marks=needs_opencl, id="OpenCL-double"),
-    pytest.param("OpenCL", {"Precision": "mixed"}, True, 1e-10, marks=needs_opencl, id="OpenCL-mixed-exact"),
-    pytest.param("OpenCL", {"Precision": "single"}, True, 1e-5, marks=needs_opencl, id="OpenCL-single-exact")])
+    pytest.param(COMMON, {"Precision": "double"}, False, 1e-11, marks=needs_opencl, id="OpenCL-double"),
+    pytest.param(COMMON, {"Precision": "mixed"}, True, 1e-10, marks=needs_opencl, id="OpenCL-mixed-exact"),
+    pytest.param(COMMON, {"Precision": "single"}, True, 1e-5, marks=needs_opencl, id="OpenCL-single-exact")])
 @pytest.mark.parametrize("position", ["ends", "middle"])
 def test_angular_momentum_to_round_off_for_an_isolated_cluster(platform, props, exact, bound, position, water8):
     """Both placements (the middle one inside omelyan-2's central kick) on every platform and precision."""
@@ -243,7 +243,7 @@ def _ideal_gas_kinetic_samples(platform, props, samples, seed=21):
 
 @pytest.mark.parametrize("platform,props,samples", [
     ("Reference", {}, 3000),
-    pytest.param("OpenCL", {"Precision": "mixed"}, 1000, marks=needs_opencl, id="OpenCL-mixed")])
+    pytest.param(COMMON, {"Precision": "mixed"}, 1000, marks=needs_opencl, id="OpenCL-mixed")])
 def test_ideal_gas_kinetic_energy_is_gamma_distributed(platform, props, samples):
     """For free particles the peculiar kinetic energy is exactly Gamma(dof/2, kT) in the canonical ensemble
     (dof = 3N - 6: centre-of-mass velocity and rotation kept): KS test, mean and variance within 3 SE."""
@@ -290,7 +290,7 @@ def test_water_box_mean_temperature(tmp_path):
 
 # -- checkpoints, XML, the NVE program ----------------------------------------------------------------------------
 @pytest.mark.parametrize("platform,props", [
-    ("Reference", {}), pytest.param("OpenCL", {"Precision": "double"}, marks=needs_opencl, id="OpenCL-double")])
+    ("Reference", {}), pytest.param(COMMON, {"Precision": "double"}, marks=needs_opencl, id="OpenCL-double")])
 def test_checkpoint_continues_bit_for_bit(platform, props, water8):
     """The heat-bath energy and the random state are in the checkpoint; the interval's phase is the step count.
     (Bit for bit on OpenCL too here: its fixed-point force sums are deterministic.)"""

@@ -18,7 +18,7 @@ import openmm as mm
 import openmm.unit as unit
 import pytest
 
-from helpers import positions_velocities
+from helpers import COMMON, positions_velocities
 from openmm_symprk import SymplecticIntegrator, plugin
 from openmm_symprk.physics.temperature import R_KJ
 from openmm_symprk.systems.properties import masses
@@ -27,9 +27,9 @@ from openmm_symprk.systems.scenes.builders import harmonic_oscillators
 pytestmark = [pytest.mark.skipif(not plugin.available(), reason=f"native plugin unavailable: {plugin.unavailable_reason()}"),
               pytest.mark.filterwarnings("ignore::openmm_symprk.systems.checks.ConservationWarning")]
 
-needs_opencl = pytest.mark.skipif("OpenCL" not in plugin.platforms(), reason="no native OpenCL kernel here")
-OPENCL = pytest.param("OpenCL", marks=needs_opencl)
-PROPERTIES = {"OpenCL": {"Precision": "mixed"}, "CPU": {"Threads": "1"}}
+needs_opencl = pytest.mark.skipif(COMMON not in plugin.platforms(), reason=f"no native {COMMON} kernel here")
+OPENCL = pytest.param(COMMON, marks=needs_opencl)
+PROPERTIES = {COMMON: {"Precision": "mixed"}, "CPU": {"Threads": "1"}}
 POSITIONS = ["ends", "middle"]
 
 
@@ -104,7 +104,7 @@ def test_no_host_transfer_per_step_on_opencl(position, exact, water8):
     steps; Python's step(n) reads the blow-up record and the skipped-event count once per call, not per step."""
     ig = _native(water8.system, 0.002, temperature=300, random_seed=4, thermostat_position=position,
                  exact_momentum=exact)
-    ctx = _context(water8.system, ig, water8.positions, water8.velocities, "OpenCL", {"Precision": "double"})
+    ctx = _context(water8.system, ig, water8.positions, water8.velocities, COMMON, {"Precision": "double"})
     raw_step = plugin.swig_module().SymPRKIntegrator.step
     raw_step(ig, 1)
     before = ig.getHostTransfers()
@@ -208,7 +208,7 @@ def test_no_peculiar_motion_is_left_as_it_is_and_warned_about(motion, position, 
     system, x = _free_particles()
     v = np.zeros_like(x) if motion == "rest" else np.tile([0.31, -0.17, 0.05], (len(x), 1))
     ig = _native(system, 0.002, temperature=300, random_seed=9, thermostat_position=position, thermostat_interval=2)
-    ctx = _context(system, ig, x, v, platform, {"Precision": "double"} if platform == "OpenCL" else None)
+    ctx = _context(system, ig, x, v, platform, {"Precision": "double"} if platform == COMMON else None)
     _, v0 = positions_velocities(ctx)
     with pytest.warns(RuntimeWarning, match="no peculiar kinetic energy to scale.*setVelocitiesToTemperature"):
         ig.step(6)
