@@ -58,7 +58,7 @@ def _solvated_villin(n_target: int, seed: int = 7):
     ff = app.ForceField("amber14-all.xml", "amber14/tip3p.xml")
     mod = app.Modeller(pdb.topology, pdb.positions)
     mod.deleteWater()
-    side = (n_target * 0.03) ** (1 / 3)  # ~33 water atoms per nm^3 at ~1 g/cm^3
+    side = (n_target / 100.0) ** (1 / 3)  # ~33 waters, ~100 atoms, per nm^3 at ~1 g/cm^3
     mod.addSolvent(ff, boxSize=mm.Vec3(side, side, side) * unit.nanometer, neutralize=True)
     system = ff.createSystem(mod.topology, nonbondedMethod=app.PME, nonbondedCutoff=0.9 * unit.nanometer,
                              constraints=app.HBonds, rigidWater=True, removeCMMotion=False)
