@@ -72,15 +72,26 @@ def scene_replicas(name: str, folder: str, replicas: int, temperature: float, se
     return {"xml": xml, "x": np.asarray(xs), "v": np.asarray(vs)}
 
 
+#: The boxes built in this process, keyed by everything :func:`water_box_scene` reads from a study's settings.
+_boxes: dict = {}
+
+
 def water_box_scene(cfg: dict, model: str) -> Scene:
     """The rigid-water box of ``model`` (:func:`openmm_symprk.systems.scenes.water_box`: ``n_waters``,
-    ``cutoff_nm``, ``density_g_cm3`` of ``cfg``) as a Scene whose ``meta["model"]`` names the model; its state is
-    Modeller's (the replica states are :func:`water_box_replicas`)."""
-    system, topology, x = water_box(model, cfg["n_waters"], cfg["cutoff_nm"],
-                                    density_g_cm3=cfg.get("density_g_cm3", WATER_DENSITY_G_CM3))
-    return Scene(f"water-box-{model}", system, x, np.zeros_like(x), f"{cfg['n_waters']} rigid {model} waters, PME",
-                 topology, purpose="production", platform="CPU", invariants=("energy", "momentum"),
-                 temperature=float(cfg["temperature"]), meta={"model": model})
+    ``cutoff_nm``, ``density_g_cm3`` of ``cfg``) as a Scene whose ``meta["model"]`` names the model and whose
+    temperature is ``cfg["temperature"]``; its state is Modeller's (the replica states are :func:`water_box_replicas`).
+    Built once per process for each (model, n_waters, cutoff_nm, density_g_cm3, temperature), so a worker running
+    many rows reuses it, and a study with other settings in the same process never gets a stale box; treat it as
+    read-only."""
+    density = float(cfg.get("density_g_cm3", WATER_DENSITY_G_CM3))
+    key = (model, int(cfg["n_waters"]), float(cfg["cutoff_nm"]), density, float(cfg["temperature"]))
+    if key not in _boxes:
+        system, topology, x = water_box(model, cfg["n_waters"], cfg["cutoff_nm"], density_g_cm3=density)
+        _boxes[key] = Scene(f"water-box-{model}", system, x, np.zeros_like(x),
+                            f"{cfg['n_waters']} rigid {model} waters, PME", topology, purpose="production",
+                            platform="CPU", invariants=("energy", "momentum"), temperature=float(cfg["temperature"]),
+                            meta={"model": model})
+    return _boxes[key]
 
 
 def box_state_key(cfg: dict) -> str:

@@ -43,18 +43,12 @@ def legacy_key(cfg: dict, model: str, label: str, replica: int) -> str:
                         "replica": int(replica), "version": RUN_VERSION})
 
 
-_boxes: dict = {}
-
-
 def work(shared: dict, label: str, replica: int):
-    """One NVE run in whatever process executes it (the box is built once per process and model)."""
+    """One NVE run in whatever process executes it (the box is built once per process and settings)."""
     from .runs import run_nve
 
     cfg, model = shared["cfg"], shared["model"]
-    key = (model, cfg["n_waters"], cfg["cutoff_nm"])
-    if key not in _boxes:
-        _boxes[key] = water_box_scene(cfg, model)
-    return run_nve(_boxes[key], shared["x"][replica], shared["v"][replica], label, cfg)
+    return run_nve(water_box_scene(cfg, model), shared["x"][replica], shared["v"][replica], label, cfg)
 
 
 def load_runs(cfg: dict, out: str) -> dict:

@@ -63,18 +63,12 @@ def references(cfg: dict, rows: list) -> dict:
     return out
 
 
-_boxes: dict = {}
-
-
 def work(shared: dict, row: dict, replica: int):
-    """One run in whatever process executes it (the box is built once per process)."""
+    """One run in whatever process executes it (the box is built once per process and settings)."""
     from .runs import run_row
 
     cfg = shared["cfg"]
-    key = (cfg["model"], cfg["n_waters"], cfg["cutoff_nm"], cfg["density_g_cm3"])
-    if key not in _boxes:
-        _boxes[key] = water_box_scene(cfg, cfg["model"])
-    return run_row(_boxes[key], shared["x"][replica], shared["v"][replica], row, cfg, replica)
+    return run_row(water_box_scene(cfg, cfg["model"]), shared["x"][replica], shared["v"][replica], row, cfg, replica)
 
 
 def check(cfg: dict) -> list:
