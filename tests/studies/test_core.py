@@ -137,3 +137,19 @@ def test_a_study_on_a_dask_cluster(tmp_path):
         study = ToyStudy(str(tmp_path / "dask"), ["ref", "b"], replicas=3, scheduler=cluster.scheduler_address)
         res = study.run()
     assert res["b"].replicas == 3 and len(RunStore(str(tmp_path / "dask"))) == 6
+
+
+def test_the_water_box_is_built_once_per_setting_and_never_reused_for_another():
+    """Workers build the box once per process (replicas.water_box_scene); the key holds everything the box depends on,
+    so a second study with another density or temperature in the same process gets its own box (the equipartition
+    study's key once left the density out)."""
+    from openmm_symprk.studies.core.replicas import water_box_scene
+
+    cfg = {"n_waters": 64, "cutoff_nm": 0.55, "density_g_cm3": 0.997, "temperature": 300.0}
+    box = water_box_scene(cfg, "spce")
+    assert water_box_scene(dict(cfg), "spce") is box
+    denser = water_box_scene(dict(cfg, density_g_cm3=1.05), "spce")
+    hotter = water_box_scene(dict(cfg, temperature=320.0), "spce")
+    edge = lambda sc: sc.system.getDefaultPeriodicBoxVectors()[0][0]._value  # noqa: E731
+    assert edge(denser) == pytest.approx(edge(box) * (0.997 / 1.05) ** (1 / 3), rel=1e-6)
+    assert hotter is not box and hotter.temperature == 320.0 and box.temperature == 300.0
