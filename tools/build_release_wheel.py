@@ -42,7 +42,7 @@ import tempfile
 import time
 import zipfile
 
-#: The kernel libraries a release wheel must hold (Reference also serves CPU; CUDA is compiled, never run here).
+#: The kernel libraries a release wheel must hold (Reference also serves CPU; CUDA is compiled here, run only where a GPU is).
 DEFAULT_REQUIRE = "Reference,OpenCL,CUDA"
 #: An OpenMM library a binary of the wheel may need: provided by the openmm wheel, never grafted.
 OPENMM_LIBRARY = re.compile(r"^libOpenMM[A-Za-z0-9_]*\.so(\.[0-9]+)*$")

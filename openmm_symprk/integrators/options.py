@@ -9,7 +9,8 @@ both backends then read that one object.
 The options (defaults in brackets):
 
 * both backends: ``exact_momentum`` [False] (needs ``system=``), ``check_finite`` [True], ``max_speed`` [None: only
-  NaN and infinity count as a blow-up], ``groups`` and ``inner_method`` (multiple time stepping), and the
+  NaN, infinity and absurd speeds (the custom program: a velocity component above 1e15 nm/ps) count as a blow-up;
+  at most :data:`MAX_SPEED_LIMIT`], ``groups`` and ``inner_method`` (multiple time stepping), and the
   thermostat's ``temperature``, ``collision_time``, ``thermostat_interval``, ``random_seed``
   (:func:`.thermostat.thermostat_settings`);
 * the CustomIntegrator backend only: ``constraints`` [None: from ``system=``], ``allow_nonsymplectic`` [False],
@@ -59,8 +60,14 @@ def check_option_names(given, accepted, where: str) -> None:
                     f"it accepts {', '.join(accepted)}")
 
 
+#: The largest ``max_speed`` (nm/ps): its square is written into the programs, where single precision (CUDA) refuses a
+#: literal beyond float's range (about 3.4e38); 1e15 nm/ps is already some 3e9 times the speed of light.
+MAX_SPEED_LIMIT = 1e15
+
+
 def check_max_speed(max_speed) -> float:
-    """``max_speed`` in nm/ps as a float >= 0 (None or 0: only NaN and infinity count as a blow-up)."""
+    """``max_speed`` in nm/ps as a float in [0, MAX_SPEED_LIMIT] (None or 0: only NaN, infinity and absurd speeds count
+    as a blow-up)."""
     if max_speed is None:
         return 0.0
     if unit.is_quantity(max_speed):
@@ -69,9 +76,9 @@ def check_max_speed(max_speed) -> float:
         value = float(max_speed)
     except (TypeError, ValueError):
         raise TypeError(f"max_speed must be a speed in nm/ps (or None), got {max_speed!r}") from None
-    if not math.isfinite(value) or value < 0:
-        raise ValueError(f"max_speed must be a finite speed >= 0 nm/ps (None or 0: only NaN and infinity), "
-                         f"got {max_speed!r}")
+    if not math.isfinite(value) or value < 0 or value > MAX_SPEED_LIMIT:
+        raise ValueError(f"max_speed must be a speed from 0 to {MAX_SPEED_LIMIT:g} nm/ps (None or 0: only NaN, "
+                         f"infinity and absurd speeds), got {max_speed!r}")
     return value
 
 

@@ -266,9 +266,9 @@ def _constrained_chain(n=10):
 def test_every_splitting_keeps_constraints_on_opencl_at_the_default_tolerance():
     """With tolerance 1e-5 the constraint solver leaves residuals of that size; a drift after a much smaller one
     (pefrl: 0.775 after -0.066) used to amplify them from drift to drift, and the energy wandered 15-25x more
-    than Verlet's (pefrl, mclachlan-sb3a4, sofroniou-spaletta-10).  Every splitting now stays within 4x of
-    Verlet's energy error at the same tolerance, step and length: within 2x on OpenCL (PoCL); on CUDA (H100, double)
-    position-verlet and bcss-2, whose steps hold two constrained drifts, measured 3.0x and 2.8x."""
+    than Verlet's (pefrl, mclachlan-sb3a4, sofroniou-spaletta-10).  Every splitting now stays within 2x of
+    Verlet's energy error at the same tolerance, step and length on OpenCL (PoCL), within 4x on CUDA (H100, double:
+    position-verlet and bcss-2, whose steps hold two constrained drifts, measured 3.0x and 2.8x)."""
     from openmm_symprk import catalogue
 
     system, pos, vel = _constrained_chain()
@@ -288,5 +288,6 @@ def test_every_splitting_keeps_constraints_on_opencl_at_the_default_tolerance():
             energies.append((st.getKineticEnergy() + st.getPotentialEnergy()).value_in_unit(unit.kilojoule_per_mole))
         errors[m.name] = max(energies) - min(energies)
         del ctx
-    worst = {k: v for k, v in errors.items() if v > 4 * errors["verlet"]}
+    bound = 4 if COMMON == "CUDA" else 2
+    worst = {k: v for k, v in errors.items() if v > bound * errors["verlet"]}
     assert not worst, (errors["verlet"], worst)

@@ -12,7 +12,7 @@ For mixed and double precision it prints, as markdown tables:
    ``exact_momentum`` (:mod:`.conservation`'s table);
 3. speed: time per step of the native ``verlet`` and ``yoshida-4`` against OpenMM's VerletIntegrator (ratio per
    force evaluation, integrators taking turns: :mod:`.speed`'s table) on a periodic rigid TIP3P box with PME and
-   on villin solvated to about 23,000 atoms (PME, HBonds, rigid water).
+   on villin solvated to about 21,000 atoms (PME, HBonds, rigid water).
 
 Without a CUDA platform it says why in one line and exits with status 2.  Not a test: nothing is asserted.
 """
@@ -110,7 +110,7 @@ def run(args):
     print("\nConservation, native verlet, 27-water cluster, 2 fs (off/on: exact_momentum):\n")
     print(conservation.table([conservation.compare(cluster, f"CUDA:{p}", "verlet", 500 if args.quick else 2000,
                                                    backend="native") for p in precisions]))
-    boxes = [speed.water_box_system(3.9)] + ([] if args.quick else [_solvated_villin(23000)])
+    boxes = [speed.water_box_system(3.9)] + ([] if args.quick else [_solvated_villin(23000)])  # about 21,000 atoms
     print("\nSpeed (fastest of the blocks, integrators taking turns):\n")
     for title, system, pos, vel in boxes:
         for p in precisions:
