@@ -88,7 +88,8 @@ def same_program(scenes, precisions, steps):
 def build_parser(prog: str = "symprk gpucheck"):
     p = argparse.ArgumentParser(prog=prog, description=__doc__.split("\n\n")[0])
     p.add_argument("--quick", action="store_true", help="fewer steps; the PME box only for speed")
-    p.add_argument("--precisions", default="mixed,double")
+    p.add_argument("--precisions", default="mixed,double",
+                   help="comma-separated CUDA precisions to check (default: mixed,double)")
     return p
 
 
