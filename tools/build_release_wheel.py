@@ -14,9 +14,10 @@ C++17 compiler, and PyPI (or pip's cache) for the build requirements.  Linux onl
    CUDA headers), with SYMPRK_REQUIRE_NATIVE_BUILD naming every kernel library (``--require``), so that a wheel
    without the plugin or with a kernel left out is an error rather than a warning;
 3. ``auditwheel repair`` to a manylinux tag with OpenMM's libraries excluded from grafting: the plugin links
-   libOpenMM.so and OpenMM's OpenCL and CUDA platforms (libOpenMMOpenCL.so, libOpenMMCUDA.so), which the openmm wheels provide at run time through the
-   plugin's $ORIGIN run paths; a grafted copy would put a second OpenMM into the process.  The names excluded are
-   read from the wheel's own ELF files (every libOpenMM* a binary needs that the wheel does not hold);
+   libOpenMM.so and OpenMM's OpenCL and CUDA platforms (libOpenMMOpenCL.so, libOpenMMCUDA.so), which the openmm
+   wheels provide at run time through the plugin's $ORIGIN run paths; a grafted copy would put a second OpenMM into
+   the process.  The names excluded are read from the wheel's own ELF files (every libOpenMM* a binary needs that the
+   wheel does not hold);
 4. checks the result and stops with a message if a check fails: the manylinux tag, nothing of OpenMM inside, the
    wheel's openmm requirement pinned to the minor series the plugin was compiled against, every required kernel
    library present, ``auditwheel show`` finding no external library but the OpenMM ones excluded (it calls the
@@ -42,7 +43,8 @@ import tempfile
 import time
 import zipfile
 
-#: The kernel libraries a release wheel must hold (Reference also serves CPU; CUDA is compiled here, run only where a GPU is).
+#: The kernel libraries a release wheel must hold (Reference also serves CPU; CUDA is compiled here, run only where a
+#: GPU is).
 DEFAULT_REQUIRE = "Reference,OpenCL,CUDA"
 #: An OpenMM library a binary of the wheel may need: provided by the openmm wheel, never grafted.
 OPENMM_LIBRARY = re.compile(r"^libOpenMM[A-Za-z0-9_]*\.so(\.[0-9]+)*$")
