@@ -208,7 +208,9 @@ def summarise(cfg: dict, rows: list, grouped: dict, timings: dict | None = None,
     if cfg.get("tolerances"):  # issue 35's frontier (the 3-SE table above stays as a secondary view)
         from .frontier import frontier_summary
 
-        out["frontier"] = frontier_summary([e["label"] for e in table], per, refs, cfg["tolerances"], timings)
+        side = {describe(r)["label"] for r in cfg.get("side", ())}
+        out["frontier"] = frontier_summary([e["label"] for e in table if e["label"] not in side], per, refs,
+                                           cfg["tolerances"], timings)
     return out
 
 
