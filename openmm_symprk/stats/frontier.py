@@ -15,6 +15,11 @@ the reference replica by replica (the same initial state), this module
 * and the largest step at which every observable stays inside its tolerance with a stated confidence (the
   ``1 - level`` quantile of the bootstrap's h_eps: the step a user can take).
 
+A family whose dynamics differ from the reference's at any step (OpenMM's Langevin integrators against a velocity-
+rescaling reference: friction slows diffusion whatever h) names those observables in ``free``: their bias is fitted
+as a + c h^p, and the equal-accuracy step is where |a + c h^p| leaves the tolerance, none (0) where |a| is already
+beyond it: such a family costs infinitely much at that tolerance, as it should.
+
 Two families of the same order compare by one number per observable whatever eps:
 cost_B / cost_A = (s_B / s_A) (c_B / c_A)^(1/p); with several observables the step is the smallest h_eps over them,
 so the answer depends on the tolerances' relative sizes, and a family whose bias is indistinguishable from zero is
@@ -26,7 +31,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-__all__ = ["Family", "fit_c", "bootstrap", "equal_accuracy_step", "FrontierPoint", "frontier", "compare"]
+__all__ = ["Family", "fit", "fit_c", "bootstrap", "equal_accuracy_step", "FrontierPoint", "frontier", "compare"]
 
 
 @dataclass(frozen=True)
@@ -42,6 +47,7 @@ class Family:
     order: int = 2
     cost_per_step: float = 1.0
     cap: float | None = None  # the largest usable step (default: the largest measured)
+    free: tuple = ()  # observables whose bias has an h-independent part a (fitted as a + c h^p)
 
     def __post_init__(self):
         steps = np.asarray(self.steps, dtype=float)
@@ -67,17 +73,41 @@ def _row_stats(b: np.ndarray) -> tuple:
     return mean, np.sqrt(var / np.maximum(n, 1)), n
 
 
-def fit_c(steps, bias, order: int, weights=None) -> float:
-    """c of b(h) = c h^p by weighted least squares through the origin over the rows (``bias`` (R, N), NaN for
-    missing replicas); ``weights`` per row (default 1/SE^2 of the row means; a row with one replica, or none, is left
-    out)."""
+def _solve(x, mean, w, intercept: bool) -> tuple:
+    """(a, c) of mean = a + c x by weighted least squares (a = 0 without ``intercept``); NaNs where the rows cannot
+    fix them (no row; an intercept with fewer than two distinct x)."""
+    ok = np.isfinite(mean) & np.isfinite(w) & (w > 0)
+    if not ok.any():
+        return float("nan"), float("nan")
+    x, mean, w = x[ok], mean[ok], w[ok]
+    if not intercept:
+        return 0.0, float(np.sum(w * x * mean) / np.sum(w * x * x))
+    if len(np.unique(x)) < 2:
+        return float("nan"), float("nan")
+    sw, sx, sy = np.sum(w), np.sum(w * x), np.sum(w * mean)
+    sxx, sxy = np.sum(w * x * x), np.sum(w * x * mean)
+    c = (sw * sxy - sx * sy) / (sw * sxx - sx * sx)
+    return float((sy - c * sx) / sw), float(c)
+
+
+def fit(steps, bias, order: int, weights=None, intercept: bool = False) -> tuple:
+    """(a, c) of b(h) = a + c h^p by weighted least squares over the rows (``bias`` (R, N), NaN for missing
+    replicas; a = 0, through the origin, without ``intercept``); ``weights`` per row (default 1/SE^2 of the row
+    means; a row with one replica, or none, is left out).  ValueError where no row can be used, or an intercept is
+    asked for with fewer than two steps."""
     x = np.asarray(steps, dtype=float) ** order
     mean, se, n = _row_stats(np.asarray(bias, dtype=float))
     w = 1.0 / se ** 2 if weights is None else np.asarray(weights, dtype=float)
-    ok = np.isfinite(mean) & np.isfinite(w) & (w > 0)
-    if not ok.any():
-        raise ValueError("no row with a finite mean bias and a positive weight: need at least two replicas in a row")
-    return float(np.sum(w[ok] * x[ok] * mean[ok]) / np.sum(w[ok] * x[ok] ** 2))
+    a, c = _solve(x, mean, w, intercept)
+    if not np.isfinite(c):
+        raise ValueError("no row with a finite mean bias and a positive weight (need at least two replicas in a row"
+                         + (", and two steps for an intercept)" if intercept else ")"))
+    return a, c
+
+
+def fit_c(steps, bias, order: int, weights=None) -> float:
+    """c of b(h) = c h^p, through the origin (:func:`fit` without an intercept)."""
+    return fit(steps, bias, order, weights)[1]
 
 
 def _weights(family: Family, obs: str) -> np.ndarray:
@@ -86,10 +116,10 @@ def _weights(family: Family, obs: str) -> np.ndarray:
 
 
 def bootstrap(families, observables, n_boot: int = 2000, seed: int = 1) -> dict:
-    """{family name: {observable: (n_boot,) array of c}}: the replicas resampled with replacement, the same indices
-    for every row of every family (they are paired through the reference and the initial states); each fit keeps the
-    weights of the full data (resampling them too would let a resample with two equal replicas weigh a row
-    infinitely)."""
+    """{family name: {observable: (n_boot, 2) array of (a, c)}} (a = 0 but for the family's ``free`` observables):
+    the replicas resampled with replacement, the same indices for every row of every family (they are paired through
+    the reference and the initial states); each fit keeps the weights of the full data (resampling them too would let
+    a resample with two equal replicas weigh a row infinitely)."""
     families = list(families)
     n = max(np.shape(f.bias[o])[1] for f in families for o in observables)
     rng = np.random.default_rng(seed)
@@ -102,24 +132,36 @@ def bootstrap(families, observables, n_boot: int = 2000, seed: int = 1) -> dict:
             b = np.pad(b, ((0, 0), (0, n - b.shape[1])), constant_values=np.nan)
             w = _weights(f, obs)
             x = np.asarray(f.steps, dtype=float) ** f.order
-            cs = np.empty(n_boot)
+            fits = np.empty((n_boot, 2))
             for i, pick in enumerate(picks):
-                mean, _, count = _row_stats(b[:, pick])
-                ok = np.isfinite(mean) & np.isfinite(w) & (w > 0)
-                cs[i] = np.sum(w[ok] * x[ok] * mean[ok]) / np.sum(w[ok] * x[ok] ** 2) if ok.any() else np.nan
-            out[f.name][obs] = cs
+                mean, _, _ = _row_stats(b[:, pick])
+                fits[i] = _solve(x, mean, w, obs in f.free)
+            out[f.name][obs] = fits
     return out
 
 
-def equal_accuracy_step(cs: dict, tolerances: dict, order: int, cap: float) -> np.ndarray:
-    """h_eps = min over observables of (eps / |c|)^(1/p), at most ``cap``; ``cs`` {observable: c or array of c}; NaN
-    where some c is NaN (a bootstrap resample that left a row without data says nothing of the step)."""
+def _pair(value) -> tuple:
+    """(a, c) of a fit given as c alone (through the origin), as a pair, or as an (..., 2) array of pairs."""
+    if isinstance(value, tuple):
+        return np.asarray(value[0], dtype=float), np.asarray(value[1], dtype=float)
+    arr = np.asarray(value, dtype=float)
+    if arr.ndim >= 2 and arr.shape[-1] == 2:
+        return arr[..., 0], arr[..., 1]
+    return np.zeros_like(arr), arr
+
+
+def equal_accuracy_step(fits: dict, tolerances: dict, order: int, cap: float) -> np.ndarray:
+    """h_eps = min over observables of the largest h at which |a + c h^p| <= eps holds from h = 0 on (for a = 0:
+    (eps / |c|)^(1/p); 0 where |a| > eps already), at most ``cap``; ``fits`` {observable: c, (a, c), or an (n, 2)
+    array of (a, c) pairs}; NaN where a fit is NaN (a bootstrap resample that left a row without data says nothing
+    of the step)."""
     h = np.asarray(cap, dtype=float)
     for obs, eps in tolerances.items():
-        c = np.abs(np.asarray(cs[obs], dtype=float))
-        with np.errstate(divide="ignore"):
-            step = np.where(c > 0, (eps / np.where(c > 0, c, 1.0)) ** (1.0 / order), np.inf)
-        h = np.where(np.isnan(c), np.nan, np.minimum(h, step))  # no c (a resample without data): no step
+        a, c = _pair(fits[obs])
+        with np.errstate(divide="ignore", invalid="ignore"):
+            x_out = np.where(c != 0, (np.sign(c) * eps - a) / np.where(c != 0, c, 1.0), np.inf)
+            step = np.where(np.abs(a) > eps, 0.0, np.maximum(x_out, 0.0) ** (1.0 / order))
+        h = np.where(np.isnan(c) | np.isnan(a), np.nan, np.minimum(h, step))  # no fit: no step
     return h
 
 
@@ -140,7 +182,8 @@ class FrontierPoint:
 
 def frontier(family: Family, tolerances: dict, boot: dict, level: float = 0.95) -> FrontierPoint:
     """``family`` at ``tolerances`` ({observable: eps}); ``boot`` its {observable: bootstrap c's}."""
-    cs = {obs: fit_c(family.steps, family.bias[obs], family.order, _weights(family, obs)) for obs in tolerances}
+    cs = {obs: fit(family.steps, family.bias[obs], family.order, _weights(family, obs), obs in family.free)
+          for obs in tolerances}
     step = float(equal_accuracy_step(cs, tolerances, family.order, family.largest_step))
     limits = {obs: float(equal_accuracy_step({obs: cs[obs]}, {obs: eps}, family.order, np.inf))
               for obs, eps in tolerances.items()}
@@ -148,8 +191,9 @@ def frontier(family: Family, tolerances: dict, boot: dict, level: float = 0.95) 
     limited_by = binding if limits[binding] < family.largest_step else "largest step"
     samples = equal_accuracy_step({obs: boot[obs] for obs in tolerances}, tolerances, family.order, family.largest_step)
     safe = float(np.nanquantile(samples, 1.0 - level)) if np.isfinite(samples).any() else float("nan")
-    return FrontierPoint(family.name, step, family.cost_per_step / step, safe, family.cost_per_step / safe,
-                         limited_by, samples)
+    with np.errstate(divide="ignore"):
+        return FrontierPoint(family.name, step, family.cost_per_step / step if step > 0 else np.inf, safe,
+                             family.cost_per_step / safe if safe > 0 else np.inf, limited_by, samples)
 
 
 def compare(ours: FrontierPoint, theirs: FrontierPoint, cost_ours: float, cost_theirs: float,
@@ -160,10 +204,13 @@ def compare(ours: FrontierPoint, theirs: FrontierPoint, cost_ours: float, cost_t
     in the same order; nans where no resample gives both)."""
     if len(ours.samples) != len(theirs.samples):
         raise ValueError("the two families' bootstrap samples must come from the same resamples (one bootstrap call)")
-    ratio = (cost_theirs / theirs.step) / (cost_ours / ours.step)
-    boot = (cost_theirs / theirs.samples) / (cost_ours / ours.samples)
-    boot = boot[np.isfinite(boot)]
+    with np.errstate(divide="ignore", invalid="ignore"):  # a step of 0 (a bias beyond the tolerance at h -> 0): inf
+        ratio = (cost_theirs / np.float64(theirs.step)) / (cost_ours / np.float64(ours.step))
+        boot = (cost_theirs / theirs.samples) / (cost_ours / ours.samples)
+    boot = boot[~np.isnan(boot)]
     if not len(boot):
         return float(ratio), float("nan"), float("nan")
     tail = (1.0 - level) / 2
-    return float(ratio), float(np.quantile(boot, tail)), float(np.quantile(boot, 1.0 - tail))
+    method = "linear" if np.isfinite(boot).all() else "inverted_cdf"  # no interpolation between infinite samples
+    return (float(ratio), float(np.quantile(boot, tail, method=method)),
+            float(np.quantile(boot, 1.0 - tail, method=method)))

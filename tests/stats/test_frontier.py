@@ -3,7 +3,7 @@ b(h) = c h^p plus replica noise, paired with a reference replica by replica."""
 import numpy as np
 import pytest
 
-from openmm_symprk.stats.frontier import Family, bootstrap, compare, equal_accuracy_step, fit_c, frontier
+from openmm_symprk.stats.frontier import Family, bootstrap, compare, equal_accuracy_step, fit, fit_c, frontier
 
 
 def _family(name, c, steps, n=12, noise=0.01, order=2, seed=0, cost=1.0, shared=None, cap=None):
@@ -91,3 +91,27 @@ def test_a_resample_without_data_gives_no_step():
     safe at the largest step (review of the frontier: it was the cap)."""
     h = equal_accuracy_step({"a": np.array([np.nan, 0.01])}, {"a": 0.04}, 2, 3.0)
     assert np.isnan(h[0]) and h[1] == pytest.approx(2.0)
+
+
+def test_a_family_whose_bias_does_not_vanish_with_h_is_fitted_with_its_intercept():
+    """A thermostat that changes the dynamics at any step (friction: diffusion 15 % slow) has a bias a + c h^2; fitted
+    through the origin it would look small at small h.  With ``free`` the fit finds a, and where |a| exceeds the
+    tolerance no step meets it: the family's cost is infinite, and a comparison against it has no finite bound."""
+    rng = np.random.default_rng(5)
+    steps = np.array([1.0, 2.0, 3.0])
+    b = -0.15 + 0.004 * steps[:, None] ** 2 + rng.normal(0, 1e-4, (3, 12))
+    friction = Family("langevin", tuple(steps), {"D": b}, free=("D",))
+    a, c = fit(friction.steps, friction.bias["D"], 2, intercept=True)
+    assert a == pytest.approx(-0.15, abs=1e-3) and c == pytest.approx(0.004, rel=0.02)
+    boot = bootstrap([friction], ["D"], n_boot=100)
+    assert boot["langevin"]["D"].shape == (100, 2) and np.allclose(boot["langevin"]["D"][:, 0], -0.15, atol=2e-3)
+    assert frontier(friction, {"D": 0.05}, boot["langevin"]).step == 0.0  # |a| = 0.15 > 0.05 at every step
+    # within the tolerance the bias leaves it where a + c h^2 crosses -eps or +eps: here +0.05 at h^2 = (0.05+0.15)/0.004
+    assert float(equal_accuracy_step({"D": (-0.15, 0.004)}, {"D": 0.2}, 2, cap=100.0)) == pytest.approx(
+        (0.35 / 0.004) ** 0.5)
+    ours = _family("ours", 0.001, [2, 4, 6], noise=1e-4, cap=6)
+    ours = Family("ours", ours.steps, {"D": ours.bias["pe"]}, cost_per_step=2.0)
+    boot = bootstrap([ours, friction], ["D"], n_boot=100)
+    ratio, low, high = compare(frontier(ours, {"D": 0.05}, boot["ours"]), frontier(friction, {"D": 0.05},
+                                                                                   boot["langevin"]), 2.0, 1.0)
+    assert ratio == np.inf and high == np.inf and low == np.inf

@@ -16,12 +16,13 @@ import dataclasses
 
 import numpy as np
 
-from ...stats.frontier import Family, bootstrap, compare, fit_c, frontier
+from ...stats.frontier import Family, bootstrap, compare, fit, frontier
 from ..core.charts import pyplot, save
 from ..core.rows import OPENMM_KINDS
 from .rowspec import to_row
 
-__all__ = ["family_of", "bias_order", "families", "frontier_summary", "format_frontier", "frontier_chart", "N_BOOT"]
+__all__ = ["family_of", "bias_order", "free_observables", "families", "frontier_summary", "format_frontier",
+           "frontier_chart", "N_BOOT", "DYNAMICAL"]
 
 #: Bootstrap resamples of the replicas.
 N_BOOT = 2000
@@ -42,6 +43,23 @@ def bias_order(label: str) -> int:
     if not row.is_ours or row.ensemble != "NVE":
         return 2
     return int(row.resolved(constraints=True).constrained_order or 2)
+
+
+#: The observables of the dynamics (diffusion, reorientation, the angular-velocity correlation): a thermostat that
+#: acts on each particle (OpenMM's Langevin integrators) changes them at any step, which the paired bias against a
+#: velocity-rescaling reference keeps as an h-independent part.
+DYNAMICAL = ("D", "tau2_dip", "w_zero", "w_min")
+
+
+def free_observables(label: str, reference: str) -> tuple:
+    """The observables whose bias against ``reference`` has an h-independent part (fitted as a + c h^p): the
+    dynamical ones (:data:`DYNAMICAL`) of a row whose thermostat is not the reference's kind (OpenMM's Langevin, Nose-
+    Hoover or DPD against the package's velocity rescaling); none for rows of the reference's own kind, whose bias
+    vanishes with h (their thermostat and collision time are the reference's)."""
+    row, ref = to_row(label), to_row(reference)
+    if row.ensemble == "NVE" or (row.is_ours and row.tau_ps == ref.tau_ps):
+        return ()
+    return DYNAMICAL
 
 
 def _absolute(tolerances: dict, ref_means: dict) -> dict:
@@ -85,7 +103,9 @@ def families(rows, per: dict, reference: str, ensemble: str, observables) -> lis
             bias[k] = b
         rows_ = [to_row(lab) for lab in labels]
         out.append((Family(name, tuple(r.step_fs for r in rows_), bias, order=bias_order(labels[0]),
-                           cost_per_step=float(np.mean([r.evals_per_step() for r in rows_]))), labels))
+                           cost_per_step=float(np.mean([r.evals_per_step() for r in rows_])),
+                           free=tuple(k for k in free_observables(labels[0], reference) if k in observables)),
+                    labels))
     return out
 
 
@@ -99,7 +119,7 @@ def frontier_summary(rows, per: dict, references: dict, tolerances: dict, timing
         # a family on the frontier has two steps or more (one step fixes c but not that the bias goes as h^2), each
         # with two replicas or more of every observable
         found = families(rows, per, reference, ensemble, keys)
-        fams = [(f, labs) for f, labs in found if len(set(f.steps)) >= 2
+        fams = [(f, labs) for f, labs in found if len(set(f.steps)) >= (3 if f.free else 2)
                 and all(np.isfinite(f.bias[k]).sum(axis=1).min() >= 2 for k in keys)]
         if not fams:
             continue
@@ -113,8 +133,13 @@ def frontier_summary(rows, per: dict, references: dict, tolerances: dict, timing
             entry["families"].append({
                 "family": f.name, "rows": labs, "steps_fs": list(f.steps), "evals_per_step": f.cost_per_step,
                 "s_per_step": wall[f.name], "openmm": to_row(labs[0]).who in OPENMM_KINDS,
-                "c": {k: fit_c(f.steps, f.bias[k], f.order) for k in keys},
-                "c_interval": {k: [float(np.nanquantile(boot[f.name][k], q)) for q in (0.025, 0.975)] for k in keys}})
+                "c": {k: fit(f.steps, f.bias[k], f.order, intercept=k in f.free)[1] for k in keys},
+                "c_interval": {k: [float(np.nanquantile(boot[f.name][k][:, 1], q)) for q in (0.025, 0.975)]
+                               for k in keys}})
+            if f.free:  # the h-independent part of the bias, where the family has one
+                entry["families"][-1]["a"] = {k: fit(f.steps, f.bias[k], f.order, intercept=True)[0] for k in f.free}
+                entry["families"][-1]["a_interval"] = {
+                    k: [float(np.nanquantile(boot[f.name][k][:, 0], q)) for q in (0.025, 0.975)] for k in f.free}
         for level, tol in tolerances.items():
             eps = _absolute(tol, ref_means)
             points = {f.name: frontier(f, eps, boot[f.name]) for f, _ in fams}
@@ -124,23 +149,30 @@ def frontier_summary(rows, per: dict, references: dict, tolerances: dict, timing
                 level_entry["families"][f.name] = {
                     "step_fs": p.step, "evals_per_ps": 1000.0 * p.cost, "safe_step_fs": p.safe_step,
                     "limited_by": p.limited_by,
-                    "s_per_ps": 1000.0 * wall[f.name] / p.step if wall[f.name] else None}
+                    "s_per_ps": 1000.0 * _per_step(wall[f.name], p.step) if wall[f.name] else None}
             for unit, cost_of in (("evals", lambda name: next(f.cost_per_step for f, _ in fams if f.name == name)),
                                   ("wall", lambda name: wall[name])):
                 ours = [f.name for f, labs in fams if to_row(labs[0]).who not in OPENMM_KINDS and cost_of(f.name)]
                 theirs = [f.name for f, labs in fams if to_row(labs[0]).who in OPENMM_KINDS and cost_of(f.name)]
                 if not ours or not theirs:
                     continue
-                best_ours = min(ours, key=lambda n: cost_of(n) / points[n].step)
-                best_theirs = min(theirs, key=lambda n: cost_of(n) / points[n].step)
-                a = dataclasses.replace(points[best_ours], cost=cost_of(best_ours) / points[best_ours].step)
-                b = dataclasses.replace(points[best_theirs], cost=cost_of(best_theirs) / points[best_theirs].step)
+                best_ours = min(ours, key=lambda n: _per_step(cost_of(n), points[n].step))
+                best_theirs = min(theirs, key=lambda n: _per_step(cost_of(n), points[n].step))
+                a = dataclasses.replace(points[best_ours], cost=_per_step(cost_of(best_ours), points[best_ours].step))
+                b = dataclasses.replace(points[best_theirs],
+                                        cost=_per_step(cost_of(best_theirs), points[best_theirs].step))
                 ratio, low, high = compare(a, b, cost_of(best_ours), cost_of(best_theirs))
                 level_entry[f"ratio_{unit}"] = {"ours": best_ours, "theirs": best_theirs, "ratio": ratio,
                                                 "low": low, "high": high}
             entry["levels"][level] = level_entry
         out[ensemble] = entry
     return out
+
+
+def _per_step(cost: float, step: float) -> float:
+    """A cost per step over the step: the cost per unit of simulated time, infinite at a step of 0 (a family that
+    meets the tolerance at no step)."""
+    return cost / step if step > 0 else float("inf")
 
 
 def _wall_per_step(labels, timings: dict) -> float | None:
@@ -155,8 +187,8 @@ def format_frontier(summary: dict) -> str:
     OpenMM's with the 95 % interval."""
     lines = []
     for ensemble, entry in summary.items():
-        lines.append(f"{ensemble}: biases against {entry['reference']} fitted as c h^2 (h in fs), 95 % intervals "
-                     f"from {N_BOOT} resamples of the replicas")
+        lines.append(f"{ensemble}: biases against {entry['reference']} fitted as c h^p (h in fs; p the order kept, "
+                     f"2 with a thermostat), 95 % intervals from {N_BOOT} resamples of the replicas")
         keys = sorted(entry["families"][0]["c"]) if entry["families"] else []
         lines.append("  " + "family".ljust(34) + "steps fs".ljust(16) + "".join(f"c[{k}]".rjust(24) for k in keys))
         for fam in entry["families"]:
@@ -164,6 +196,10 @@ def format_frontier(summary: dict) -> str:
                          .rjust(24) for k in keys)
             lines.append("  " + fam["family"][:33].ljust(34) + ",".join(f"{h:g}" for h in fam["steps_fs"]).ljust(16)
                          + cs)
+            if fam.get("a"):
+                lines.append("    and an h-independent part a (its thermostat is not the reference's): " + ", ".join(
+                    f"a[{k}] {fam['a'][k]:+.3g} [{fam['a_interval'][k][0]:+.2g},{fam['a_interval'][k][1]:+.2g}]"
+                    for k in fam["a"]))
         if entry.get("left_out"):
             lines.append(f"  not on the frontier (fewer than two steps, or fewer than two replicas of an observable): "
                          f"{'; '.join(entry['left_out'])}")
