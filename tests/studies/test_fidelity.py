@@ -507,10 +507,11 @@ def test_the_committed_results_load_and_report_as_committed(tmp_path, monkeypatc
             assert "planned runs are not finished" not in captured.out, captured.out
 
 
-def test_the_frontier_preset_pairs_its_nvt_rows_on_one_event_grid():
-    """issue 35's rows: every NVT row of the package thermostats every EVENT_FS fs with the reference's seed (its
-    draws are the reference's, event for event), every family has two steps or more, and the tolerances name the
-    observables the report fits."""
+def test_the_frontier_preset_runs_every_nvt_family_on_three_steps_or_more():
+    """The frontier's rows: every NVT row of the package thermostats with the reference's seed at the reference's
+    collision time, on the 12-fs event grid where its step divides it (else every step); every family has two steps
+    or more, every NVT family three or more (LangevinMiddle at friction 1/ps and 0.1/ps among them), the side rows
+    (hypothesis tests) sit outside the families, and the tolerances name the observables the report fits."""
     from openmm_symprk.studies.core.rows import Row
     from openmm_symprk.studies.fidelity import presets
     from openmm_symprk.studies.fidelity.frontier import family_of
@@ -518,16 +519,25 @@ def test_the_frontier_preset_pairs_its_nvt_rows_on_one_event_grid():
 
     cfg = presets.frontier()
     rows = check(cfg)
-    assert cfg["run_version"] == 3 and cfg["equilibrator"] == "svr" and "frozen" not in cfg
-    ours_nvt = [Row.parse(r) for r in rows if Row.parse(r).ensemble == "NVT" and Row.parse(r).is_ours]
-    assert ours_nvt and all(r.every * r.step_fs == presets.EVENT_FS and r.position in ("ends", "middle") and r.seed == 1
+    side = set(cfg["side"])
+    assert cfg["run_version"] == 3 and cfg["equilibrator"] == "svr" and "frozen" not in cfg and side < set(rows)
+    ours_nvt = [Row.parse(r) for r in rows if Row.parse(r).ensemble == "NVT" and Row.parse(r).is_ours and r not in side]
+    assert ours_nvt and all(r.seed == 1 and r.tau_ps == presets.NVT_TAU_PS and r.position in ("ends", "middle")
                             for r in ours_nvt)
+    assert all(r.every * r.step_fs == presets.EVENT_FS if (presets.EVENT_FS / r.step_fs).is_integer() else r.every == 1
+               for r in ours_nvt)
     families = {}
     for r in rows:
-        if r not in cfg["references"].values():
+        if r not in cfg["references"].values() and r not in side:
             families.setdefault(family_of(r), set()).add(Row.parse(r).step_fs)
     assert all(len(steps) >= 2 for steps in families.values()), families
-    assert family_of("omelyan-2 4 fs SVR 0.1 ps every 3") == family_of("omelyan-2 6 fs SVR 0.1 ps every 2")
+    nvt = {f: steps for f, steps in families.items() if " SVR " in f or f.startswith("langevin")}
+    # where "auto" puts the thermostat (Verlet's ends rows answer the placement question at two steps)
+    auto = {f: steps for f, steps in nvt.items() if f != "verlet SVR 0.1 ps"}
+    assert all(len(steps) >= 3 for steps in auto.values()), auto
+    assert {"langevin friction 1/ps", "langevin friction 0.1/ps", "predescu-3 SVR 0.1 ps"} <= set(nvt)
+    assert len(nvt["omelyan-2 SVR 0.1 ps"]) >= 4
+    assert family_of("omelyan-2 4 fs SVR 0.1 ps every 3") == family_of("omelyan-2 5 fs SVR 0.1 ps")
     from openmm_symprk.studies.fidelity.cli import select_rows
 
     deciding = select_rows(cfg, "deciding")

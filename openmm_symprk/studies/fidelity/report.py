@@ -121,12 +121,13 @@ def resolution_needed(n: int, se: float | None, target: float) -> int | None:
 
 
 def summarise(cfg: dict, rows: list, grouped: dict, timings: dict | None = None, box_nm: float | None = None,
-              references: dict | None = None) -> dict:
+              references: dict | None = None, model: dict | None = None) -> dict:
     """The study's results from its finished runs (``grouped``: {row label: [(arrays, info) per replica]}),
     timings ({label: wall seconds per simulated ps}) and the references
     ({ensemble: label}; default: the first row for NVE, and the NVT rows against it too).  NVT rows are paired
     with the NVT reference where there is one, NVE rows with the NVE reference; each ensemble's rows also with
-    its Verlet rows extrapolated to h -> 0."""
+    its Verlet rows extrapolated to h -> 0.  ``model``: the box's properties for the modified-energy model
+    (:func:`.model.box_properties`), whose predictions are set beside the measured biases."""
     timings = timings or {}
     refs = {ens: describe(lab)["label"] for ens, lab in (references or {"NVE": rows[0]}).items()}
     ref_label = refs["NVE"]
@@ -211,7 +212,36 @@ def summarise(cfg: dict, rows: list, grouped: dict, timings: dict | None = None,
         side = {describe(r)["label"] for r in cfg.get("side", ())}
         out["frontier"] = frontier_summary([e["label"] for e in table if e["label"] not in side], per, refs,
                                            cfg["tolerances"], timings)
+    if model and model.get("c_conf") is not None:
+        from .model import bias_predictions
+
+        out["model"] = {"box": model, "rows": bias_predictions([e["label"] for e in table if e.get("vs_ref")], refs,
+                                                               model, cfg["temperature"])}
     return out
+
+
+def model_lines(summary: dict) -> list:
+    """The modified-energy model's predicted biases beside the measured ones (T_trans, T_rot - T_trans, PE)."""
+    model = summary.get("model")
+    if not model or not model["rows"]:
+        return []
+    box = model["box"]
+    lines = ["", f"Modified-energy model (studies.fidelity.model): <w^2> translation {box['omega2_ps2']['trans']:.0f}, "
+                 f"rotation {box['omega2_ps2']['rot']:.0f} ps^-2 ({box['states']} replica states), C_conf "
+                 f"{box['c_conf']:.4f} kJ/mol/K per molecule ({box.get('pe_runs', 0)} reference runs); predicted bias "
+                 f"against the row's reference | measured (paired, ± SE)",
+             "  " + "row".ljust(46) + "T_trans K".rjust(20) + "Trot-Ttr K".rjust(20) + "PE kJ/mol".rjust(24)]
+    by_label = {e["label"]: e for e in summary["rows"]}
+    for lab, pred in model["rows"].items():
+        meas = by_label[lab].get("vs_ref", {})
+
+        def cell(k, fmt, width):
+            m = meas.get(k)
+            got = f"{format(m['mean'], fmt)}±{format(m['se'], fmt.replace('+', ''))}" if m else "-"
+            return f"{format(pred[k], fmt)} | {got}".rjust(width)
+        lines.append("  " + lab[:45].ljust(46) + cell("T_trans", "+.2f", 20) + cell("dT", "+.2f", 20)
+                     + cell("pe", "+.3f", 24))
+    return lines
 
 
 def _resolution(entry: dict, ref: dict | None) -> dict:
@@ -371,6 +401,7 @@ def format_summary(summary: dict) -> str:
     for k, (why, where) in notes.items():
         lines.append(f"{_SHORT[k]} not measured in {len(where)} row(s) ({', '.join(where[:3])}"
                      f"{', ...' if len(where) > 3 else ''}), e.g.: {why}")
+    lines += model_lines(summary)
     if summary.get("frontier"):
         from .frontier import format_frontier
 

@@ -35,6 +35,9 @@ RUN_VERSION = 3
 #: The file of the rows' wall time per simulated ps, timed in turns (kept so that --report-only remakes the cost
 #: columns on any machine; a run that times again replaces it).
 TIMINGS = "timings.json"
+#: The file of the box's properties for the modified-energy model (computed once from the states and the NVT
+#: reference's runs, whose series are not committed).
+MODEL = "model.json"
 
 
 def run_key(cfg: dict, row, replica: int) -> str:
@@ -139,8 +142,9 @@ class FidelityStudy(Study):
                 stable = {lab for lab, reps in grouped.items()
                           if any(i.get("replica") == 0 and i.get("status") == "ok" for _, i in reps)}
                 timings = self.timings(stable)
-        summary = summarise(self.cfg, self.rows, grouped, timings, self.box_edge(),
-                            references(self.cfg, self.rows))
+        refs = references(self.cfg, self.rows)
+        summary = summarise(self.cfg, self.rows, grouped, timings, self.box_edge(), refs,
+                            self.model_properties(grouped, refs) if self.cfg.get("tolerances") else None)
         # the temperature view needs each run's time series (<key>.npz), which a committed data set leaves out
         with_series = {lab: [rep for rep in reps if len(rep[0].get("t", ()))] for lab, reps in grouped.items()}
         summary["temperature_view"] = temperature_view(self.cfg, self.rows, with_series, timings)
@@ -165,6 +169,29 @@ class FidelityStudy(Study):
             chart(summary, os.path.join(self.out, "fidelity-wall.png"), x="s_per_ps")
         if summary.get("frontier"):
             frontier_chart(summary, os.path.join(self.out, "frontier.png"))
+
+    def model_properties(self, grouped: dict, refs: dict) -> dict | None:
+        """The box's properties for the modified-energy model (:func:`..model.box_properties`), kept in
+        :data:`MODEL` so that --report-only remakes the model's lines anywhere: computed once, where the NVT
+        reference's runs have their potential-energy series on disk; None before."""
+        import json
+
+        path = os.path.join(self.out, MODEL)
+        try:
+            with open(path) as fh:
+                return json.load(fh)
+        except (FileNotFoundError, json.JSONDecodeError):
+            pass
+        series = [arrays["pe"] for arrays, info in grouped.get(refs.get("NVT"), [])
+                  if info.get("status") == "ok" and len(arrays.get("pe", ()))]
+        if self.report_only or not series:
+            return None
+        from ..model import box_properties
+
+        x, _ = self.states
+        props = box_properties(self.box.system, x, self.box.molecules, self.cfg["temperature"], series)
+        write_json(path, props)
+        return props
 
     def box_edge(self) -> float:
         import openmm.unit as unit
