@@ -125,3 +125,18 @@ def test_an_event_every_n_steps_keeps_each_placements_known_answer():
             for r in range(n):  # read at each step boundary of the interval
                 q2, _ = harmonic_sampling(sum(steps[r + 1:] + steps[:r + 1], []), 0.5, decay=0.5)
                 assert q2 == pytest.approx(exact, rel=1e-9), (where, n, r)
+
+
+def test_the_middle_placement_advice_names_where_it_falls_and_what_it_costs():
+    """The middle is the worse placement for every splitting but Verlet: the advice says where the middle falls (a
+    kick for BABAB schemes), quotes the harmonic oscillator's configurational temperature in both placements, and
+    the measurement in water where there is one; for Verlet, whose best placement is the middle, there is none."""
+    from openmm_symprk.methods.catalogue import get_method
+    from openmm_symprk.methods.placement import middle_placement_advice
+
+    assert middle_placement_advice("verlet", get_method("verlet").splitting.steps) is None
+    text = middle_placement_advice("omelyan-2", get_method("omelyan-2").splitting.steps)
+    assert "inside its central kick" in text and "1.0150" in text and "1.0003" in text and "SPC/E" in text
+    assert "'auto'" in text
+    pefrl = middle_placement_advice("pefrl", get_method("pefrl").splitting.steps)
+    assert pefrl is not None and "SPC/E" not in pefrl  # not measured in water: the harmonic numbers only
