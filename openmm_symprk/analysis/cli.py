@@ -80,10 +80,14 @@ def observe(universe, *, window_ps=None, viscosity_mpas=None, temperature_k=None
     def diffusion():
         d = SelfDiffusion(universe, window_ps, viscosity_mpas=viscosity_mpas, temperature_k=temperature_k).run()
         obs["D"] = _pair(d.results.D, d.results.se)
+        if d.results.se_note:
+            notes["D"] = d.results.se_note
         if viscosity_mpas is None:
             notes["D_inf"] = "give --viscosity (mPa s, the model's) and --temperature (K) for the Yeh-Hummer value"
         else:
             obs["D_inf"] = _pair(d.results.D_infinite, d.results.se)
+            if d.results.se_note:
+                notes["D_inf"] = d.results.se_note
 
     def reorientation():
         r = Reorientation(universe).run()
@@ -137,13 +141,13 @@ def observe(universe, *, window_ps=None, viscosity_mpas=None, temperature_k=None
 
 
 def format_table(obs: dict, notes: dict) -> str:
-    """The observables as a text table, the missing ones with their reasons below it."""
+    """The observables as a text table, the missing ones (and missing errors) with their reasons below it."""
     lines = [f"{'observable':40s} {'value':>22s}  unit"]
     for key, what, unit in OBSERVED:
         pair = obs.get(key)
         text = "-" if pair is None else f"{pair[0]:.4g} ± " + ("?" if pair[1] is None else f"{pair[1]:.2g}")
         lines.append(f"{what:40s} {text:>22s}  {unit}")
-    missing = [key for key, _, _ in OBSERVED if obs.get(key) is None and key in notes]
+    missing = [key for key, _, _ in OBSERVED if (obs.get(key) is None or obs[key][1] is None) and key in notes]
     if missing:
         lines.append("")
         labels = dict((key, what) for key, what, _ in OBSERVED)
@@ -165,7 +169,8 @@ def build_parser(prog: str = "symprk observe"):
                          "read as 1 ps apart otherwise) or files whose clock starts again; refused where it "
                          "contradicts the times a file stores")
     ap.add_argument("--window", type=float, nargs=2, metavar=("T_MIN", "T_MAX"), default=None,
-                    help="diffusion fit window, ps (default: T/10 to T/2 of the analysed time T)")
+                    help="diffusion fit window, ps (default: T/10 to T/2 of the analysed time T); D's error comes "
+                         "from 5 blocks of the run and needs T_MAX <= T/10")
     ap.add_argument("--viscosity", type=float, default=None, help="the model's shear viscosity, mPa s (Yeh-Hummer)")
     ap.add_argument("--temperature", type=float, default=None, help="temperature, K (Yeh-Hummer)")
     ap.add_argument("--omega-lag", type=float, default=0.5, help="longest lag of the omega ACF, ps (default 0.5)")
@@ -264,7 +269,7 @@ def run(args):
     when = "" if read.dt_from == "the file's times" else f" ({read.dt_from})"
     print(f"{n_waters} waters, {memory.trajectory.n_frames} frames every {dt:g} ps{when}"
           f"{'' if has_v else ' (positions only: no velocities)'}; errors are standard errors "
-          f"(molecules' scatter, jackknife over molecules, or blocks of frames)")
+          f"(blocks of frames, or jackknife over molecules)")
     if read.box_from:
         print(f"box from {read.box_from}")
     print(format_table(obs, notes))
