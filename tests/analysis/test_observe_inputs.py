@@ -95,7 +95,8 @@ def test_a_gap_in_time_between_files_is_refused_naming_it(files, capsys):
     assert main([files.pdb, str(files.a), str(files.b), "--progress", "never"]) == 2
     err, out = _err_line(capsys)
     assert "between frame 99 (t = 0.99 ps) and frame 100 (t = 1.5 ps) 0.51 ps pass where the other frames are " \
-           "0.01 ps apart" in err and "--start 0 --stop 100" in err and "--dt" in err
+           "0.01 ps apart" in err and "--start 0 --stop 100" in err
+    assert "--dt" not in err  # a stretch not written is not joined by --dt (refused there)
     assert out == ""  # refused before anything was computed
     assert main([files.pdb, str(files.a), str(files.b), "--stop", "100", "--progress", "never"]) == 0
     assert "100 frames every 0.01 ps" in capsys.readouterr().out
@@ -103,6 +104,7 @@ def test_a_gap_in_time_between_files_is_refused_naming_it(files, capsys):
     assert main([files.pdb, files.dcd, files.dcd, "--progress", "never"]) == 2
     err, _ = _err_line(capsys)
     assert "between frame 599 (t = 6 ps) and frame 600 (t = 0.01 ps) time goes back by 5.99 ps" in err
+    assert "give it with --dt PS" in err  # a clock that starts again: --dt says the frames follow each other
 
 
 def test_the_classes_name_the_gap_too(files):

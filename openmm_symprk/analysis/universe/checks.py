@@ -103,7 +103,7 @@ def dt_problem(times, dt: float, frame_numbers=None) -> tuple:
     numbers = np.arange(len(t)) if frame_numbers is None else np.asarray(frame_numbers)
     steps = np.diff(t)
     want = dt * np.diff(numbers).astype(np.float64)
-    tol = np.array([_tolerance(w, t) for w in want])
+    tol = np.maximum(TIME_RTOL * np.abs(want), _tolerance(0.0, t))
     forward = steps > 0
     bad = np.flatnonzero(forward & ~(np.abs(steps - want) <= tol))
     restarts = [int(numbers[k + 1]) for k in np.flatnonzero(~forward)]

@@ -178,11 +178,12 @@ def read_waters(universe, select=None, start=None, stop=None, step=None, progres
     interval, irregular = time_steps(times)
     if len(irregular):
         first, stop = longest_piece(frames, irregular)
+        restart = dt is None and bool(np.any(np.diff(times)[irregular] <= 0))
         raise ValueError(f"{describe_steps(times, irregular, frames)}: a time correlation (MSD, reorientation) "
                          f"over them would join what is not joined. Analyse one evenly spaced piece with "
-                         f"--start/--stop (the longest: --start {first} --stop {stop}), or, if the "
-                         f"frames do follow each other at one interval (a file whose clock starts again), give it "
-                         f"with --dt PS")
+                         f"--start/--stop (the longest: --start {first} --stop {stop})"
+                         + (", or, if the frames do follow each other at one interval (a file whose clock starts "
+                            "again), give it with --dt PS" if restart else ""))
     box_from = None
     missing = np.isnan(dims[:, 0])
     if missing.any():
