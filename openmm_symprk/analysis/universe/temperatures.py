@@ -74,10 +74,10 @@ class WholeMolecules:
             far = (np.abs(d) > WHOLE_LIMIT * np.diag(self._box_vectors(box))).any(axis=1)
             if far.any():
                 k = int(np.argmax(far))
-                raise ValueError(f"atom {self._ag[self._loose[k]].index} lies beyond {WHOLE_LIMIT} of a box edge from "
-                                 f"atom {self._ag[self._anchor[k]].index}, the first of {self._label(self._anchor[k])}: "
-                                 f"without bonds the molecule cannot be made whole; give the topology its bonds "
-                                 f"(or guess_bonds=True)")
+                site, first = self._ag[self._loose[k]].index, self._ag[self._anchor[k]].index
+                raise ValueError(f"atom {site} lies beyond {WHOLE_LIMIT} of a box edge from atom {first}, the first "
+                                 f"of {self._label(self._anchor[k])}: without bonds the molecule cannot be made "
+                                 f"whole; give the topology its bonds (or guess_bonds=True)")
             x[self._loose] = x[self._anchor] + d
         return x
 
