@@ -9,11 +9,13 @@ the angular-velocity autocorrelation and the translational and rotational temper
 short, too coarse, no velocities) is printed as missing with the reason.  ``--json FILE`` writes them all.
 
 Refused, in one line, before anything is computed: frames unevenly spaced in time (files of one run with a
-stretch not written between them: analyse one piece with --start/--stop), molecules that are not water in the
-first frame (a topology listing the atoms in another order than the trajectory), positions wrapped into a box
-the file does not store, a --json path that cannot be written, and files MDAnalysis cannot read.  Frames
-without a box take the first frame's, or the topology's (a multi-model PDB's one CRYST1); a format without
-times (PDB, GRO ...) is read as frames 1 ps apart unless --dt gives the interval.
+stretch not written between them: analyse one piece with --start/--stop), a --dt that contradicts the times the
+file stores, a --step that is not a positive integer, molecules that are not water in the first frame (a
+topology listing the atoms in another order than the trajectory), positions wrapped into a box the file does
+not store, a --json path that cannot be written or that names an input file, and files MDAnalysis cannot read.
+Frames without a box take the first frame's, or the topology's (a multi-model PDB's one CRYST1); molecules
+split across the box (atoms wrapped one by one) are made whole.  A format without times (PDB, GRO ...) is read
+as frames 1 ps apart unless --dt gives the interval; --dt also joins files whose clock starts again.
 """
 from __future__ import annotations
 
@@ -78,10 +80,14 @@ def observe(universe, *, window_ps=None, viscosity_mpas=None, temperature_k=None
     def diffusion():
         d = SelfDiffusion(universe, window_ps, viscosity_mpas=viscosity_mpas, temperature_k=temperature_k).run()
         obs["D"] = _pair(d.results.D, d.results.se)
+        if d.results.se_note:
+            notes["D"] = d.results.se_note
         if viscosity_mpas is None:
             notes["D_inf"] = "give --viscosity (mPa s, the model's) and --temperature (K) for the Yeh-Hummer value"
         else:
             obs["D_inf"] = _pair(d.results.D_infinite, d.results.se)
+            if d.results.se_note:
+                notes["D_inf"] = d.results.se_note
 
     def reorientation():
         r = Reorientation(universe).run()
@@ -135,13 +141,13 @@ def observe(universe, *, window_ps=None, viscosity_mpas=None, temperature_k=None
 
 
 def format_table(obs: dict, notes: dict) -> str:
-    """The observables as a text table, the missing ones with their reasons below it."""
+    """The observables as a text table, the missing ones (and missing errors) with their reasons below it."""
     lines = [f"{'observable':40s} {'value':>22s}  unit"]
     for key, what, unit in OBSERVED:
         pair = obs.get(key)
         text = "-" if pair is None else f"{pair[0]:.4g} ± " + ("?" if pair[1] is None else f"{pair[1]:.2g}")
         lines.append(f"{what:40s} {text:>22s}  {unit}")
-    missing = [key for key, _, _ in OBSERVED if obs.get(key) is None and key in notes]
+    missing = [key for key, _, _ in OBSERVED if (obs.get(key) is None or obs[key][1] is None) and key in notes]
     if missing:
         lines.append("")
         labels = dict((key, what) for key, what, _ in OBSERVED)
@@ -157,12 +163,14 @@ def build_parser(prog: str = "symprk observe"):
     ap.add_argument("--select", default=None, help="MDAnalysis selection to look for waters in (default: all)")
     ap.add_argument("--start", type=int, default=None)
     ap.add_argument("--stop", type=int, default=None)
-    ap.add_argument("--step", type=int, default=None)
+    ap.add_argument("--step", type=int, default=None, help="read every STEP-th frame (a positive integer)")
     ap.add_argument("--dt", type=float, default=None, metavar="PS",
                     help="time between the trajectory's frames, ps, for formats that store no times (PDB, GRO, XYZ: "
-                         "read as 1 ps apart otherwise); replaces the file's times")
+                         "read as 1 ps apart otherwise) or files whose clock starts again; refused where it "
+                         "contradicts the times a file stores")
     ap.add_argument("--window", type=float, nargs=2, metavar=("T_MIN", "T_MAX"), default=None,
-                    help="diffusion fit window, ps (default: T/10 to T/2 of the analysed time T)")
+                    help="diffusion fit window, ps (default: T/10 to T/2 of the analysed time T); D's error comes "
+                         "from 5 blocks of the run and needs T_MAX <= T/10")
     ap.add_argument("--viscosity", type=float, default=None, help="the model's shear viscosity, mPa s (Yeh-Hummer)")
     ap.add_argument("--temperature", type=float, default=None, help="temperature, K (Yeh-Hummer)")
     ap.add_argument("--omega-lag", type=float, default=0.5, help="longest lag of the omega ACF, ps (default 0.5)")
@@ -170,6 +178,26 @@ def build_parser(prog: str = "symprk observe"):
     ap.add_argument("--progress", choices=("auto", "always", "never"), default="auto",
                     help=f"progress bar while reading (auto: more than {PROGRESS_FRAMES} frames)")
     return ap
+
+
+def _same_file(a: str, b: str) -> bool:
+    """Whether the paths ``a`` and ``b`` name one existing file (through symlinks and hard links too)."""
+    try:
+        return os.path.samefile(a, b)
+    except OSError:  # one of them does not exist (or cannot be looked at): not the same file
+        return False
+
+
+def _refuse_json_on_inputs(path: str, topology: str, trajectories) -> None:
+    """ValueError when ``--json path`` names a file ``symprk observe`` reads (the topology or a trajectory): writing
+    the observables there would replace the input."""
+    for what, given in [("topology", topology)] + [("trajectory", t) for t in trajectories]:
+        if _same_file(path, given):
+            same = "" if os.path.abspath(path) == os.path.abspath(given) else f" ({given})"
+            stem = os.path.splitext(path)[0]
+            raise ValueError(f"--json {path} is the {what}{same} that symprk observe reads: writing the "
+                             f"observables there would replace it; give another file name (e.g. "
+                             f"{stem}.observe.json)")
 
 
 def _json_target(path: str) -> tuple:
@@ -223,6 +251,8 @@ def run(args):
     if args.dt is not None and not (np.isfinite(args.dt) and args.dt > 0):
         raise ValueError(f"--dt must be a positive number of ps (the time between the trajectory's frames), "
                          f"got {args.dt:g}")
+    if args.json:
+        _refuse_json_on_inputs(args.json, args.topology, args.trajectory)
     target, stream = _json_target(args.json) if args.json else (None, False)
     require("MDAnalysis", "analysis", "symprk observe")
     from .universe.reading import open_universe, read_waters, stored_box
@@ -239,7 +269,7 @@ def run(args):
     when = "" if read.dt_from == "the file's times" else f" ({read.dt_from})"
     print(f"{n_waters} waters, {memory.trajectory.n_frames} frames every {dt:g} ps{when}"
           f"{'' if has_v else ' (positions only: no velocities)'}; errors are standard errors "
-          f"(molecules' scatter, jackknife over molecules, or blocks of frames)")
+          f"(blocks of frames, or jackknife over molecules)")
     if read.box_from:
         print(f"box from {read.box_from}")
     print(format_table(obs, notes))

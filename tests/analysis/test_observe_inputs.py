@@ -95,7 +95,8 @@ def test_a_gap_in_time_between_files_is_refused_naming_it(files, capsys):
     assert main([files.pdb, str(files.a), str(files.b), "--progress", "never"]) == 2
     err, out = _err_line(capsys)
     assert "between frame 99 (t = 0.99 ps) and frame 100 (t = 1.5 ps) 0.51 ps pass where the other frames are " \
-           "0.01 ps apart" in err and "--start 0 --stop 100" in err and "--dt" in err
+           "0.01 ps apart" in err and "--start 0 --stop 100" in err
+    assert "--dt" not in err  # a stretch not written is not joined by --dt (refused there)
     assert out == ""  # refused before anything was computed
     assert main([files.pdb, str(files.a), str(files.b), "--stop", "100", "--progress", "never"]) == 0
     assert "100 frames every 0.01 ps" in capsys.readouterr().out
@@ -103,6 +104,7 @@ def test_a_gap_in_time_between_files_is_refused_naming_it(files, capsys):
     assert main([files.pdb, files.dcd, files.dcd, "--progress", "never"]) == 2
     err, _ = _err_line(capsys)
     assert "between frame 599 (t = 6 ps) and frame 600 (t = 0.01 ps) time goes back by 5.99 ps" in err
+    assert "give it with --dt PS" in err  # a clock that starts again: --dt says the frames follow each other
 
 
 def test_the_classes_name_the_gap_too(files):
@@ -244,3 +246,67 @@ def test_an_unreadable_trajectory_leaves_one_line_on_stderr(content, tmp_path):
     lines = [line for line in run.stderr.splitlines() if line.strip()]
     assert run.returncode == 2 and len(lines) == 1, run.stderr
     assert lines[0].startswith(f"symprk observe: error: MDAnalysis cannot read {datafiles.PRM_NCBOX} with {trr}: ")
+
+
+def test_a_dt_that_contradicts_the_stored_times_is_refused(files, capsys):
+    """Before: --dt replaced the file's times without a word: it joined the 0.5 ps not written between two files
+    (D computed across the gap), and --dt 0.02 on frames 0.01 ps apart halved D and doubled the times.  Now a
+    --dt is checked against the times a file stores; one that agrees is taken, one that contradicts them is
+    refused naming both."""
+    assert main([files.pdb, str(files.a), str(files.b), "--dt", "0.01", "--progress", "never"]) == 2
+    err, out = _err_line(capsys)
+    assert ("--dt 0.01 contradicts the times the file stores: between frame 99 (t = 0.99 ps) and frame 100 "
+            "(t = 1.5 ps) 0.51 ps pass, where --dt puts 0.01 ps: --dt cannot join a stretch of the run that was not "
+            "written; analyse one evenly spaced piece with --start/--stop (the longest: --start 0 --stop 100)") in err
+    assert out == ""
+    assert main([files.pdb, str(files.a), "--dt", "0.02", "--progress", "never"]) == 2
+    err, out = _err_line(capsys)
+    assert ("--dt 0.02 contradicts the times the file stores: between frame 0 (t = 0 ps) and frame 1 (t = 0.01 ps) "
+            "0.01 ps pass, where --dt puts 0.02 ps (99 of the 99 steps so): the file's frames are 0.01 ps apart; "
+            "drop --dt") in err and out == ""
+    # with --step the stored steps span several frames: --dt is still the interval between the file's frames
+    assert main([files.pdb, str(files.a), "--dt", "0.02", "--step", "2"]) == 2
+    assert "between frame 0 (t = 0 ps) and frame 2 (t = 0.02 ps) 0.02 ps pass, where --dt puts 0.04 ps" in \
+        _err_line(capsys)[0]
+    # a --dt that agrees with the stored times is taken
+    assert main([files.pdb, str(files.a), "--dt", "0.01", "--step", "2", "--progress", "never"]) == 0
+    assert "50 frames every 0.02 ps (--dt)" in capsys.readouterr().out
+
+
+def test_dt_joins_files_whose_clock_starts_again_and_says_so(files, capsys):
+    """The DCD twice: the second file's clock starts again (t = 6 ps, then 0.01 ps).  Without --dt that is
+    refused (time goes back); --dt 0.01 says the frames follow each other, which the header repeats."""
+    argv = [files.pdb, files.dcd, files.dcd, "--start", "550", "--stop", "650", "--progress", "never"]
+    assert main(argv) == 2
+    assert "time goes back by 5.99 ps" in _err_line(capsys)[0]
+    assert main(argv + ["--dt", "0.01"]) == 0
+    assert "100 frames every 0.01 ps (--dt; the file's clock starts again at frame 600)" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("step", ["-1", "0"])
+def test_a_step_that_is_not_a_positive_integer_is_refused_by_name(files, step, capsys):
+    """Before: --step -1 read the frames backwards and was refused as frames '... nan ps apart'."""
+    assert main([files.pdb, files.dcd, "--step", step]) == 2
+    err, out = _err_line(capsys)
+    assert err.endswith(f"--step must be a positive integer (read every step-th frame: 1 reads them all), got {step}")
+    assert out == ""
+
+
+@pytest.mark.parametrize("which", ["trajectory", "topology", "a link to the topology"])
+def test_json_naming_an_input_file_is_refused_and_the_file_kept(files, which, tmp_path, capsys):
+    """Before: --json naming the trajectory (or the topology) replaced it with the JSON, exit 0."""
+    pdb, dcd = tmp_path / "water.pdb", tmp_path / "water.dcd"
+    pdb.write_bytes(open(files.pdb, "rb").read())
+    dcd.write_bytes(open(files.dcd, "rb").read())
+    before = {p: p.read_bytes() for p in (pdb, dcd)}
+    target = {"trajectory": dcd, "topology": pdb, "a link to the topology": tmp_path / "obs.json"}[which]
+    if which.startswith("a link"):
+        target.symlink_to(pdb)
+    assert main([str(pdb), str(dcd), "--stop", "20", "--json", str(target)]) == 2
+    err, out = _err_line(capsys)
+    what = "trajectory" if which == "trajectory" else "topology"
+    assert f"--json {target} is the {what}" in err and "that symprk observe reads" in err and out == ""
+    assert "give another file name (e.g. " in err
+    if which.startswith("a link"):
+        assert f"({pdb})" in err
+    assert {p: p.read_bytes() for p in (pdb, dcd)} == before

@@ -5,6 +5,8 @@ saying what it found (None when the frames pass), for the caller to raise with i
 * :func:`time_steps` - frames evenly spaced in time, or where they are not (files of one run with a stretch not
   written between them, a file whose clock starts again): a time correlation over them would join what is not
   joined;
+* :func:`dt_problem` - an interval given for the frames (``symprk observe --dt``) agrees with the times the file
+  stores: a gap or another interval is not joined or rescaled without a word;
 * :func:`geometry_problem` - the molecules found in the topology are water in the frame: O-H and H-H distances
   in :data:`OH_RANGE` and :data:`HH_RANGE` (a topology listing the atoms in another order than the trajectory
   takes an H for the O);
@@ -17,7 +19,7 @@ from __future__ import annotations
 import numpy as np
 
 __all__ = ["TIME_RTOL", "OH_RANGE", "HH_RANGE", "SPLIT_LIMIT", "JUMP_FRACTION", "MIN_JUMP", "time_steps",
-           "describe_steps", "geometry_problem", "wrapped_problem"]
+           "describe_steps", "longest_piece", "dt_problem", "geometry_problem", "wrapped_problem"]
 
 #: Relative spread of the time steps accepted as one interval (beyond float32's rounding of the times).
 TIME_RTOL = 1e-3
@@ -34,6 +36,19 @@ JUMP_FRACTION = 0.8
 MIN_JUMP = 5.0
 
 
+def _tolerance(step: float, times) -> float:
+    """How far a time step may differ from ``step`` (ps) and still be that step: :data:`TIME_RTOL` of it, or the
+    float32 rounding of the ``times`` (as XTC stores them), whichever is larger."""
+    return max(TIME_RTOL * abs(step), 4.0 * float(np.spacing(np.float32(np.abs(times).max()))))
+
+
+def _fixed(usual: float):
+    """A formatter of times to one decimal place beyond the first digit of ``usual`` (ps): 100002.9, not 100003
+    or 100002.8984."""
+    places = 1 + max(0, -int(np.floor(np.log10(abs(usual))))) if np.isfinite(usual) and usual != 0 else 3
+    return lambda value: f"{value:.{places}f}".rstrip("0").rstrip(".")
+
+
 def time_steps(times) -> tuple:
     """(dt, irregular): the interval between the frames at ``times`` (ps; the mean step) and the indices k whose
     step times[k + 1] - times[k] differs from the median step by more than :data:`TIME_RTOL` of it (or than the
@@ -43,7 +58,7 @@ def time_steps(times) -> tuple:
         return float("nan"), np.zeros(0, dtype=int)
     steps = np.diff(t)
     median = float(np.median(steps))
-    tol = max(TIME_RTOL * abs(median), 4.0 * float(np.spacing(np.float32(np.abs(t).max()))))
+    tol = _tolerance(median, t)
     irregular = np.flatnonzero(~(np.abs(steps - median) <= tol)) if median > 0 else np.arange(len(steps))
     return float((t[-1] - t[0]) / (len(t) - 1)) if median > 0 else median, irregular
 
@@ -57,15 +72,56 @@ def describe_steps(times, irregular, frame_numbers=None) -> str:
     step = t[k + 1] - t[k]
     regular = np.delete(np.diff(t), irregular)
     usual = float(regular.mean()) if len(regular) else float("nan")
-    # to one decimal place beyond the usual step's first digit: 100002.9, not 100003 or 100002.8984
-    places = 1 + max(0, -int(np.floor(np.log10(abs(usual))))) if np.isfinite(usual) and usual != 0 else 3
-    fixed = (lambda value: f"{value:.{places}f}".rstrip("0").rstrip("."))
+    fixed = _fixed(usual)
     what = (f"time goes back by {fixed(-step)} ps" if step < 0 else "no time passes" if step == 0 else
             f"{fixed(step)} ps pass")
     more = f" ({len(irregular)} such steps)" if len(irregular) > 1 else ""
     return (f"the frames are not evenly spaced in time: between frame {numbers[k]} (t = {fixed(t[k])} ps) and "
             f"frame {numbers[k + 1]} (t = {fixed(t[k + 1])} ps) {what} where the other frames are {fixed(usual)} ps "
             f"apart{more}")
+
+
+def longest_piece(frame_numbers, breaks) -> tuple:
+    """(first, stop) frame numbers (``--start``/``--stop``) of the longest run of ``frame_numbers`` not cut by
+    ``breaks`` (the indices k of the steps between frame k and k + 1 that cut it)."""
+    pieces = np.split(np.asarray(frame_numbers), np.asarray(breaks, dtype=int) + 1)
+    longest = max(pieces, key=len)
+    return int(longest[0]), int(longest[-1]) + 1
+
+
+def dt_problem(times, dt: float, frame_numbers=None) -> tuple:
+    """(problem, restarts) for an interval ``dt`` (ps between consecutive frames of the file) given for frames
+    whose file stores ``times`` (ps; ``frame_numbers``: the frames' numbers in the file, default 0, 1, ...).
+
+    Every step of the stored times must be ``dt`` times the frames it spans (within :data:`TIME_RTOL` and the
+    float32 rounding of the times) or go back or stand still (a clock that starts again, as in files of one run
+    each starting at t = 0: whether they follow each other only the user knows, and ``dt`` says they do).  A step
+    forward by anything else contradicts ``dt``: a stretch of the run not written (``dt`` would join it) or
+    another interval (``dt`` would rescale every time).  ``problem`` is None or a sentence naming the first such
+    step, how many there are and what to do; ``restarts`` lists the frame numbers where the clock starts again."""
+    t = np.asarray(times, dtype=np.float64)
+    numbers = np.arange(len(t)) if frame_numbers is None else np.asarray(frame_numbers)
+    steps = np.diff(t)
+    want = dt * np.diff(numbers).astype(np.float64)
+    tol = np.maximum(TIME_RTOL * np.abs(want), _tolerance(0.0, t))
+    forward = steps > 0
+    bad = np.flatnonzero(forward & ~(np.abs(steps - want) <= tol))
+    restarts = [int(numbers[k + 1]) for k in np.flatnonzero(~forward)]
+    if not len(bad):
+        return None, restarts
+    k = int(bad[0])
+    fixed = _fixed(min(float(want[k]), float(steps[k])))
+    more = f" ({len(bad)} of the {len(steps)} steps so)" if len(bad) > 1 else ""
+    found = (f"--dt {dt:g} contradicts the times the file stores: between frame {numbers[k]} (t = {fixed(t[k])} ps) "
+             f"and frame {numbers[k + 1]} (t = {fixed(t[k + 1])} ps) {fixed(steps[k])} ps pass, where --dt puts "
+             f"{fixed(want[k])} ps{more}")
+    if len(bad) == int(forward.sum()):  # every step forward disagrees: the file has another interval
+        stored = float(np.median(steps[forward] / np.diff(numbers)[forward]))
+        return (f"{found}: the file's frames are {fixed(stored)} ps apart; drop --dt to use the file's times "
+                f"(--dt is for files that store none, or whose clock starts again)"), restarts
+    first, stop = longest_piece(numbers, bad)
+    return (f"{found}: --dt cannot join a stretch of the run that was not written; analyse one evenly spaced piece "
+            f"with --start/--stop (the longest: --start {first} --stop {stop})"), restarts
 
 
 def _whole(x, molecules, box):

@@ -13,7 +13,7 @@ import numpy as np
 
 from ...support import require
 from .base import find_waters
-from .checks import describe_steps, geometry_problem, time_steps, wrapped_problem
+from .checks import describe_steps, dt_problem, geometry_problem, longest_piece, time_steps, wrapped_problem
 
 __all__ = ["WaterTrajectory", "read_waters", "open_universe", "stored_box"]
 
@@ -23,9 +23,9 @@ _NO_TIMES = "Reader has no dt information"  # MDAnalysis' warning for a format w
 @dataclass
 class WaterTrajectory:
     """The waters read into memory: ``universe`` (an in-memory Universe of them), ``has_velocities``, ``dt``
-    (ps between its frames), ``dt_from`` (where dt came from: "the file's times", "--dt", or a note that the
-    file stores none), ``box_from`` (None: each frame's own; else where the box of frames without one came
-    from)."""
+    (ps between its frames), ``dt_from`` (where dt came from: "the file's times", "--dt" (with the frames where
+    the file's clock starts again, if it does), or a note that the file stores none), ``box_from`` (None: each
+    frame's own; else where the box of frames without one came from)."""
 
     universe: object
     has_velocities: bool
@@ -107,33 +107,32 @@ def stored_box(topology: str, trajectories):
     return np.asarray(cell, dtype=np.float64), f"the topology {os.path.basename(topology)}"
 
 
-def _frame_times(trajectory, frames, dt):
-    """(times of ``frames``, where they came from)."""
-    numbers = np.asarray(frames, dtype=np.float64)
-    if dt is not None:
-        return numbers * dt, "--dt"
+def _stores_times(trajectory, frame) -> bool:
+    """Whether the trajectory's format stores times (MDAnalysis warns when it does not, and counts 1 ps)."""
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        trajectory[frames[0]].time  # noqa: B018 - read for the warning of a format without times
-    if any(_NO_TIMES in str(w.message) for w in caught):
-        return numbers * 1.0, "no times in the file: taken 1 ps apart; give the interval with --dt PS"
-    return None, "the file's times"
+        trajectory[frame].time  # noqa: B018 - read for the warning of a format without times
+    return not any(_NO_TIMES in str(w.message) for w in caught)
 
 
 def read_waters(universe, select=None, start=None, stop=None, step=None, progress: bool | int = 200, dt=None,
                 fallback_box=None) -> WaterTrajectory:
     """The waters of ``universe`` (``select``: an MDAnalysis selection to look in) at frames ``start:stop:step``,
-    read into memory and checked (:class:`WaterTrajectory`).  ``dt``: the interval between the trajectory's
-    frames (ps), replacing the file's times; ``fallback_box``: a callable giving (box, where) for frames that
-    store no box (:func:`stored_box`); ``progress``: show a tqdm bar (True, False, or beyond that many
-    frames).  ValueError, saying what to do, for frames unevenly spaced in time, molecules
-    that are not water in the first frame, or positions wrapped into a box the file does not store."""
+    read into memory and checked (:class:`WaterTrajectory`).  ``step``: a positive integer; ``dt``: the
+    interval between the trajectory's frames (ps) for a file that stores no times, or whose clock starts again;
+    it must agree with the times a file stores (:func:`~.checks.dt_problem`); ``fallback_box``: a callable giving
+    (box, where) for frames that store no box (:func:`stored_box`); ``progress``: show a tqdm bar (True, False,
+    or beyond that many frames).  ValueError, saying what to do, for a ``step`` or ``dt`` out of range, a ``dt``
+    that contradicts the stored times, frames unevenly spaced in time, molecules that are not water in the first
+    frame, or positions wrapped into a box the file does not store."""
     mda = require("MDAnalysis", "analysis", "symprk observe")
     MemoryReader = require("MDAnalysis.coordinates.memory", "analysis", "symprk observe").MemoryReader
     tqdm = require("tqdm", "analysis", "symprk observe's progress bar").tqdm
 
     if dt is not None and not (np.isfinite(dt) and dt > 0):
         raise ValueError(f"--dt must be a positive number of ps (the time between the trajectory's frames), got {dt}")
+    if step is not None and (isinstance(step, bool) or int(step) != step or step < 1):
+        raise ValueError(f"--step must be a positive integer (read every step-th frame: 1 reads them all), got {step}")
     group = universe.select_atoms(select) if select else universe.atoms
     if select and group.n_atoms == 0:
         raise ValueError(f"the selection {select!r} matches no atom")
@@ -141,7 +140,7 @@ def read_waters(universe, select=None, start=None, stop=None, step=None, progres
     frames = range(*slice(start, stop, step).indices(universe.trajectory.n_frames))
     if len(frames) < 2:
         raise ValueError(f"{len(frames)} frame(s) selected: the observables need at least 2")
-    times, dt_from = _frame_times(universe.trajectory, frames, dt)
+    stores_times = _stores_times(universe.trajectory, frames[0])
     n = waters.atoms.n_atoms
     x = np.empty((len(frames), n, 3), dtype=np.float32)
     v = np.empty_like(x) if universe.trajectory.ts.has_velocities else None
@@ -159,19 +158,32 @@ def read_waters(universe, select=None, start=None, stop=None, step=None, progres
                 v[k] = waters.atoms.velocities
         if ts.dimensions is not None and np.all(np.asarray(ts.dimensions[:3]) > 0):
             dims[k] = ts.dimensions
-        if times is None:
+        if stores_times:
             read_times[k] = ts.time
-    if times is None:
-        times = read_times
+    numbers = np.asarray(frames, dtype=np.float64)
+    if dt is not None:
+        dt_from = "--dt"
+        if stores_times:
+            problem, restarts = dt_problem(read_times, dt, frames)
+            if problem is not None:
+                raise ValueError(problem)
+            if restarts:
+                dt_from += (f"; the file's clock starts again at frame{'s' if len(restarts) > 1 else ''} "
+                            f"{', '.join(str(f) for f in restarts[:5])}{' ...' if len(restarts) > 5 else ''}")
+        times = numbers * dt
+    elif stores_times:
+        times, dt_from = read_times, "the file's times"
+    else:
+        times, dt_from = numbers * 1.0, "no times in the file: taken 1 ps apart; give the interval with --dt PS"
     interval, irregular = time_steps(times)
     if len(irregular):
-        pieces = np.split(np.asarray(frames), irregular + 1)
-        longest = max(pieces, key=len)
+        first, stop = longest_piece(frames, irregular)
+        restart = dt is None and bool(np.any(np.diff(times)[irregular] <= 0))
         raise ValueError(f"{describe_steps(times, irregular, frames)}: a time correlation (MSD, reorientation) "
                          f"over them would join what is not joined. Analyse one evenly spaced piece with "
-                         f"--start/--stop (the longest: --start {longest[0]} --stop {longest[-1] + 1}), or, if the "
-                         f"frames do follow each other at one interval (a file whose clock starts again), give it "
-                         f"with --dt PS")
+                         f"--start/--stop (the longest: --start {first} --stop {stop})"
+                         + (", or, if the frames do follow each other at one interval (a file whose clock starts "
+                            "again), give it with --dt PS" if restart else ""))
     box_from = None
     missing = np.isnan(dims[:, 0])
     if missing.any():
