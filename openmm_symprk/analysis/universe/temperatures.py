@@ -8,6 +8,7 @@ from ...conservation.analysis import group_masses, subgroups
 from ...physics.temperature import kinetic_temperatures
 from ...stats import block_stats, series_stats
 from .base import ANGSTROM_IN_NM, AnalysisBase, refuse_unknown_keywords
+from ...support.errors import InputError
 
 __all__ = ["KineticTemperatures"]
 
@@ -41,14 +42,14 @@ class KineticTemperatures(AnalysisBase):
         self._ag = atomgroup
         self._m = group_masses(atomgroup, masses)
         if by not in ("residues", "fragments", "segments"):
-            raise ValueError(f"by must be 'residues', 'fragments' or 'segments', got {by!r}")
+            raise InputError(f"by must be 'residues', 'fragments' or 'segments', got {by!r}")
         self._sub = [list(g) for g in subgroups(atomgroup, by)]
         self._fixed = momentum_fixed
         if constraints is None and hasattr(masses, "getNumConstraints"):
             constraints = masses.getNumConstraints()
         self._constraints = constraints or 0
         if n_blocks is not None and (int(n_blocks) != n_blocks or n_blocks < 2):
-            raise ValueError(f"n_blocks must be an integer >= 2 or None, got {n_blocks!r}")
+            raise InputError(f"n_blocks must be an integer >= 2 or None, got {n_blocks!r}")
         self._n_blocks = n_blocks
 
     def _prepare(self):
@@ -57,7 +58,7 @@ class KineticTemperatures(AnalysisBase):
 
     def _single_frame(self):
         if not self._ts.has_velocities:
-            raise ValueError(f"KineticTemperatures needs velocities and frame {self._ts.frame} of the trajectory "
+            raise InputError(f"KineticTemperatures needs velocities and frame {self._ts.frame} of the trajectory "
                              f"has none (DCD, XTC and PDB store positions only: use a TRR, NetCDF or H5MD "
                              f"trajectory written with velocities)")
         x = self._ag.positions.astype(np.float64) * ANGSTROM_IN_NM

@@ -35,9 +35,10 @@ from .records import RunRecord
 from ..core.rows import Row
 from .runs import RunSpec, bench_row, label
 from .store import Store, legacy_key, run_key
+from ...support.errors import InputError, SymprkError
 
 
-class SweepExistsError(FileExistsError):
+class SweepExistsError(SymprkError, FileExistsError):
     """The output folder already holds finished runs and resume was not asked for."""
 
 
@@ -202,7 +203,7 @@ def retime_sweep(config: dict, out: str, rounds: int = 3, workers: int = 1, char
     from .runs import retime
 
     if not os.path.isdir(os.path.join(out, "runs")) or not len(Store(out)):
-        raise ValueError(f"{out} holds no finished runs to time again: run the sweep first")
+        raise InputError(f"{out} holds no finished runs to time again: run the sweep first")
     lock = FolderLock(out, "symprk bench", SweepLockedError)
     try:
         store = Store(out)

@@ -19,7 +19,7 @@ from __future__ import annotations
 import os
 from dataclasses import dataclass, field
 
-from ...support import MissingDependencyError, require
+from ...support import InputError, MissingDependencyError, require
 from .executors import make_executor
 from .folders import FolderLock
 from .jobs import Job, run_jobs, single
@@ -56,7 +56,7 @@ class Study:
     def __init__(self, out: str, workers: int = 1, scheduler: str | None = None, progress: bool = True,
                  log=print):
         if int(workers) < 1:
-            raise ValueError(f"workers must be >= 1, got {workers!r}")
+            raise InputError(f"workers must be >= 1, got {workers!r}")
         self.out, self.workers, self.scheduler, self.progress, self.log = out, int(workers), scheduler, progress, log
         self.store: RunStore | None = None
 
@@ -91,11 +91,11 @@ class Study:
         if report_only:
             self.store = RunStore(self.out, create=False)
             if not len(self.store):
-                raise ValueError(f"no finished runs in {self.out}: run the study without --report-only first")
+                raise InputError(f"no finished runs in {self.out}: run the study without --report-only first")
             runs = self._adopt(self.plan())
             missing = sum(r.key not in self.store for r in runs)
             if missing == len(runs):
-                raise ValueError(f"none of the {len(runs)} planned runs is stored in {self.out} (other settings?)")
+                raise InputError(f"none of the {len(runs)} planned runs is stored in {self.out} (other settings?)")
             if missing:
                 self.log(f"report only: {missing} of {len(runs)} planned runs are not finished and are left out")
             return self.summarise(runs)

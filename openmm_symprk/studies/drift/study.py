@@ -15,6 +15,7 @@ from ..core import Run, Study, platforms, run_key as row_run_key, write_json, wr
 from ..core.options import check_settings
 from ..core.replicas import scene_replicas, scene_state_key
 from .runs import row_of
+from ...support.errors import InputError
 
 __all__ = ["DriftStudy", "run_study", "run_key", "check"]
 
@@ -57,21 +58,21 @@ def check(cfg: dict):
 
     check_settings(cfg, ("replicas",), ("length_ps", "sample_ps", "temperature", "constraint_tolerance"))
     if float(cfg["decorrelate_ps"]) < 0:
-        raise ValueError(f"decorrelate_ps must be >= 0, got {cfg['decorrelate_ps']!r}")
+        raise InputError(f"decorrelate_ps must be >= 0, got {cfg['decorrelate_ps']!r}")
     names = [r["name"] for r in cfg["rows"]]
     if len(set(names)) != len(names):
-        raise ValueError(f"row names must be unique, got {names}")
+        raise InputError(f"row names must be unique, got {names}")
     for row in cfg["rows"]:
         if row["scene"] not in SCENES:
-            raise ValueError(f"row {row['name']}: unknown scene {row['scene']!r}; known: {', '.join(SCENES)}")
+            raise InputError(f"row {row['name']}: unknown scene {row['scene']!r}; known: {', '.join(SCENES)}")
         step = row_of(row).step_fs  # ValueError naming the catalogue and OpenMM's integrators
         n = float(cfg["length_ps"]) * 1e3 / step
         if round(n) < 3:
-            raise ValueError(f"row {row['name']}: {cfg['length_ps']} ps is under 3 steps of {step:g} fs")
+            raise InputError(f"row {row['name']}: {cfg['length_ps']} ps is under 3 steps of {step:g} fs")
     for c in cfg["comparisons"]:
         for k in ("row", "ref"):
             if c[k] not in names:
-                raise ValueError(f"comparison {c}: no row named {c[k]!r} (rows: {', '.join(names)})")
+                raise InputError(f"comparison {c}: no row named {c[k]!r} (rows: {', '.join(names)})")
 
 
 _systems: dict = {}

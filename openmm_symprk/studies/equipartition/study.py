@@ -20,6 +20,7 @@ from ..core.replicas import BOX_STATE_KEYS, water_box_replicas, water_box_scene
 from ..core.rows import Row
 from ..core.timing import seconds_per_ps
 from .report import summarise
+from ...support.errors import InputError
 
 __all__ = ["run_study", "run_key", "load_runs", "EquipartitionStudy"]
 
@@ -80,7 +81,7 @@ def _check(cfg):
         for row in rows:
             row.require_kick_drift(f"{model}: rigid water (constraints, or the rigid-body engine)")
         if Row.parse(cfg["reference"]) not in rows:
-            raise ValueError(f"{model}: the reference row {cfg['reference']!r} is not among its rows")
+            raise InputError(f"{model}: the reference row {cfg['reference']!r} is not among its rows")
 
 
 class EquipartitionStudy(Study):

@@ -7,6 +7,7 @@ import argparse
 
 from ..core.options import add_study_arguments, run_study
 from . import presets
+from ...support.errors import InputError
 
 
 def build_parser(prog: str = "symprk fidelity"):
@@ -47,7 +48,7 @@ def select_rows(cfg: dict, text: str) -> list:
             named.append(w)
     unknown = [w for w, lab in zip(wanted, named) if lab not in labels]
     if unknown:
-        raise ValueError(f"unknown row(s) {', '.join(repr(u) for u in unknown)}; the rows are: {'; '.join(labels)}")
+        raise InputError(f"unknown row(s) {', '.join(repr(u) for u in unknown)}; the rows are: {'; '.join(labels)}")
     keep = set(named) | {label(r) for r in (cfg.get("references") or {}).values()} | {labels[0]}
     return [r for r, lab in zip(cfg["rows"], labels) if lab in keep]
 

@@ -20,6 +20,7 @@ from ...core import Run, Study, run_key as row_run_key, write_json, write_text
 from ...core.options import check_settings
 from ...core.replicas import BOX_STATE_KEYS, BOX_STATE_VERSION, water_box_replicas, water_box_scene
 from ..rowspec import check_row, label, to_row
+from ....support.errors import InputError
 
 __all__ = ["FidelityStudy", "run_study", "run_key", "temperature_view", "RUN_KEYS", "RUN_VERSION"]
 
@@ -50,16 +51,16 @@ def references(cfg: dict, rows: list) -> dict:
     out = {}
     for ens, lab in given.items():
         if ens not in ("NVE", "NVT"):
-            raise ValueError(f"references: ensemble {ens!r}; known: NVE, NVT")
+            raise InputError(f"references: ensemble {ens!r}; known: NVE, NVT")
         lab = check_row(lab)
         if lab not in rows:
-            raise ValueError(f"the {ens} reference {lab!r} is not among the rows")
+            raise InputError(f"the {ens} reference {lab!r} is not among the rows")
         r = to_row(lab)
         if r.ensemble != ens or not r.is_ours or r.hmr_da is not None or r.mts:
-            raise ValueError(f"the {ens} reference must be an {ens} row of this package without HMR or MTS, got {lab!r}")
+            raise InputError(f"the {ens} reference must be an {ens} row of this package without HMR or MTS, got {lab!r}")
         out[ens] = lab
     if "NVE" not in out:
-        raise ValueError("references: an NVE reference is needed")
+        raise InputError("references: an NVE reference is needed")
     return out
 
 
@@ -76,17 +77,17 @@ def check(cfg: dict) -> list:
     check_settings(cfg, ("replicas", "n_waters", "rdf_every"),
                    ("length_ps", "sample_fs", "omega_ps", "omega_fs", "equilibrate_ps", "cutoff_nm", "temperature"))
     if float(cfg["omega_fs"]) > 4.0:
-        raise ValueError(f"omega_fs must be <= 4 fs (the angular-velocity correlation falls to zero within "
+        raise InputError(f"omega_fs must be <= 4 fs (the angular-velocity correlation falls to zero within "
                          f"~20 fs), got {cfg['omega_fs']}")
     if cfg.get("model", "spce") not in ("spce", "tip3p"):
-        raise ValueError(f"model {cfg.get('model')!r}; known: spce, tip3p")
+        raise InputError(f"model {cfg.get('model')!r}; known: spce, tip3p")
     rows = [check_row(r) for r in cfg["rows"]]
     if not rows:
-        raise ValueError("no rows")
+        raise InputError("no rows")
     references(cfg, rows)
     dup = sorted({x for x in rows if rows.count(x) > 1})
     if dup:
-        raise ValueError(f"rows given twice: {', '.join(dup)}")
+        raise InputError(f"rows given twice: {', '.join(dup)}")
     return rows
 
 
@@ -236,11 +237,11 @@ def run_study(cfg: dict, out: str, workers: int = 2, timing: bool = True, progre
     and writes ``summary.txt``, ``equipartition.txt`` (:func:`temperature_view`), ``results.json``, ``fidelity.png`` (bias against force evaluations per ps) and,
     with timing, ``fidelity-wall.png`` (against wall time per simulated ps) there."""
     if cfg.get("frozen") and not report_only:
-        raise ValueError(f"the {cfg['frozen']} study is kept as it ran (its runs are of version "
+        raise InputError(f"the {cfg['frozen']} study is kept as it ran (its runs are of version "
                          f"{cfg.get('run_version')}, made by earlier code): remake its report with --report-only; new "
                          f"measurements run with --preset frontier")
     if int(cfg.get("run_version", RUN_VERSION)) != RUN_VERSION and not report_only:
-        raise ValueError(f"runs of version {cfg.get('run_version')} cannot be made any more (this code makes version "
+        raise InputError(f"runs of version {cfg.get('run_version')} cannot be made any more (this code makes version "
                          f"{RUN_VERSION}): use --report-only")
     study = FidelityStudy(cfg, out, workers, timing, progress, log, scheduler)
     study.report_only = bool(report_only)
