@@ -14,7 +14,7 @@ from openmm_symprk.cli import main as symprk
 from openmm_symprk.studies.fidelity.observables import OBSERVABLES
 from openmm_symprk.studies.fidelity.report import K_SE, summarise
 from openmm_symprk.studies.fidelity.rowspec import check_row, describe, label
-from openmm_symprk.studies.fidelity.simulation import run_key, run_study
+from openmm_symprk.studies.fidelity.simulation import run_of, run_study
 
 
 def main(argv):
@@ -245,6 +245,10 @@ def test_a_published_effect_is_claimed_only_beyond_three_standard_errors():
 
 
 # -- settings -------------------------------------------------------------------------------------------------------
+def run_key(cfg, row, replica):
+    return run_of(cfg, row, replica).key
+
+
 def test_run_keys_follow_every_setting_and_are_pinned():
     cfg = presets.full()
     row = "omelyan-2 4 fs"

@@ -84,8 +84,7 @@ class RunSpec:
         return asdict(self)
 
     def record_fields(self) -> dict:
-        """The record's fields of the run (a row as the bench's name and its step): what a key hashed before runs
-        were keyed by their rows' labels."""
+        """The record's fields of the run: the spec with its row as the bench's name, its step and its seed."""
         row = self.spec_row
         out = {k: v for k, v in asdict(self).items() if k != "row"}
         return dict(out, method=bench_name(row), step_fs=row.step_fs, seed=row.seed)

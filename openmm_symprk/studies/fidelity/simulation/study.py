@@ -6,7 +6,7 @@
 
 ``<out>/states/<model>-<key>.npz`` holds the replica states (:func:`~...core.replicas.water_box_replicas`: the same
 file, key and states as ``symprk equipartition`` makes for the same box and equilibration settings),
-``<out>/runs/<key>.json`` (+ .npz) one finished run each; a key (:func:`~...core.store.run_key`) hashes everything a
+``<out>/runs/<key>.json`` (+ .npz) one finished run each; a key (:attr:`~...core.study.Run.key`) hashes everything a
 run depends on (box, states, row label, replica, lengths, the observables' settings), so a second call reuses every
 finished run and a changed setting never reuses a stale one.
 """
@@ -16,13 +16,13 @@ import os
 import warnings
 
 from ....systems.checks import ConservationWarning
-from ...core import Run, Study, run_key as row_run_key, write_json, write_text
+from ...core import Run, Study, write_json, write_text
 from ...core.options import check_settings
 from ...core.replicas import BOX_STATE_KEYS, BOX_STATE_VERSION, water_box_replicas, water_box_scene
 from ..rowspec import check_row, label, to_row
 from ....support.errors import InputError
 
-__all__ = ["FidelityStudy", "run_study", "run_key", "temperature_view", "RUN_KEYS", "RUN_VERSION"]
+__all__ = ["FidelityStudy", "run_study", "run_of", "temperature_view", "RUN_KEYS", "RUN_VERSION"]
 
 #: What a run depends on besides its row and replica (the observables are computed in the run: their settings too).
 RUN_KEYS = BOX_STATE_KEYS + ("model", "settle_ps", "omega_ps", "omega_fs", "omega_max_lag_ps", "length_ps",
@@ -38,10 +38,13 @@ RUN_VERSION = 3
 TIMINGS = "timings.json"
 
 
-def run_key(cfg: dict, row, replica: int) -> str:
+def run_of(cfg: dict, row, replica: int, cost: float = 1.0) -> Run:
+    """The run of ``row`` (a label) from ``replica``: keyed by the row, the replica, the settings of
+    :data:`RUN_KEYS` (and the equilibrator, where the config names one), the states' and the runs' versions."""
+    lab = check_row(row)
     keys = RUN_KEYS + (("equilibrator",) if "equilibrator" in cfg else ())
-    return row_run_key(check_row(row), replica, {k: cfg[k] for k in keys}, states=BOX_STATE_VERSION,
-                       version=int(cfg.get("run_version", RUN_VERSION)))
+    return Run(lab, replica, {k: cfg[k] for k in keys}, "box", (lab, replica), {"row": lab, "replica": replica}, cost,
+               context={"states": BOX_STATE_VERSION, "version": int(cfg.get("run_version", RUN_VERSION))})
 
 
 def references(cfg: dict, rows: list) -> dict:
@@ -116,8 +119,7 @@ class FidelityStudy(Study):
         runs = []
         for row in map(to_row, self.rows):
             cost = row.evals_per_ps(True) * (cfg["settle_ps"] + cfg["omega_ps"] + cfg["length_ps"])
-            runs += [Run(run_key(cfg, row.label, r), "box", (row.label, r), {"row": row.label, "replica": r}, cost)
-                     for r in range(int(cfg["replicas"]))]
+            runs += [run_of(cfg, row.label, r, cost) for r in range(int(cfg["replicas"]))]
         return runs
 
     def shared(self, runs) -> dict:
