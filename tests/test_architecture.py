@@ -4,11 +4,11 @@ never import the studies, and no ``--help`` names an issue of the project."""
 import argparse
 import ast
 import os
-import re
 import subprocess
 import sys
 
 import pytest
+from helpers import ISSUE_NUMBER
 
 import openmm_symprk
 
@@ -218,11 +218,6 @@ def test_the_library_tests_do_not_import_the_studies():
     assert _study_imports(ast.parse("from openmm_symprk.studies.nvt.known import run\nfrom openmm_symprk import studies"
                                     "\nimportlib.import_module('openmm_symprk.studies.bench')")) == \
         [(1, "openmm_symprk.studies.nvt.known"), (2, "openmm_symprk.studies"), (3, "openmm_symprk.studies.bench")]
-
-
-#: An issue number of the project ("issue 26", "issues 33 and 36", "--preset issue26"): the history of the project,
-#: which a user does not know.
-ISSUE_NUMBER = re.compile(r"\bissues?[\s#_-]*\d", re.I)
 
 
 def _parsers() -> list:
