@@ -123,7 +123,8 @@ class Study:
     def run(self, report_only: bool = False):
         """Run what is missing and return :meth:`summarise` of every planned run.  ``report_only``: run nothing and
         summarise the planned runs already stored (a study still running in another process, or rows given
-        fewer replicas than the others); the folder is not locked, and ValueError says when nothing is stored."""
+        fewer replicas than the others; a plan of runs, not jobs); the folder is not locked, and ValueError says
+        when nothing is stored."""
         if report_only:
             self.store = self.open_store(create=False)
             if not len(self.store):
