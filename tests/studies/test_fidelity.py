@@ -557,7 +557,7 @@ def test_the_issue_26_study_is_kept_as_it_ran(tmp_path):
     from openmm_symprk.studies.fidelity import presets
     from openmm_symprk.studies.fidelity.simulation import run_study
 
-    with pytest.raises(ValueError, match="issue 26 study is kept as it ran.*--report-only.*--preset frontier"):
+    with pytest.raises(ValueError, match="match-3se study is kept as it ran.*--report-only.*--preset frontier"):
         run_study(presets.full(), str(tmp_path))
 
 
