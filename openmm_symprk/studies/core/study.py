@@ -154,7 +154,8 @@ class Study:
 
     def execute(self, todo: list) -> dict:
         """Run ``todo`` (runs, and jobs that yield runs), storing each run as it finishes (:meth:`keep`); on an
-        interruption keep what finished.  Returns {"computed": n, "reused": n} (:func:`~.jobs.run_jobs`)."""
+        interruption keep what finished.  Returns {"computed": n, "reused": n}
+        (:func:`~openmm_symprk.studies.core.jobs.run_jobs`)."""
         jobs = [p if isinstance(p, Job) else Job(single(p), p.cost) for p in todo]
         executor = make_executor(type(self).work, self.shared(todo), self.workers, self.scheduler)
         bar = progress_bar(sum(j.remaining for j in jobs), self.command.split()[-1] + " runs", self.progress)
