@@ -1,24 +1,43 @@
 """The ``symprk`` command, and the one frame every sub-command runs in.
 
 A sub-command is a module with ``build_parser(prog)`` (its options) and ``run(args)`` (its work; an exit status,
-None for 0; ``args`` also holds ``command``, ``prog`` and its ``argv``), named in :data:`COMMANDS`: the library's own (``methods``, ``check``, ``info`` here; ``observe`` in
-:mod:`openmm_symprk.analysis.cli`) and the studies' (:mod:`openmm_symprk.studies`).  :func:`main` parses its
-options and runs it in :func:`run_command`, so every sub-command has one error policy: a user's mistake (a bad value,
-name, file or platform, a missing extra, a blow-up: :func:`user_errors`) is one line ``symprk <name>: error: ...``
-on stderr and exit status 2, a bad option argparse's usage and status 2, Ctrl-C status 130; anything else is a bug
-and keeps its traceback.
+None for 0; ``args`` also holds ``command``, ``prog`` and its ``argv``), named in :data:`COMMANDS`: the library's
+own (``methods``, ``check``, ``info`` here; ``observe`` in :mod:`openmm_symprk.analysis.cli`) and the studies'
+(:mod:`openmm_symprk.studies`).  :func:`main` parses its options and runs it in :func:`run_command`, so every
+sub-command has one error policy:
+
+* a user's error (:func:`is_user_error`) is one line ``symprk <name>: error: ...`` on stderr and exit status 2.
+  A user's error is an exception raised on purpose: one of the package's own errors
+  (:class:`~openmm_symprk.support.errors.SymprkError`: the input checks'
+  :class:`~openmm_symprk.support.errors.InputError`, a ValueError; a missing extra named by ``require``,
+  :class:`~openmm_symprk.support.MissingDependencyError`; a blow-up; the native plugin missing where it is needed;
+  :class:`CommandError` ...), OpenMM refusing its input (``openmm.OpenMMException``), or the OS refusing a file
+  the user named (an OSError that carries the file's name);
+* anything else is a bug and keeps its traceback: a ValueError of a tuple that does not unpack, an ImportError of
+  a typo, a KeyError;
+* ``SYMPRK_DEBUG=1`` in the environment, or ``--debug`` anywhere before a ``--``, prints a user's error's
+  traceback too (still exit status 2);
+* a bad option is argparse's usage and status 2, Ctrl-C status 130.
+
+To refuse an input, raise :class:`~openmm_symprk.support.errors.InputError` (``from ..support.errors import
+InputError``; callers that catch ValueError still do), or give a new error class
+:class:`~openmm_symprk.support.errors.SymprkError` as a base beside its usual one; a plain ValueError, KeyError or
+RuntimeError reads as a bug.
 """
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 from dataclasses import dataclass
 from importlib import import_module
 
-__all__ = ["CommandError", "COMMANDS", "user_errors", "run_command", "build_parser", "main"]
+from .support.errors import SymprkError
+
+__all__ = ["CommandError", "COMMANDS", "is_user_error", "run_command", "build_parser", "main"]
 
 
-class CommandError(Exception):
+class CommandError(SymprkError):
     """A user's mistake a sub-command finds itself: printed as one line, exit status 2."""
 
 
@@ -59,37 +78,47 @@ COMMANDS = {
 ALIASES = {("nvt", "drift"): ["drift", "nvt"]}
 
 
-def user_errors() -> tuple:
-    """The exceptions that mean "the input was wrong" (one line, exit status 2), not "the package has a bug" (a
-    traceback): bad values (ValueError: unknown methods, bad tableaux and rows included), files (OSError: a study's
-    locked or occupied folder too), a missing extra (ImportError), what OpenMM refuses, a blow-up, the native
-    plugin missing where it is needed, an implicit tableau that does not converge, and :class:`CommandError`."""
+def is_user_error(exc: BaseException) -> bool:
+    """Whether ``exc`` is a user's error (one line, exit status 2) rather than a bug (a traceback): one the package
+    raises on purpose (:class:`~openmm_symprk.support.errors.SymprkError`), OpenMM refusing its input, or the OS
+    refusing a named file (module docstring)."""
     import openmm as mm
 
-    from .integrators import SimulationBlowUpError
-    from .methods.reference import ConvergenceError
-    from .plugin import NativeUnavailableError
+    if isinstance(exc, (SymprkError, mm.OpenMMException)):
+        return True
+    return isinstance(exc, OSError) and exc.filename is not None
 
-    return (ValueError, OSError, ImportError, mm.OpenMMException, SimulationBlowUpError, NativeUnavailableError,
-            ConvergenceError, CommandError)
+
+#: The environment variable that shows a user's error's traceback too (as ``--debug`` does).
+DEBUG_VARIABLE = "SYMPRK_DEBUG"
+
+
+def debugging() -> bool:
+    """Whether :data:`DEBUG_VARIABLE` asks for tracebacks (set, and not empty, 0, false or no)."""
+    return os.environ.get(DEBUG_VARIABLE, "").strip().lower() not in ("", "0", "false", "no")
 
 
 #: What an interrupted study says.
 KEPT = "interrupted (finished runs are kept; run again to continue)"
 
 
-def run_command(prog: str, action, interrupted: str = "interrupted") -> int:
-    """``action()``'s exit status (None: 0) under the one error policy (module docstring)."""
+def run_command(prog: str, action, interrupted: str = "interrupted", debug: bool | None = None) -> int:
+    """``action()``'s exit status (None: 0) under the one error policy (module docstring); ``debug`` (default:
+    :func:`debugging`) prints a user's error's traceback before its line."""
     try:
         return action() or 0
     except KeyboardInterrupt:
         print(f"{prog}: {interrupted}", file=sys.stderr)
         return 130
     except Exception as exc:
-        if isinstance(exc, user_errors()):
-            print(f"{prog}: error: {' '.join(str(exc).split())}", file=sys.stderr)
-            return 2
-        raise
+        if not is_user_error(exc):
+            raise
+        if debugging() if debug is None else debug:
+            import traceback
+
+            traceback.print_exc()
+        print(f"{prog}: error: {' '.join(str(exc).split())}", file=sys.stderr)
+        return 2
 
 
 # -- the library's own sub-commands ----------------------------------------------------------------------------------
@@ -191,6 +220,9 @@ def build_parser(prog: str = "symprk"):
                        help="exit with status 2 unless the native plugin serves these platforms (comma-separated)")
     else:
         p = argparse.ArgumentParser(prog="symprk", description="Symplectic PRK integrators for OpenMM")
+        p.add_argument("--debug", action="store_true",
+                       help=f"print the traceback of a user's error too (as {DEBUG_VARIABLE}=1 does); a bug's "
+                            f"traceback is always printed")
         sub = p.add_subparsers(dest="command", required=True)
         for name, cmd in COMMANDS.items():
             sub.add_parser(name, help=cmd.help, add_help=False)
@@ -204,6 +236,9 @@ def run(args):
 
 def main(argv=None):
     argv = list(sys.argv[1:] if argv is None else argv)
+    end = argv.index("--") if "--" in argv else len(argv)
+    debug = "--debug" in argv[:end] or None
+    argv = [a for a in argv[:end] if a != "--debug"] + argv[end:]
     name = argv[0] if argv else ""
     prog = f"symprk {' '.join(argv[:2])}" if tuple(argv[:2]) in ALIASES else f"symprk {name}"
     if tuple(argv[:2]) in ALIASES:
@@ -220,7 +255,7 @@ def main(argv=None):
         args.command, args.prog, args.argv = name, prog, argv[1:]
         return module.run(args)
 
-    return run_command(prog, action, KEPT if cmd.keeps_runs else "interrupted")
+    return run_command(prog, action, KEPT if cmd.keeps_runs else "interrupted", debug)
 
 
 if __name__ == "__main__":

@@ -1,5 +1,6 @@
 """Small float64 measurements shared by the OpenMM tests (built on openmm_symprk.conservation)."""
 import os
+import re
 
 import numpy as np
 import openmm.app as app
@@ -8,6 +9,11 @@ import openmm.unit as unit
 
 from openmm_symprk.conservation import angular_momentum, linear_momentum
 from openmm_symprk.methods.orders import observed_orders
+
+#: An issue number of the project ("issue 26", "issues 33 and 36", "--preset issue26"): the project's history, which
+#: users do not know, and which no ``--help`` (tests/test_architecture.py) and no heading of the docs
+#: (tests/test_docs.py) names.
+ISSUE_NUMBER = re.compile(r"\bissues?[\s#_-]*\d", re.I)
 
 #: The platform that runs the plugin's Common kernel in the tests: OpenCL (PoCL in CI), or the one named by
 #: SYMPRK_TEST_COMMON_PLATFORM (CUDA on a machine with an NVIDIA GPU), so the same assertions check that kernel there.

@@ -1,11 +1,14 @@
 """The package's layout, checked from the source: layers import downward only, no import cycles (lazy imports
-included), no private names imported across modules, and the pure numerics never import OpenMM."""
+included), no private names imported across modules, the pure numerics never import OpenMM, the library's tests
+never import the studies, and no ``--help`` names an issue of the project."""
+import argparse
 import ast
 import os
 import subprocess
 import sys
 
 import pytest
+from helpers import ISSUE_NUMBER
 
 import openmm_symprk
 
@@ -173,6 +176,79 @@ def test_the_library_does_not_reach_into_the_studies():
              and _layer(name) < LAYERS["studies"] for target, _, _ in _imports(name, path)
              if target.startswith("openmm_symprk.studies")]
     assert not wrong, wrong
+#: The test-suite's folder; tests/studies/ tests the studies, everything else the library.
+TESTS = os.path.dirname(os.path.abspath(__file__))
+
+
+def _study_imports(tree) -> list:
+    """(line, module) of every import of openmm_symprk.studies in ``tree``: import statements, and
+    ``import_module("openmm_symprk.studies...")``."""
+    found = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.ImportFrom) and not node.level:
+            mods = [f"{node.module}.{a.name}" for a in node.names] if node.module == "openmm_symprk" else [node.module]
+        elif isinstance(node, ast.Import):
+            mods = [a.name for a in node.names]
+        elif isinstance(node, ast.Call) and getattr(node.func, "attr", getattr(node.func, "id", None)) == \
+                "import_module" and node.args and isinstance(node.args[0], ast.Constant):
+            mods = [node.args[0].value]
+        else:
+            continue
+        found += [(node.lineno, m) for m in mods if isinstance(m, str) and
+                  (m == "openmm_symprk.studies" or m.startswith("openmm_symprk.studies."))]
+    return found
+
+
+def test_the_library_tests_do_not_import_the_studies():
+    """A test of the library (under tests/, outside tests/studies/) imports no study, so that a study's change never
+    breaks it: what a library test shares with a study lives in the library (or in the tests' helpers)."""
+    wrong, read = [], 0
+    for folder, dirs, files in os.walk(TESTS):
+        dirs[:] = [d for d in dirs if not d.startswith((".", "_")) and
+                   os.path.relpath(os.path.join(folder, d), TESTS) != "studies"]
+        for f in files:
+            if f.endswith(".py"):
+                path = os.path.join(folder, f)
+                read += 1
+                wrong += [f"{os.path.relpath(path, TESTS)}:{line} imports {m}"
+                          for line, m in _study_imports(ast.parse(open(path).read()))]
+    assert not wrong, "\n".join(wrong)
+    assert read > 50  # the walk saw the library's tests
+    # and the rule sees an import where there is one
+    assert _study_imports(ast.parse("from openmm_symprk.studies.nvt.known import run\nfrom openmm_symprk import studies"
+                                    "\nimportlib.import_module('openmm_symprk.studies.bench')")) == \
+        [(1, "openmm_symprk.studies.nvt.known"), (2, "openmm_symprk.studies"), (3, "openmm_symprk.studies.bench")]
+
+
+def _parsers() -> list:
+    """``symprk``'s parser and every sub-command's, their own sub-commands' included (``symprk nvt cost`` ...)."""
+    from importlib import import_module
+
+    from openmm_symprk.cli import COMMANDS, build_parser
+
+    todo = [build_parser()] + [import_module(c.module).build_parser(f"symprk {n}") for n, c in COMMANDS.items()]
+    out = []
+    while todo:
+        p = todo.pop(0)
+        out.append(p)
+        todo += [sub for a in p._actions if isinstance(a, argparse._SubParsersAction) for sub in a.choices.values()]
+    return out
+
+
+def test_no_issue_number_in_any_help():
+    """``--help`` speaks to users: no sub-command's help, option, choice (a preset's name) or default names an issue
+    of the project."""
+    from openmm_symprk.cli import COMMANDS
+
+    parsers = _parsers()
+    found = [f"{p.prog}: ...{p.format_help()[max(0, m.start() - 40):m.end() + 20]!r}..." for p in parsers
+             for m in ISSUE_NUMBER.finditer(p.format_help())]
+    assert not found, "\n".join(found)
+    assert len(parsers) > len(COMMANDS) + 1 and {"symprk nvt cost", "symprk nvt known"} <= {p.prog for p in parsers}
+    assert all(ISSUE_NUMBER.search(t) for t in ("the rows that decide issue 26's answer", "--preset issue26",
+                                                "(issues 33 and 36)", "Issue #35"))
+
+
 #: The modules that build or run the step: they execute the resolved method's sub-steps, thermostat events included,
 #: and decide nothing of where the events go (openmm_symprk.methods.resolved does).
 STEP_RUNNERS = ("integrators.program", "integrators.thermostat_program", "integrators.custom_backend",

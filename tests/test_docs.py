@@ -14,6 +14,7 @@ import sys
 import warnings
 
 import pytest
+from helpers import ISSUE_NUMBER
 
 REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 DOCS = [os.path.join(REPO, "README.md")] + sorted(glob.glob(os.path.join(REPO, "docs", "*.md")))
@@ -25,6 +26,30 @@ def python_blocks(path):
     with open(path, encoding="utf-8") as fh:
         text = fh.read()
     return [(m.group(2), bool(m.group(1))) for m in BLOCK.finditer(text)]
+
+
+#: Pages whose headings still name issues of the project, until they are rewritten (docs/fidelity.md's results are
+#: organised by issue): each is expected to fail the rule below, and passing it fails the test, so that it leaves
+#: this list then.
+HEADINGS_PENDING = {"docs/fidelity.md"}
+FENCE = re.compile(r"^```.*?^```", re.S | re.M)
+
+
+def headings(text: str) -> list:
+    """The Markdown headings of ``text``, fenced code blocks left out (a shell comment is not a heading)."""
+    return re.findall(r"^#{1,6} .*$", FENCE.sub("", text), re.M)
+
+
+@pytest.mark.parametrize("path", [pytest.param(p, marks=pytest.mark.xfail(strict=True, reason="to be rewritten"))
+                                  if os.path.relpath(p, REPO) in HEADINGS_PENDING else p for p in DOCS],
+                         ids=lambda p: os.path.relpath(p, REPO))
+def test_no_heading_names_an_issue(path):
+    """README and the docs lead with what is true now, named by what it is; the project's history (which issue asked
+    for what) is the CHANGELOG's."""
+    with open(path, encoding="utf-8") as fh:
+        found = [h for h in headings(fh.read()) if ISSUE_NUMBER.search(h)]
+    assert not found, found
+    assert headings("# A\n```bash\n# issue 26\n```\n## Issue 35: B") == ["# A", "## Issue 35: B"]
 
 
 def test_the_docs_are_found():

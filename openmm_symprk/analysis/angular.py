@@ -32,7 +32,7 @@ import numpy as np
 
 from ..stats import jackknife
 from .correlation import origin_averaged_correlation
-from ..support import require
+from ..support import InputError, require
 from .molecules import make_whole, molecule_index, trajectory_frames
 
 __all__ = ["angular_velocities", "angular_velocity_acf", "AcfSummary", "acf_summary", "first_zero", "first_minimum",
@@ -48,7 +48,7 @@ def _body_axes(inertia, r):
     moments, axes = np.linalg.eigh(inertia)
     gap = np.minimum(moments[..., 1] - moments[..., 0], moments[..., 2] - moments[..., 1])
     if np.any(gap <= _DEGENERATE * moments[..., 2]):
-        raise ValueError("a molecule has two equal principal moments (a symmetric or linear top): its body "
+        raise InputError("a molecule has two equal principal moments (a symmetric or linear top): its body "
                          "frame is not unique; use frame='space'")
     for a in (0, 1):
         proj = np.einsum("...kd,...d->...k", r, axes[..., :, a])
@@ -65,13 +65,13 @@ def angular_velocities(x, v, m, molecules, frame: str = "space", box=None) -> np
     (F, 3)), velocities ``v`` (F, N, 3) nm/ps and masses ``m`` (N,) Da; components in the ``frame`` "space"
     or "body" (see the module docstring)."""
     if frame not in ("space", "body"):
-        raise ValueError(f"frame must be 'space' or 'body', got {frame!r}")
+        raise InputError(f"frame must be 'space' or 'body', got {frame!r}")
     if box is not None:
         x = np.array(x, dtype=np.float64)
         x[:, molecule_index(molecules)] = make_whole(x, molecules, box)
     fr = trajectory_frames(x, v, m, molecules)
     if np.any(fr.M <= 0):
-        raise ValueError("a molecule has no mass: no angular velocity")
+        raise InputError("a molecule has no mass: no angular velocity")
     # pseudo-inverse: a linear molecule has no rotation about its axis (as physics.temperature counts it)
     omega = np.einsum("...ij,...j->...i", np.linalg.pinv(fr.inertia, rcond=_LINEAR, hermitian=True), fr.L)
     if frame == "body":
@@ -86,15 +86,15 @@ def angular_velocity_acf(omega, max_lag: int | None = None, components: bool = F
     mean square)."""
     omega = np.asarray(omega, dtype=np.float64)
     if omega.ndim != 3 or omega.shape[2] != 3:
-        raise ValueError(f"omega must have shape (n_frames, n_molecules, 3) in rad/ps, got {omega.shape}")
+        raise InputError(f"omega must have shape (n_frames, n_molecules, 3) in rad/ps, got {omega.shape}")
     c = origin_averaged_correlation(omega, max_lag).mean(axis=1)  # (L, 3)
     if components:
         if np.any(c[0] == 0):
-            raise ValueError("a component of omega is zero at every frame: it has no normalised autocorrelation")
+            raise InputError("a component of omega is zero at every frame: it has no normalised autocorrelation")
         return c / c[0]
     total = c.sum(axis=1)
     if total[0] == 0:
-        raise ValueError("omega is zero at every frame: it has no normalised autocorrelation")
+        raise InputError("omega is zero at every frame: it has no normalised autocorrelation")
     return total / total[0]
 
 
@@ -119,9 +119,9 @@ def acf_summary(c, dt_ps: float) -> AcfSummary:
     """The summary (:class:`AcfSummary`) of a normalised correlation function ``c`` (lags 0, dt, ...)."""
     c = np.asarray(c, dtype=np.float64)
     if c.ndim != 1 or len(c) < 3:
-        raise ValueError(f"c must be a 1-D correlation function of at least 3 lags, got shape {c.shape}")
+        raise InputError(f"c must be a 1-D correlation function of at least 3 lags, got shape {c.shape}")
     if not dt_ps > 0:
-        raise ValueError(f"dt_ps must be > 0, got {dt_ps}")
+        raise InputError(f"dt_ps must be > 0, got {dt_ps}")
     t_zero = first_zero(c) * dt_ps
     lag, c_min = first_minimum(c)
     integral = float(dt_ps * (c.sum() - 0.5 * (c[0] + c[-1])))
@@ -174,10 +174,10 @@ def omega_correlation(omega, dt_ps: float, max_lag: int | None = None, n_groups:
     delete-one-group jackknife over ``n_groups`` groups of molecules."""
     omega = np.asarray(omega, dtype=np.float64)
     if omega.ndim != 3 or omega.shape[2] != 3:
-        raise ValueError(f"omega must have shape (n_frames, n_molecules, 3) in rad/ps, got {omega.shape}")
+        raise InputError(f"omega must have shape (n_frames, n_molecules, 3) in rad/ps, got {omega.shape}")
     per = origin_averaged_correlation(omega, max_lag).sum(axis=2)  # (L, n), not normalised
     if not per[0].mean() > 0:
-        raise ValueError("omega is zero at every frame: it has no normalised autocorrelation")
+        raise InputError("omega is zero at every frame: it has no normalised autocorrelation")
     c = per.mean(axis=1) / per[0].mean()
 
     def figures(mean):

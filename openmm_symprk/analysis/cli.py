@@ -26,7 +26,7 @@ import stat
 
 import numpy as np
 
-from ..support import require
+from ..support import InputError, require
 
 __all__ = ["OBSERVED", "observe", "build_parser", "run"]
 
@@ -102,7 +102,7 @@ def observe(universe, *, window_ps=None, viscosity_mpas=None, temperature_k=None
     def omega():
         dt = float(universe.trajectory.dt)
         if dt > OMEGA_MAX_INTERVAL_PS:
-            raise ValueError(f"frames every {dt:g} ps cannot resolve the omega ACF (water's librations last ~0.1 "
+            raise InputError(f"frames every {dt:g} ps cannot resolve the omega ACF (water's librations last ~0.1 "
                              f"ps): store frames every {1000 * OMEGA_MAX_INTERVAL_PS:g} fs or less")
         lag = max(2, int(round(omega_lag_ps / dt)))
         a = AngularVelocityCorrelation(universe, max_lag=min(lag, universe.trajectory.n_frames - 1)).run()
@@ -124,7 +124,7 @@ def observe(universe, *, window_ps=None, viscosity_mpas=None, temperature_k=None
     def structure():
         g = RadialDistribution(universe).run()
         if g.results.peak is None:
-            raise ValueError(g.results.note)
+            raise InputError(g.results.note)
         obs["g_r"] = _pair(g.results.peak.r, g.results.peak.r_se, ANGSTROM_IN_NM)  # the table's nm
         obs["g_h"] = _pair(g.results.peak.height, g.results.peak.height_se)
 
@@ -195,7 +195,7 @@ def _refuse_json_on_inputs(path: str, topology: str, trajectories) -> None:
         if _same_file(path, given):
             same = "" if os.path.abspath(path) == os.path.abspath(given) else f" ({given})"
             stem = os.path.splitext(path)[0]
-            raise ValueError(f"--json {path} is the {what}{same} that symprk observe reads: writing the "
+            raise InputError(f"--json {path} is the {what}{same} that symprk observe reads: writing the "
                              f"observables there would replace it; give another file name (e.g. "
                              f"{stem}.observe.json)")
 
@@ -206,22 +206,22 @@ def _json_target(path: str) -> tuple:
     a new one) is replaced whole (:func:`_write_json`), through a symlink to the file it names; anything else
     that exists (a device such as /dev/stdout or /dev/null, a FIFO) is written into, never replaced."""
     if os.path.isdir(path):
-        raise ValueError(f"--json {path} is a folder: give a file name (e.g. {os.path.join(path, 'observe.json')})")
+        raise InputError(f"--json {path} is a folder: give a file name (e.g. {os.path.join(path, 'observe.json')})")
     if os.path.exists(path) and not stat.S_ISREG(os.stat(path).st_mode):
         if not os.access(path, os.W_OK):
-            raise ValueError(f"--json {path} cannot be written (permission denied)")
+            raise InputError(f"--json {path} cannot be written (permission denied)")
         return path, True
     target = os.path.realpath(path)
     folder = os.path.dirname(target)
     if not os.path.isdir(folder):
-        raise ValueError(f"--json {path}: the folder {folder} does not exist")
+        raise InputError(f"--json {path}: the folder {folder} does not exist")
     probe = os.path.join(folder, f".{os.path.basename(target)}.{os.getpid()}.probe")
     try:
         with open(probe, "x"):
             pass
         os.remove(probe)
     except OSError as exc:
-        raise ValueError(f"--json {path}: cannot write in {folder} ({exc.strerror or exc})") from None
+        raise InputError(f"--json {path}: cannot write in {folder} ({exc.strerror or exc})") from None
     return target, False
 
 
@@ -241,15 +241,15 @@ def _write_json(target: str, stream: bool, data: dict) -> None:
     except OSError as exc:
         if not stream and os.path.exists(tmp):
             os.remove(tmp)
-        raise ValueError(f"cannot write --json {target}: {exc.strerror or exc}") from None
+        raise InputError(f"cannot write --json {target}: {exc.strerror or exc}") from None
 
 
 def run(args):
     """The command (:func:`openmm_symprk.cli.main` runs it): ValueError and OSError are the user's mistakes."""
     if (args.viscosity is None) != (args.temperature is None):
-        raise ValueError("the Yeh-Hummer correction needs both --viscosity and --temperature")
+        raise InputError("the Yeh-Hummer correction needs both --viscosity and --temperature")
     if args.dt is not None and not (np.isfinite(args.dt) and args.dt > 0):
-        raise ValueError(f"--dt must be a positive number of ps (the time between the trajectory's frames), "
+        raise InputError(f"--dt must be a positive number of ps (the time between the trajectory's frames), "
                          f"got {args.dt:g}")
     if args.json:
         _refuse_json_on_inputs(args.json, args.topology, args.trajectory)

@@ -14,18 +14,20 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..support.errors import InputError
+
 __all__ = ["origin_averaged_correlation", "check_max_lag"]
 
 
 def check_max_lag(n_frames: int, max_lag: int | None) -> int:
     """The maximum lag (frames) for a series of ``n_frames``: ``max_lag``, or n_frames // 2 when None."""
     if n_frames < 2:
-        raise ValueError(f"a correlation needs at least 2 frames, got {n_frames}")
+        raise InputError(f"a correlation needs at least 2 frames, got {n_frames}")
     if max_lag is None:
         return n_frames // 2
     max_lag = int(max_lag)
     if not 1 <= max_lag <= n_frames - 1:
-        raise ValueError(f"max_lag must be between 1 and n_frames - 1 = {n_frames - 1} frames, got {max_lag}")
+        raise InputError(f"max_lag must be between 1 and n_frames - 1 = {n_frames - 1} frames, got {max_lag}")
     return max_lag
 
 

@@ -38,6 +38,7 @@ import numpy as np
 from .correlation import origin_averaged_correlation
 from .literature import K_BOLTZMANN, NM2_PER_PS_IN_1E5_CM2_PER_S, VISCOSITY_MPAS, XI_CUBIC
 from .molecules import check_box
+from ..support.errors import InputError
 
 
 
@@ -56,13 +57,13 @@ def unwrap(r, box) -> np.ndarray:
     apart to tell which image the molecule went to)."""
     r = np.asarray(r, dtype=np.float64)
     if r.ndim != 3 or r.shape[2] != 3:
-        raise ValueError(f"r must have shape (n_frames, n_molecules, 3) in nm, got {r.shape}")
+        raise InputError(f"r must have shape (n_frames, n_molecules, 3) in nm, got {r.shape}")
     box = check_box(box, r.shape[0])[1:, None, :]
     step = np.diff(r, axis=0)
     step -= box * np.round(step / box)
     worst = np.abs(step / box).max() if step.size else 0.0
     if worst > _UNWRAP_LIMIT:
-        raise ValueError(f"a molecule moved {worst:.2f} of a box edge between two stored frames (limit "
+        raise InputError(f"a molecule moved {worst:.2f} of a box edge between two stored frames (limit "
                          f"{_UNWRAP_LIMIT}): store frames more often to unwrap the trajectory")
     out = np.empty_like(r)
     out[0] = r[0]
@@ -82,10 +83,10 @@ def remove_drift(r, weights=None) -> np.ndarray:
     walkers (thermostats that do not conserve momentum) removing it lowers D by a factor 1 - 1/n."""
     r = np.asarray(r, dtype=np.float64)
     if r.ndim != 3 or r.shape[2] != 3:
-        raise ValueError(f"r must have shape (n_frames, n_molecules, 3) in nm, got {r.shape}")
+        raise InputError(f"r must have shape (n_frames, n_molecules, 3) in nm, got {r.shape}")
     w = np.ones(r.shape[1]) if weights is None else np.asarray(weights, dtype=np.float64)
     if w.shape != (r.shape[1],) or not np.all(w >= 0) or not w.sum() > 0:
-        raise ValueError(f"weights must be {r.shape[1]} non-negative numbers (one per molecule), not all zero")
+        raise InputError(f"weights must be {r.shape[1]} non-negative numbers (one per molecule), not all zero")
     centre = np.einsum("n,fnd->fd", w / w.sum(), r)
     return r - (centre - centre[0])[:, None, :]
 
@@ -95,7 +96,7 @@ def mean_squared_displacement(r, max_lag: int | None = None) -> np.ndarray:
     trajectory), averaged over time origins, from continuous positions ``r`` (F, n, 3) nm."""
     r = np.asarray(r, dtype=np.float64)
     if r.ndim != 3 or r.shape[2] != 3:
-        raise ValueError(f"r must have shape (n_frames, n_molecules, 3) in nm, got {r.shape}")
+        raise InputError(f"r must have shape (n_frames, n_molecules, 3) in nm, got {r.shape}")
     n = r.shape[0]
     s2 = origin_averaged_correlation(r, max_lag).sum(axis=2)
     lags = np.arange(s2.shape[0])
@@ -135,7 +136,7 @@ def _window(window_ps, dt_ps, max_lag):
     t_min, t_max = (float(w) for w in window_ps)
     lo, hi = int(np.ceil(t_min / dt_ps - 1e-6)), int(np.floor(t_max / dt_ps + 1e-6))  # dt from a float32 header
     if not 0 <= t_min < t_max or hi > max_lag or hi - lo < 2:
-        raise ValueError(f"fit window {window_ps} ps must satisfy 0 <= t_min < t_max <= the longest lag "
+        raise InputError(f"fit window {window_ps} ps must satisfy 0 <= t_min < t_max <= the longest lag "
                          f"{max_lag * dt_ps:g} ps and hold at least 3 lags of {dt_ps:g} ps")
     return lo, hi
 
@@ -150,9 +151,9 @@ def self_diffusion(r, dt_ps: float, window_ps, *, error: str = "molecules", n_bl
     (:func:`remove_drift`, with ``weights``).  Uncorrected for the box size (see :func:`yeh_hummer`)."""
     r = remove_drift(r, weights) if drift else np.asarray(r, dtype=np.float64)
     if not dt_ps > 0:
-        raise ValueError(f"dt_ps must be > 0 (the time between stored frames, ps), got {dt_ps}")
+        raise InputError(f"dt_ps must be > 0 (the time between stored frames, ps), got {dt_ps}")
     if error not in ("molecules", "blocks"):
-        raise ValueError(f"error must be 'molecules' or 'blocks', got {error!r}")
+        raise InputError(f"error must be 'molecules' or 'blocks', got {error!r}")
     msd = mean_squared_displacement(r, max_lag)
     lo, hi = _window(window_ps, dt_ps, msd.shape[0] - 1)
     t = np.arange(lo, hi + 1) * dt_ps
@@ -163,14 +164,14 @@ def self_diffusion(r, dt_ps: float, window_ps, *, error: str = "molecules", n_bl
         per = _slopes(t, msd[lo:hi + 1]) * scale
     else:
         if n_blocks < 2:
-            raise ValueError(f"n_blocks must be >= 2, got {n_blocks}")
+            raise InputError(f"n_blocks must be >= 2, got {n_blocks}")
         length = r.shape[0] // n_blocks
         if hi > length - 1:
-            raise ValueError(f"the fit window ends at {t[-1]:g} ps, longer than a block of {length} frames "
+            raise InputError(f"the fit window ends at {t[-1]:g} ps, longer than a block of {length} frames "
                              f"({(length - 1) * dt_ps:g} ps): use fewer blocks or a shorter window")
         per = _block_slopes(r, t, lo, hi, n_blocks) * scale
     if len(per) < 2:
-        raise ValueError("the error needs at least 2 molecules (or blocks)")
+        raise InputError("the error needs at least 2 molecules (or blocks)")
     se = float(np.std(per, ddof=1) / np.sqrt(len(per)))
     return DiffusionFit(D, se, np.arange(msd.shape[0]) * dt_ps, mean_msd, (float(t[0]), float(t[-1])), error,
                         len(per), msd)
@@ -197,16 +198,16 @@ def block_error(r, dt_ps: float, window_ps, *, n_blocks: int = ERROR_BLOCKS, dri
     window from half its frames as origins): a window reaching further leaves too few independent stretches
     of the run to tell an error from."""
     if isinstance(n_blocks, bool) or int(n_blocks) != n_blocks or n_blocks < 2:
-        raise ValueError(f"n_blocks must be an integer >= 2, got {n_blocks!r}")
+        raise InputError(f"n_blocks must be an integer >= 2, got {n_blocks!r}")
     if not dt_ps > 0:
-        raise ValueError(f"dt_ps must be > 0 (the time between stored frames, ps), got {dt_ps}")
+        raise InputError(f"dt_ps must be > 0 (the time between stored frames, ps), got {dt_ps}")
     r = remove_drift(r, weights) if drift else np.asarray(r, dtype=np.float64)
     length = r.shape[0] // int(n_blocks)
     t_min, t_max = (float(w) for w in window_ps)
     half = 0.5 * length * dt_ps
     if not t_max <= half + 1e-6 * dt_ps:
         run = (r.shape[0] - 1) * dt_ps
-        raise ValueError(f"no error bar: it comes from {n_blocks} blocks of the run ({run:g} ps: blocks of "
+        raise InputError(f"no error bar: it comes from {n_blocks} blocks of the run ({run:g} ps: blocks of "
                          f"{length * dt_ps:g} ps), each of which must hold the fit window twice, and the window ends "
                          f"at {t_max:g} ps; a window ending by {half:g} ps, or a run of {2 * n_blocks * t_max:g} ps "
                          f"or more, gives one (the molecules' own scatter would understate it 2-3x: a liquid's "
@@ -223,6 +224,6 @@ def yeh_hummer(box_nm: float, temperature_k: float, viscosity_mpas: float) -> fl
     the literature only; ``viscosity_mpas``: the model's shear viscosity (e.g. :data:`VISCOSITY_MPAS`)."""
     for name, value in (("box_nm", box_nm), ("temperature_k", temperature_k), ("viscosity_mpas", viscosity_mpas)):
         if not float(value) > 0:
-            raise ValueError(f"{name} must be > 0, got {value}")
+            raise InputError(f"{name} must be > 0, got {value}")
     si = K_BOLTZMANN * temperature_k * XI_CUBIC / (6.0 * np.pi * viscosity_mpas * 1e-3 * box_nm * 1e-9)  # m^2/s
     return float(si / 1e-9)  # 1e-5 cm^2/s = 1e-9 m^2/s

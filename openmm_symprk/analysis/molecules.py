@@ -12,6 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..physics.momenta import MoleculeFrames, molecule_frames
+from ..support.errors import InputError
 
 __all__ = ["trajectory_frames", "centre_of_mass_trajectory", "molecule_index", "make_whole", "check_box"]
 
@@ -24,7 +25,7 @@ def molecule_index(molecules) -> np.ndarray:
         idx = None
     if idx is None or idx.ndim != 2 or idx.shape[0] == 0 or idx.shape[1] == 0:
         sizes = sorted({len(g) for g in molecules}) if hasattr(molecules, "__iter__") else None
-        raise ValueError(f"molecules must be a non-empty list of atom-index lists all of one length (one kind of "
+        raise InputError(f"molecules must be a non-empty list of atom-index lists all of one length (one kind of "
                          f"molecule, e.g. water); got lengths {sizes}")
     return idx
 
@@ -37,7 +38,7 @@ def check_box(box, n_frames: int | None = None) -> np.ndarray:
         b = np.broadcast_to(b, (n_frames, 3))
     want = (3,) if n_frames is None else (n_frames, 3)
     if b.shape != want or not np.all(b > 0):
-        raise ValueError(f"box must be the 3 edge lengths (nm, all > 0) of an orthorhombic box"
+        raise InputError(f"box must be the 3 edge lengths (nm, all > 0) of an orthorhombic box"
                          f"{'' if n_frames is None else ', or one row of 3 per frame'}, got shape {b.shape}")
     return b
 
@@ -48,7 +49,7 @@ def make_whole(x, molecules, box) -> np.ndarray:
     (F, 3) one per frame; None: ``x`` is whole already)."""
     x = np.asarray(x)
     if x.ndim != 3 or x.shape[2] != 3:
-        raise ValueError(f"x must have shape (n_frames, n_atoms, 3) in nm, got {x.shape}")
+        raise InputError(f"x must have shape (n_frames, n_atoms, 3) in nm, got {x.shape}")
     xg = x[:, molecule_index(molecules)].astype(np.float64)
     if box is not None:
         b = check_box(box, x.shape[0])[:, None, None, :]
@@ -63,7 +64,7 @@ def make_whole(x, molecules, box) -> np.ndarray:
 def _trajectory(x, name):
     x = np.asarray(x, dtype=np.float64)
     if x.ndim != 3 or x.shape[2] != 3:
-        raise ValueError(f"{name} must have shape (n_frames, n_atoms, 3) in nm or nm/ps, got {x.shape}")
+        raise InputError(f"{name} must have shape (n_frames, n_atoms, 3) in nm or nm/ps, got {x.shape}")
     return x
 
 
@@ -75,12 +76,12 @@ def trajectory_frames(x, v, m, molecules) -> MoleculeFrames:
     x = _trajectory(x, "x")
     v = np.zeros_like(x) if v is None else _trajectory(v, "v")
     if v.shape != x.shape:
-        raise ValueError(f"v has shape {v.shape}, x has {x.shape}: they must match")
+        raise InputError(f"v has shape {v.shape}, x has {x.shape}: they must match")
     idx = molecule_index(molecules)
     f, n_atoms = x.shape[:2]
     m = np.asarray(m, dtype=np.float64)
     if m.shape != (n_atoms,):
-        raise ValueError(f"m must have shape ({n_atoms},) (one mass per atom, Da), got {m.shape}")
+        raise InputError(f"m must have shape ({n_atoms},) (one mass per atom, Da), got {m.shape}")
     stacked = (idx[None] + n_atoms * np.arange(f)[:, None, None]).reshape(-1, idx.shape[1])
     fr = molecule_frames(x.reshape(-1, 3), v.reshape(-1, 3), np.tile(m, f), stacked)
     n = idx.shape[0]
@@ -94,15 +95,15 @@ def centre_of_mass_trajectory(x, m, molecules, box=None, chunk: int = 256) -> np
     time, so that float32 frames are never copied whole into float64."""
     x = np.asarray(x)
     if x.ndim != 3 or x.shape[2] != 3:
-        raise ValueError(f"x must have shape (n_frames, n_atoms, 3) in nm, got {x.shape}")
+        raise InputError(f"x must have shape (n_frames, n_atoms, 3) in nm, got {x.shape}")
     m = np.asarray(m, dtype=np.float64)
     if m.shape != (x.shape[1],):
-        raise ValueError(f"m must have shape ({x.shape[1]},) (one mass per atom, Da), got {m.shape}")
+        raise InputError(f"m must have shape ({x.shape[1]},) (one mass per atom, Da), got {m.shape}")
     idx = molecule_index(molecules)
     mg = m[idx]
     total = mg.sum(axis=1)
     if np.any(total <= 0):
-        raise ValueError("a molecule has no mass: no centre of mass")
+        raise InputError("a molecule has no mass: no centre of mass")
     w = mg / total[:, None]
     boxes = None if box is None else check_box(box, x.shape[0])
     out = np.empty((x.shape[0], len(idx), 3))

@@ -28,6 +28,7 @@ import numpy as np
 from ..stats import jackknife
 from .correlation import origin_averaged_correlation
 from .molecules import make_whole, molecule_index
+from ..support.errors import InputError
 
 __all__ = ["atom_vectors", "bisector_vectors", "dipole_vectors", "legendre_correlation", "correlation_time",
            "CorrelationTime", "reorientation_time", "molecules_correlation_time"]
@@ -41,7 +42,7 @@ def _positions(x, molecules, box):
 def _unit(u):
     norm = np.linalg.norm(u, axis=-1, keepdims=True)
     if np.any(norm == 0):
-        raise ValueError("a molecule's vector has zero length (coincident atoms, or a molecule without dipole)")
+        raise InputError("a molecule's vector has zero length (coincident atoms, or a molecule without dipole)")
     return u / norm
 
 
@@ -66,7 +67,7 @@ def dipole_vectors(x, molecules, charges, box=None) -> np.ndarray:
     q = np.asarray(charges, dtype=np.float64)[idx]
     net = np.abs(q.sum(axis=1)).max()
     if net > 1e-6:
-        raise ValueError(f"a molecule carries a net charge of {net:.3g} e: its dipole depends on the origin; "
+        raise InputError(f"a molecule carries a net charge of {net:.3g} e: its dipole depends on the origin; "
                          f"use atom_vectors or bisector_vectors for charged molecules")
     xg = _positions(x, molecules, box)
     return _unit(np.einsum("nk,fnkd->fnd", q, xg))
@@ -77,7 +78,7 @@ def legendre_correlation(u, order: int, max_lag: int | None = None) -> np.ndarra
     from unit vectors ``u`` (F, n, 3), averaged over time origins (average over axis 1 for the molecules)."""
     u = np.asarray(u, dtype=np.float64)
     if u.ndim != 3 or u.shape[2] != 3:
-        raise ValueError(f"u must have shape (n_frames, n_molecules, 3), got {u.shape}")
+        raise InputError(f"u must have shape (n_frames, n_molecules, 3), got {u.shape}")
     if order == 1:
         return origin_averaged_correlation(u, max_lag).sum(axis=2)
     if order == 2:
@@ -86,7 +87,7 @@ def legendre_correlation(u, order: int, max_lag: int | None = None) -> np.ndarra
         weight = np.where(a == b, 1.0, 2.0)
         cos2 = (origin_averaged_correlation(products, max_lag) * weight).sum(axis=2)
         return 1.5 * cos2 - 0.5
-    raise ValueError(f"order must be 1 or 2 (first or second Legendre polynomial), got {order}")
+    raise InputError(f"order must be 1 or 2 (first or second Legendre polynomial), got {order}")
 
 
 @dataclass
@@ -110,20 +111,20 @@ def correlation_time(c, dt_ps: float, c_cut: float = 0.1, c_fit: float = 0.5) ->
     as the module docstring states: trapezoid to t_cut, exponential tail beyond it (se left at nan)."""
     c = np.asarray(c, dtype=np.float64)
     if not dt_ps > 0:
-        raise ValueError(f"dt_ps must be > 0, got {dt_ps}")
+        raise InputError(f"dt_ps must be > 0, got {dt_ps}")
     if not 0 < c_cut < c_fit < 1:
-        raise ValueError(f"need 0 < c_cut < c_fit < 1, got c_cut={c_cut}, c_fit={c_fit}")
+        raise InputError(f"need 0 < c_cut < c_fit < 1, got c_cut={c_cut}, c_fit={c_fit}")
     below = np.nonzero(c <= c_cut)[0]
     cut = int(below[0]) if len(below) else len(c) - 1
     fit = np.nonzero((c[:cut + 1] >= c_cut) & (c[:cut + 1] <= c_fit))[0]
     if len(fit) < 3:
-        raise ValueError(f"the correlation function has fewer than 3 lags between C = {c_fit} and C = {c_cut} "
+        raise InputError(f"the correlation function has fewer than 3 lags between C = {c_fit} and C = {c_cut} "
                          f"(it ends at C = {c[-1]:.3g} after {(len(c) - 1) * dt_ps:g} ps, or decays within a "
                          f"frame): store frames more often or run longer")
     t = np.arange(len(c)) * dt_ps
     slope, intercept = np.polyfit(t[fit], np.log(c[fit]), 1)
     if not slope < 0:
-        raise ValueError(f"the correlation function does not decay between C = {c_fit} and C = {c_cut}")
+        raise InputError(f"the correlation function does not decay between C = {c_fit} and C = {c_cut}")
     tau_exp = -1.0 / slope
     integral = float(dt_ps * (c[:cut + 1].sum() - 0.5 * (c[0] + c[cut])))  # trapezoid
     tail = float(np.exp(intercept - t[cut] / tau_exp) * tau_exp)

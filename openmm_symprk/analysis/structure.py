@@ -19,7 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..support import require
+from ..support import InputError, require
 from .molecules import check_box
 
 __all__ = ["Rdf", "radial_distribution", "Peak", "first_peak"]
@@ -43,16 +43,16 @@ def radial_distribution(x, box, r_max: float, dr: float = 0.005, n_blocks: int =
     ``InterRDF`` on an in-memory Universe of the sites."""
     x = np.asarray(x, dtype=np.float64)
     if x.ndim != 3 or x.shape[2] != 3 or x.shape[1] < 2:
-        raise ValueError(f"x must have shape (n_frames, n_sites >= 2, 3) in nm, got {x.shape}")
+        raise InputError(f"x must have shape (n_frames, n_sites >= 2, 3) in nm, got {x.shape}")
     f, n = x.shape[:2]
     box = check_box(box, f)
     if not 0 < r_max <= 0.5 * box.min() + 1e-12:
-        raise ValueError(f"r_max = {r_max} nm must be > 0 and at most half the shortest box edge "
+        raise InputError(f"r_max = {r_max} nm must be > 0 and at most half the shortest box edge "
                          f"({0.5 * box.min():g} nm): the minimum image misses pairs beyond it")
     if not 0 < dr < r_max:
-        raise ValueError(f"dr must be between 0 and r_max = {r_max} nm, got {dr}")
+        raise InputError(f"dr must be between 0 and r_max = {r_max} nm, got {dr}")
     if not 1 <= n_blocks <= f:
-        raise ValueError(f"n_blocks must be between 1 and the number of frames {f}, got {n_blocks}")
+        raise InputError(f"n_blocks must be between 1 and the number of frames {f}, got {n_blocks}")
     mda = require("MDAnalysis", "analysis", "openmm_symprk.analysis.structure.radial_distribution")
     InterRDF = require("MDAnalysis.analysis.rdf", "analysis", "openmm_symprk.analysis.structure").InterRDF
     MemoryReader = require("MDAnalysis.coordinates.memory", "analysis", "openmm_symprk.analysis.structure").MemoryReader
@@ -90,12 +90,12 @@ def _vertex(r, g, r_min, above, unit="nm"):
     neighbours: (position, height)."""
     over = (r > r_min) & (g > above)
     if not over.any():
-        raise ValueError(f"g(r) never exceeds {above} beyond r_min = {r_min:g} {unit}: no first peak")
+        raise InputError(f"g(r) never exceeds {above} beyond r_min = {r_min:g} {unit}: no first peak")
     start = int(np.argmax(over))
     stop = start + (int(np.argmin(over[start:])) if not over[start:].all() else len(g) - start)
     k = start + int(np.argmax(g[start:stop]))
     if k == 0 or k == len(g) - 1:
-        raise ValueError(f"the first peak's highest bin is at the end of the range (r = {r[k]:.4g} {unit}): "
+        raise InputError(f"the first peak's highest bin is at the end of the range (r = {r[k]:.4g} {unit}): "
                          f"no peak to refine (raise r_max or r_min)")
     g0, g1, g2 = g[k - 1], g[k], g[k + 1]
     curv = g0 - 2.0 * g1 + g2

@@ -34,7 +34,7 @@ import openmm as mm
 import openmm.unit as unit
 
 from ..physics import momenta
-from ..support import require
+from ..support import InputError, require
 from ..systems.properties import masses as system_masses
 
 AnalysisBase = require("MDAnalysis.analysis.base", "analysis", "openmm_symprk.conservation.analysis").AnalysisBase
@@ -59,7 +59,7 @@ def group_masses(atomgroup, masses=None) -> np.ndarray:
     if m.shape != (atomgroup.n_atoms,):
         if m.shape == (atomgroup.universe.atoms.n_atoms,):
             return m[atomgroup.indices]
-        raise ValueError(f"masses has shape {m.shape}, expected ({atomgroup.n_atoms},)")
+        raise InputError(f"masses has shape {m.shape}, expected ({atomgroup.n_atoms},)")
     return m
 
 
@@ -68,9 +68,9 @@ def subgroups(atomgroup, by):
     if by is None:
         return None
     if by not in ("residues", "fragments", "segments"):
-        raise ValueError(f"by must be None, 'residues', 'fragments' or 'segments', got {by!r}")
+        raise InputError(f"by must be None, 'residues', 'fragments' or 'segments', got {by!r}")
     if by == "fragments" and not hasattr(atomgroup, "fragments"):
-        raise ValueError("by='fragments' needs bonds: build the Universe with openmm_symprk.conservation.analysis.universe() "
+        raise InputError("by='fragments' needs bonds: build the Universe with openmm_symprk.conservation.analysis.universe() "
                          "or mda.Universe(..., guess_bonds=True)")
     pos = {ix: k for k, ix in enumerate(atomgroup.indices)}
     out = []
@@ -92,7 +92,7 @@ class _MomentumBase(AnalysisBase):
     def _state(self):
         ts = self._ts
         if not ts.has_velocities:
-            raise ValueError("the trajectory has no velocities (write it with VelocityTRRReporter, or any TRR/H5MD "
+            raise InputError("the trajectory has no velocities (write it with VelocityTRRReporter, or any TRR/H5MD "
                              "with velocities); DCD and XTC store positions only")
         x = self._ag.positions.astype(np.float64) * _A
         v = self._ag.velocities.astype(np.float64) * _A
@@ -139,7 +139,7 @@ class AngularMomentum(_MomentumBase):
 
     def __init__(self, atomgroup, about: str = "com", masses=None, by=None, **kwargs):
         if about not in ("com", "origin"):
-            raise ValueError(f"about must be 'com' or 'origin', got {about!r}")
+            raise InputError(f"about must be 'com' or 'origin', got {about!r}")
         super().__init__(atomgroup, masses=masses, by=by, **kwargs)
         self._about = about
 

@@ -40,7 +40,7 @@ import openmm.unit as unit
 
 from ..physics import momenta
 from ..physics.temperature import kinetic_temperatures
-from ..support import require
+from ..support import InputError, require
 from ..stats.slope import RunningLine
 from ..systems.checks import conservation_issues, integrator_issues, warn_conservation, warn_once
 from ..systems.properties import constraint_arrays, constraint_violation, degrees_of_freedom, masses, molecules
@@ -52,7 +52,7 @@ _NM, _NM_PS, _KJ = unit.nanometer, unit.nanometer / unit.picosecond, unit.kilojo
 def report_interval(value) -> int:
     """``value`` as a number of steps: a positive integer (a float such as 2.5, or True, is refused, not truncated)."""
     if isinstance(value, bool) or not isinstance(value, numbers.Integral) or int(value) < 1:
-        raise ValueError(f"reportInterval must be a positive whole number of steps (an int such as 100), "
+        raise InputError(f"reportInterval must be a positive whole number of steps (an int such as 100), "
                          f"got {value!r}")
     return int(value)
 
@@ -93,7 +93,7 @@ class ConservationReporter:
                  append: bool = False, warn: bool = True):
         self._interval = report_interval(reportInterval)
         if about not in ("com", "origin"):
-            raise ValueError(f"about must be 'com' or 'origin', got {about!r}")
+            raise InputError(f"about must be 'com' or 'origin', got {about!r}")
         self._about = about
         self._sep = separator
         self._append = append

@@ -17,6 +17,7 @@ from ..methods.resolved import ConstraintSupportError, ResolvedMethod, resolve
 from ..systems.checks import validate_system, warn_once
 from ..systems.forcegroups import check_groups
 from .options import NATIVE_OPTIONS, OPTIONS, IntegratorOptions, check_option_names
+from ..support.errors import InputError
 
 __all__ = ["BACKENDS", "choose_backend", "resolve_for_system", "BackendWarning", "NativeMethodError",
            "NativeUnavailableError"]
@@ -29,7 +30,7 @@ class BackendWarning(UserWarning):
     """backend="auto" could not use the native plugin (the message says why and how to fix it)."""
 
 
-class NativeMethodError(ValueError):
+class NativeMethodError(InputError):
     """The method cannot run on the native backend (only kick/drift splittings and compositions can)."""
 
 
@@ -69,7 +70,7 @@ def resolve_for_system(where: str, method, system, options: IntegratorOptions, n
 def choose_backend(method, backend: str = "auto", options=None) -> str:
     """"native" or "custom" for a catalogue method (see the module docstring)."""
     if backend not in BACKENDS:
-        raise ValueError(f"backend must be one of {', '.join(map(repr, BACKENDS))}, got {backend!r}")
+        raise InputError(f"backend must be one of {', '.join(map(repr, BACKENDS))}, got {backend!r}")
     check_option_names(options or {}, OPTIONS, "SymplecticIntegrator")
     if backend == "custom":
         return "custom"
@@ -84,7 +85,7 @@ def choose_backend(method, backend: str = "auto", options=None) -> str:
                 f"backend='native' runs kick/drift splittings and compositions only; {m.name!r} is a PRK tableau "
                 f"of the {m.family or m.form} family. Use backend='custom' (or 'auto').")
         if extra:
-            raise ValueError(f"backend='native' does not take the option(s) {', '.join(extra)}; it accepts "
+            raise InputError(f"backend='native' does not take the option(s) {', '.join(extra)}; it accepts "
                              f"{', '.join(sorted(NATIVE_OPTIONS))}. Use backend='custom'.")
         return "native"
     if not m.is_splitting or extra:

@@ -41,12 +41,13 @@ import openmm.unit as unit
 from ..physics.temperature import R_KJ
 from .quantities import positive_quantity
 from .thermostat import check_seed, on_step_temperature
+from ..support.errors import InputError, SymprkError
 
 __all__ = ["IntegratorBase", "SimulationBlowUpError", "ConvergenceWarning", "SystemMismatchError",
            "CheckpointMismatchError", "step_size_in_ps"]
 
 
-class SimulationBlowUpError(RuntimeError):
+class SimulationBlowUpError(SymprkError, RuntimeError):
     """The velocities stopped being finite (the step size is beyond the method's stability limit)."""
 
 
@@ -54,11 +55,11 @@ class ConvergenceWarning(RuntimeWarning):
     """An implicit method's fixed-point iteration hit its iteration cap on some steps."""
 
 
-class SystemMismatchError(ValueError):
+class SystemMismatchError(InputError):
     """The integrator was compiled for another System than the one of the Context it runs."""
 
 
-class CheckpointMismatchError(RuntimeError):
+class CheckpointMismatchError(SymprkError, RuntimeError):
     """A checkpoint written by another integrator program was loaded into this one."""
 
 
@@ -104,7 +105,7 @@ class IntegratorBase:
         except TypeError:
             raise TypeError(f"steps must be a whole number of steps, got {steps!r}") from None
         if steps < 0:
-            raise ValueError(f"steps must be >= 0, got {steps}")
+            raise InputError(f"steps must be >= 0, got {steps}")
         self._before_step()
         try:
             result = super().step(steps)
@@ -210,7 +211,7 @@ class IntegratorBase:
     def _require_thermostat(self, what: str):
         self._sync_run_state()
         if self._thermostat is None:
-            raise ValueError(f"{type(self).__name__}({self.method_name}).{what}: this integrator was created without "
+            raise InputError(f"{type(self).__name__}({self.method_name}).{what}: this integrator was created without "
                              f"temperature=, so it runs NVE and has no thermostat; create it with e.g. "
                              f"temperature=300*unit.kelvin (and system=) for NVT")
         return self._thermostat

@@ -22,6 +22,7 @@ from ..methods.resolved import ResolvedMethod, resolve
 from ..systems.properties import SystemSignature
 from .options import DEFAULT_MAX_ITERATIONS, DEFAULT_TOLERANCE, IntegratorOptions
 from .thermostat import ThermostatSettings
+from ..support.errors import InputError
 
 __all__ = ["META_PREFIX", "metadata", "add_metadata", "read_metadata", "methods_of", "options_of"]
 
@@ -81,7 +82,7 @@ def methods_of(meta: dict):
     elif "description" in meta:
         method = from_description(meta["description"])
     else:
-        raise ValueError(f"the program of {meta.get('method')!r} does not describe its method (it is not in the "
+        raise InputError(f"the program of {meta.get('method')!r} does not describe its method (it is not in the "
                          f"catalogue, and the openmm_symprk that wrote it did not record user methods): create the "
                          f"integrator again from its method")
     options = meta.get("options", {})

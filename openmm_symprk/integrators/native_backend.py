@@ -33,6 +33,7 @@ from .options import NATIVE_OPTIONS, IntegratorOptions, check_option_names
 from .thermostat import ThermostatSettings
 from .program import ProgramInfo
 from .symplectic import SymplecticIntegrator
+from ..support.errors import InputError
 
 __all__ = ["NativeSymplecticIntegrator", "native_available"]
 
@@ -147,7 +148,7 @@ class NativeSymplecticIntegrator(SymplecticIntegrator, _PluginIntegrator, backen
             except mm.OpenMMException as exc:
                 if "bound" not in str(exc):
                     raise
-                raise ValueError(f"the native backend cannot change the thermostat's collision time (from "
+                raise InputError(f"the native backend cannot change the thermostat's collision time (from "
                                  f"{current.collision_time:g} ps to {settings.collision_time:g} ps) once the integrator "
                                  f"runs a Context: its checkpoints and program signature carry it. Set it before "
                                  f"creating the Context, or create a new integrator") from None

@@ -26,6 +26,7 @@ import openmm as mm
 
 from ..stats.moments import Moments, correlation, power_sums
 from . import thermostat_program as tp
+from ..support.errors import InputError
 
 __all__ = ["NoiseSample", "sample_thermostat_noise"]
 
@@ -132,14 +133,14 @@ def sample_thermostat_noise(backend: str, dof: int, count: int, platform: str = 
     program sums the draws in its global variables, which a single-precision platform holds as floats), from
     ``seed`` (> 0)."""
     if backend not in ("native", "custom"):
-        raise ValueError(f"backend must be 'native' or 'custom', got {backend!r}")
+        raise InputError(f"backend must be 'native' or 'custom', got {backend!r}")
     dof, count = int(dof), int(count)
     if dof < 2:
-        raise ValueError(f"dof must be at least 2 (chi2 has dof - 1 degrees of freedom), got {dof}")
+        raise InputError(f"dof must be at least 2 (chi2 has dof - 1 degrees of freedom), got {dof}")
     if count < 3:
-        raise ValueError(f"count must be at least 3 events, got {count}")
+        raise InputError(f"count must be at least 3 events, got {count}")
     if not (isinstance(seed, (int, np.integer)) and 0 < seed < 2 ** 31):
-        raise ValueError(f"seed must be an integer from 1 to 2**31 - 1 (0 would draw a fresh one), got {seed!r}")
+        raise InputError(f"seed must be an integer from 1 to 2**31 - 1 (0 would draw a fresh one), got {seed!r}")
     draw = _native if backend == "native" else _custom
     r_sums, c_sums, cross, lag = draw(dof, count, platform, seed, properties)
     k = dof - 1

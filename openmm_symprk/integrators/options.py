@@ -29,6 +29,7 @@ from ..systems.checks import check_system_type
 from ..systems.properties import SystemSignature, signature
 from .base import step_size_in_ps
 from .thermostat import THERMOSTAT_OPTIONS, ThermostatSettings, thermostat_settings
+from ..support.errors import InputError
 
 __all__ = ["IntegratorOptions", "NATIVE_OPTIONS", "CUSTOM_OPTIONS", "OPTIONS", "DEFAULT_TOLERANCE",
            "DEFAULT_MAX_ITERATIONS", "check_option_names", "check_max_speed"]
@@ -77,7 +78,7 @@ def check_max_speed(max_speed) -> float:
     except (TypeError, ValueError):
         raise TypeError(f"max_speed must be a speed in nm/ps (or None), got {max_speed!r}") from None
     if not math.isfinite(value) or value < 0 or value > MAX_SPEED_LIMIT:
-        raise ValueError(f"max_speed must be a speed from 0 to {MAX_SPEED_LIMIT:g} nm/ps (None or 0: only NaN, "
+        raise InputError(f"max_speed must be a speed from 0 to {MAX_SPEED_LIMIT:g} nm/ps (None or 0: only NaN, "
                          f"infinity and absurd speeds), got {max_speed!r}")
     return value
 
@@ -85,13 +86,13 @@ def check_max_speed(max_speed) -> float:
 def _check_tolerance(tolerance) -> float:
     if not (isinstance(tolerance, (int, float)) and not isinstance(tolerance, bool) and tolerance > 0
             and math.isfinite(tolerance)):
-        raise ValueError(f"tolerance must be a positive number of nm, got {tolerance!r}")
+        raise InputError(f"tolerance must be a positive number of nm, got {tolerance!r}")
     return float(tolerance)
 
 
 def _check_max_iterations(max_iterations) -> int:
     if isinstance(max_iterations, bool) or int(max_iterations) < 1:
-        raise ValueError(f"max_iterations must be at least 1, got {max_iterations!r}")
+        raise InputError(f"max_iterations must be at least 1, got {max_iterations!r}")
     return int(max_iterations)
 
 
@@ -127,7 +128,7 @@ class IntegratorOptions:
         max_iterations = _check_max_iterations(max_iterations)
         exact_momentum = bool(exact_momentum)
         if exact_momentum and system is None:
-            raise ValueError("exact_momentum=True needs system= (the System the integrator will run): the "
+            raise InputError("exact_momentum=True needs system= (the System the integrator will run): the "
                              "projection is only right for an isolated System, which is checked, and it uses the "
                              "System's masses")
         if system is not None:

@@ -79,6 +79,8 @@ from __future__ import annotations
 
 import openmm as mm
 
+from ..support.errors import InputError
+
 PREFIX = "proj_"
 
 #: Relative Tikhonov shift of the inertia tensor (times its trace) before inversion, so that a linear
@@ -142,7 +144,7 @@ def set_masses(integrator: mm.CustomIntegrator, masses) -> None:
     as there are masses (a per-DOF variable of another length would be read out of bounds).  Needed for
     exact momentum on single/mixed precision OpenCL/CUDA (see the module docstring); harmless elsewhere."""
     if _g("mass") not in _names(integrator):
-        raise ValueError("this integrator has no exact-momentum projection (compile with exact_momentum=True)")
+        raise InputError("this integrator has no exact-momentum projection (compile with exact_momentum=True)")
     integrator.setPerDofVariableByName(_g("mass"), [mm.Vec3(m, m, m) for m in map(float, masses)])
 
 

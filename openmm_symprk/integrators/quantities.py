@@ -9,6 +9,8 @@ import math
 import numpy as np
 import openmm.unit as unit
 
+from ..support.errors import InputError
+
 __all__ = ["positive_quantity"]
 
 
@@ -32,5 +34,5 @@ def positive_quantity(value, name: str, in_unit, kind: str, example: str) -> flo
     except (TypeError, ValueError):
         raise TypeError(f"{name} {value!r} is not a {kind}: {hint}") from None
     if not math.isfinite(number) or number <= 0:
-        raise ValueError(f"{name} must be positive and finite, got {value} ({hint})")
+        raise InputError(f"{name} must be positive and finite, got {value} ({hint})")
     return number

@@ -30,6 +30,7 @@ from .custom_backend import CustomSymplecticIntegrator, PRKIntegrator
 from .metadata import methods_of, options_of, read_metadata
 from .native_backend import NativeSymplecticIntegrator, native_available
 from .options import IntegratorOptions
+from ..support.errors import InputError
 
 __all__ = ["restore", "deserialize"]
 
@@ -69,7 +70,7 @@ def _restore_custom(integrator: mm.CustomIntegrator):
     info = program.compile_program(mm.CustomIntegrator(options.step_size), resolved, options, has_sites)
     stored = integrator.getGlobalVariable(0)
     if stored != info.signature:
-        raise ValueError(f"this {cls.__name__}({resolved.name}) program is not the one its metadata compiles to (its "
+        raise InputError(f"this {cls.__name__}({resolved.name}) program is not the one its metadata compiles to (its "
                          f"signature {stored:.0f}, recompiled {info.signature}): it was written by another version "
                          f"of openmm_symprk or edited. Create the integrator again with the options it was built with")
     obj = object.__new__(cls)
@@ -121,7 +122,7 @@ def _restore_native(integrator):
         resolved = resolve(Splitting(_without_thermostat(obj.substeps())), constraints=constraints, name=name,
                            thermostat_position=position)
         if not runs_as_plugin(resolved):
-            raise ValueError(f"the SymPRKIntegrator {name!r} read from XML runs sub-steps {plugin_steps} (kind, "
+            raise InputError(f"the SymPRKIntegrator {name!r} read from XML runs sub-steps {plugin_steps} (kind, "
                              f"coefficient, force groups, flags) whose flags its sequence would not get: it was not "
                              f"built by openmm_symprk")
         if name in catalogue_methods:

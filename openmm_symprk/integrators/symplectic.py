@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from .backend import choose_backend
 from .base import IntegratorBase
+from ..support.errors import InputError
 
 __all__ = ["SymplecticIntegrator"]
 
@@ -67,5 +68,5 @@ class SymplecticIntegrator(IntegratorBase):
     @classmethod
     def _check_backend(cls, backend):
         if backend not in ("auto", cls.backend):
-            raise ValueError(f"{cls.__name__} is the {cls.backend!r} backend; backend={backend!r} asks for another "
+            raise InputError(f"{cls.__name__} is the {cls.backend!r} backend; backend={backend!r} asks for another "
                              f"(use SymplecticIntegrator(..., backend={backend!r}))")

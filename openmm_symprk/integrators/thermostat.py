@@ -22,6 +22,7 @@ from ..physics.velocity_rescaling import peculiar_kinetic_energy, relaxation_fac
 from ..systems.checks import EXACT_MOMENTUM_FORBIDDEN, check_system_type, conservation_issues
 from ..systems.properties import masses, thermostat_degrees_of_freedom
 from .quantities import positive_quantity
+from ..support.errors import InputError
 
 __all__ = ["ThermostatSettings", "thermostat_settings", "temperature_in_kelvin", "collision_time_in_ps",
            "check_interval", "check_seed", "system_is_isolated", "DEFAULT_COLLISION_TIME", "THERMOSTAT_OPTIONS",
@@ -58,7 +59,7 @@ def _whole_number(value, what: str, minimum: int, accepted: str) -> int:
     except TypeError:
         raise TypeError(f"{what} must be a whole number, got {value!r}; {accepted}") from None
     if n < minimum:
-        raise ValueError(f"{what} must be >= {minimum}, got {n}; {accepted}")
+        raise InputError(f"{what} must be >= {minimum}, got {n}; {accepted}")
     return int(n)
 
 
@@ -67,7 +68,7 @@ def check_interval(interval) -> int:
     accepted = f"give the number of steps between thermostat events, from 1 (every step) to {MAX_INTERVAL}"
     n = _whole_number(interval, "thermostat_interval", 1, accepted)
     if n > MAX_INTERVAL:
-        raise ValueError(f"thermostat_interval must be at most {MAX_INTERVAL} (the native plugin holds it in a 32-bit "
+        raise InputError(f"thermostat_interval must be at most {MAX_INTERVAL} (the native plugin holds it in a 32-bit "
                          f"integer; an interval that long is an NVE run: drop temperature= for one), got {n}")
     return n
 
@@ -77,7 +78,7 @@ def check_seed(seed) -> int:
     n = _whole_number(seed, "random_seed", 0, f"give an integer from 0 (a fresh seed for every Context) "
                                               f"to {MAX_SEED}")
     if n > MAX_SEED:
-        raise ValueError(f"random_seed must be at most {MAX_SEED} (OpenMM takes a 32-bit seed), got {n}")
+        raise InputError(f"random_seed must be at most {MAX_SEED} (OpenMM takes a 32-bit seed), got {n}")
     return n
 
 
@@ -173,7 +174,7 @@ def thermostat_settings(system, *, temperature=None, collision_time=None, thermo
                                           ("random_seed", random_seed),
                                           ("thermostat_position", thermostat_position)) if value is not None]
         if given:
-            raise ValueError(f"{', '.join(given)} {'was' if len(given) == 1 else 'were'} given without temperature: "
+            raise InputError(f"{', '.join(given)} {'was' if len(given) == 1 else 'were'} given without temperature: "
                              f"{'it sets' if len(given) == 1 else 'they set'} up the thermostat, which only runs with "
                              f"temperature= (e.g. temperature=300*unit.kelvin); drop "
                              f"{'it' if len(given) == 1 else 'them'} for an NVE run")
@@ -184,13 +185,13 @@ def thermostat_settings(system, *, temperature=None, collision_time=None, thermo
     seed = check_seed(0 if random_seed is None else random_seed)
     position = check_position(DEFAULT_POSITION if thermostat_position is None else thermostat_position)
     if system is None:
-        raise ValueError("temperature= needs system= (the System the integrator will run): the thermostat's "
+        raise InputError("temperature= needs system= (the System the integrator will run): the thermostat's "
                          "degrees of freedom and whether the rotation is kept come from it")
     check_system_type(system)
     isolated = system_is_isolated(system)
     dof = thermostat_degrees_of_freedom(system, isolated)
     if dof <= 0:
-        raise ValueError(
+        raise InputError(
             f"no degrees of freedom to thermostat: the System has {system.getNumParticles()} particle(s) and "
             f"{system.getNumConstraints()} constraint(s), which leaves {dof} degrees of freedom once the "
             f"centre-of-mass velocity{' and the rigid rotation (isolated System)' if isolated else ''} are kept "

@@ -28,6 +28,7 @@ from ..physics.temperature import R_KJ
 from ..physics.velocity_rescaling import ROUNDOFF
 from .projection import emit_inertia, emit_rigid_solve
 from .thermostat import ThermostatSettings
+from ..support.errors import InputError
 
 __all__ = ["PREFIX", "LOST_MASK_VAR", "TEMPERATURE_VAR", "COLLISION_TIME_VAR", "HEAT_BATH_VAR", "MASK_VAR", "ALPHA_VAR",
            "KINETIC_VAR", "NEW_KINETIC_VAR", "add_variables", "emit_event", "mask_values",
@@ -105,7 +106,7 @@ def mask_values(masses, dof: int) -> list:
                     ones -= 1
         out.append(mm.Vec3(*row))
     if ones:
-        raise ValueError(f"the System's particles with mass have fewer than {dof - 1} degrees of freedom")
+        raise InputError(f"the System's particles with mass have fewer than {dof - 1} degrees of freedom")
     return out
 
 

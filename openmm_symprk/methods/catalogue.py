@@ -18,6 +18,7 @@ import numpy as np
 
 from .splitting import DRIFT, KICK, Splitting, compose
 from .tableau import PRKTableau
+from ..support.errors import InputError
 
 FAMILIES = ("splitting", "composition", "implicit", "reference")
 #: The Hamiltonians a method's order holds for: any separable H = T(p) + V(q), or only those with a quadratic
@@ -25,7 +26,7 @@ FAMILIES = ("splitting", "composition", "implicit", "reference")
 HAMILTONIANS = ("separable", "quadratic-kinetic")
 
 
-class UnknownMethodError(KeyError, ValueError):
+class UnknownMethodError(KeyError, InputError):
     """An integrator name that is not in the catalogue."""
 
     def __str__(self):  # KeyError quotes its message; show it plainly.

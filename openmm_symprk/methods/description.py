@@ -17,6 +17,7 @@ from .catalogue import get_method
 from .resolved import ResolvedMethod
 from .splitting import Splitting
 from .tableau import PRKTableau
+from ..support.errors import InputError
 
 __all__ = ["describe", "from_description"]
 
@@ -49,4 +50,4 @@ def from_description(description: dict):
         t = description["tableau"]
         return PRKTableau(t["A"], t["b"], t["A_hat"], t["b_hat"], name=description.get("name"),
                           dtype=np.dtype(description.get("dtype", "float64")))
-    raise ValueError(f"not the description of a method (keys catalogue, splitting or tableau): {description!r}")
+    raise InputError(f"not the description of a method (keys catalogue, splitting or tableau): {description!r}")

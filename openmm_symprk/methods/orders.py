@@ -10,13 +10,15 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..support.errors import InputError
+
 
 def observed_orders(states, steps):
     """(orders, differences) from final states computed with the step counts ``steps`` (increasing).
 
     ``differences[k]`` = max |states[k] - states[k+1]|; one order estimate per consecutive triple."""
     if len(states) != len(steps) or len(steps) < 3:
-        raise ValueError(f"need at least three states, one per step count; got {len(states)} states for "
+        raise InputError(f"need at least three states, one per step count; got {len(states)} states for "
                          f"step counts {list(steps)}")
     ys = [np.asarray(y, dtype=np.longdouble).ravel() for y in states]
     diffs = np.array([float(np.max(np.abs(a - b))) for a, b in zip(ys, ys[1:])])

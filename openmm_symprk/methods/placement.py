@@ -20,6 +20,8 @@ from fractions import Fraction
 
 import numpy as np
 
+from ..support.errors import InputError
+
 __all__ = ["THERMOSTAT", "POSITIONS", "PLACEMENT_TEXT", "check_position", "centre", "with_thermostat", "harmonic_sampling", "placement_errors",
            "best_position", "H_OMEGA_GRID", "middle_placement_advice", "MEASURED_MIDDLE"]
 
@@ -41,7 +43,7 @@ def check_position(position) -> str:
     naming the accepted values otherwise.  The one check of a placement, for the integrators' option and
     :func:`openmm_symprk.methods.resolved.resolve` alike."""
     if not isinstance(position, str) or position not in POSITIONS:
-        raise ValueError(f"thermostat_position must be one of {', '.join(map(repr, POSITIONS))}, got {position!r}")
+        raise InputError(f"thermostat_position must be one of {', '.join(map(repr, POSITIONS))}, got {position!r}")
     return position
 
 
@@ -50,7 +52,7 @@ def centre(steps) -> int:
     in.  ValueError for a sequence that does not read the same backwards: its centre in time is not one point."""
     steps = [(label, Fraction(c)) for label, c in steps]
     if len(steps) % 2 == 0 or steps != steps[::-1]:
-        raise ValueError("the thermostat can only sit in the middle of a symmetric (self-adjoint) step, whose "
+        raise InputError("the thermostat can only sit in the middle of a symmetric (self-adjoint) step, whose "
                          "sequence reads the same backwards; this one does not (use thermostat_position='ends')")
     return len(steps) // 2
 
@@ -66,7 +68,7 @@ def with_thermostat(steps, position: str) -> list:
         i = centre(steps)
         label, c = steps[i]
         return [*steps[:i], (label, c / 2), (THERMOSTAT, Fraction(1)), (label, c / 2), *steps[i + 1:]]
-    raise ValueError(f"thermostat position must be 'ends' or 'middle', got {position!r}")
+    raise InputError(f"thermostat position must be 'ends' or 'middle', got {position!r}")
 
 
 def harmonic_sampling(steps, h_omega: float, decay: float = 0.5, forced=None) -> tuple:
@@ -81,7 +83,7 @@ def harmonic_sampling(steps, h_omega: float, decay: float = 0.5, forced=None) ->
     step's end: <v^2> is what a State's on-step velocities read.  ValueError when the step is unstable at h_omega
     (no stationary distribution)."""
     if not 0.0 < decay < 1.0:
-        raise ValueError(f"decay must lie strictly between 0 and 1, got {decay!r}")
+        raise InputError(f"decay must lie strictly between 0 and 1, got {decay!r}")
     x = float(h_omega)
     A, Q = np.eye(2), np.zeros((2, 2))
     for label, c in steps:
@@ -99,7 +101,7 @@ def harmonic_sampling(steps, h_omega: float, decay: float = 0.5, forced=None) ->
             continue  # a kick of a force group the oscillator does not feel
         A, Q = M @ A, M @ Q @ M.T + noise
     if max(abs(np.linalg.eigvals(A))) >= 1.0:
-        raise ValueError(f"the step is not stable at h*omega = {x:g}: no stationary distribution")
+        raise InputError(f"the step is not stable at h*omega = {x:g}: no stationary distribution")
     # S = A S A^T + Q, as (I - A (x) A) vec(S) = vec(Q): a 4x4 solve
     S = np.linalg.solve(np.eye(4) - np.kron(A, A), Q.reshape(4)).reshape(2, 2)
     return float(S[0, 0]), float(S[1, 1])

@@ -15,9 +15,10 @@ from .orders import observed_orders
 from .resolved import resolve
 from .splitting import KICK, Splitting
 from .tableau import PRKTableau
+from ..support.errors import SymprkError
 
 
-class ConvergenceError(RuntimeError):
+class ConvergenceError(SymprkError, RuntimeError):
     """The fixed-point iteration of an implicit method did not converge."""
 
 

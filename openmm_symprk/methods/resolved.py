@@ -40,6 +40,7 @@ from .placement import THERMOSTAT, best_position, centre, check_position
 from .respa import MTSError, evaluations_per_step, label_groups, levels, mts_groups, respa
 from .splitting import DRIFT, KICK, Splitting
 from .tableau import PRKTableau, TableauError
+from ..support.errors import InputError
 
 __all__ = ["resolve", "thermostat_position_for", "ResolvedMethod", "Substep", "substep_label", "SubstepKind", "SubstepFlag", "EventPhase",
            "ConstraintSupportError", "projected_drifts", "FORMS"]
@@ -84,7 +85,7 @@ class EventPhase(IntEnum):
         return 0 if self is EventPhase.FIRST else (n - 1 if self is EventPhase.LAST else (n - 1) // 2)
 
 
-class ConstraintSupportError(ValueError):
+class ConstraintSupportError(InputError):
     """The method cannot be used on a system with constraints."""
 
 
@@ -332,13 +333,13 @@ def resolve(method, constraints: bool | None = False, groups=None, inner_method=
         if where == "ends":
             return replace(plain, substeps=_with_end_events(plain.substeps), thermostat_position="ends")
         if not plain.is_splitting:
-            raise ValueError(f"thermostat_position='middle' needs a kick/drift method, whose step has a centre "
+            raise InputError(f"thermostat_position='middle' needs a kick/drift method, whose step has a centre "
                              f"sub-step; {plain.name!r} is a general ({plain.family or plain.form}) PRK tableau: use "
                              f"thermostat_position='ends' (or 'auto')")
         try:
             substeps = _with_middle_thermostat(plain.substeps, plain.constraints)
-        except ValueError as exc:
-            raise ValueError(f"{plain.name}: {exc}") from None
+        except InputError as exc:
+            raise InputError(f"{plain.name}: {exc}") from None
         return replace(plain, substeps=substeps, thermostat_position="middle")
     entry, splitting, tableau = _normalise(method)
     form = _form(splitting, tableau)
@@ -347,7 +348,7 @@ def resolve(method, constraints: bool | None = False, groups=None, inner_method=
     if tableau is None and set(splitting.labels) <= {KICK, DRIFT}:
         tableau = PRKTableau.from_splitting(splitting, name=name)
     if inner_method is not None and groups is None:
-        raise ValueError("inner_method= needs groups= (the force groups of the levels of multiple time stepping)")
+        raise InputError("inner_method= needs groups= (the force groups of the levels of multiple time stepping)")
     constrained = splitting is not None if constraints is None else bool(constraints)
     if constrained and splitting is None:
         raise ConstraintSupportError(

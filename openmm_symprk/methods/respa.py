@@ -19,13 +19,14 @@ from dataclasses import dataclass
 from fractions import Fraction
 
 from .splitting import DRIFT, KICK, Splitting
+from ..support.errors import InputError
 
 __all__ = ["Level", "MTSError", "kick_label", "label_groups", "mts_groups", "levels", "respa", "evaluations_per_step"]
 
 KICK_PREFIX = KICK + ":"
 
 
-class MTSError(ValueError):
+class MTSError(InputError):
     """A malformed multiple-time-step specification (the message names the bad entry)."""
 
 

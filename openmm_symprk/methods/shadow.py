@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..support.errors import InputError
 from .placement import THERMOSTAT, with_thermostat
 
 __all__ = ["coefficients", "event_coefficients", "nvt_temperatures", "shadow_target"]
@@ -54,7 +55,7 @@ def coefficients(steps) -> tuple:
     def read(x):
         a = _map(steps, x)
         if not abs(a[0, 0] - a[1, 1]) < 1e-9:
-            raise ValueError("the sequence is not symmetric about its start (its map's diagonal differs: "
+            raise InputError("the sequence is not symmetric about its start (its map's diagonal differs: "
                              f"{a[0, 0]!r}, {a[1, 1]!r}); read it at a point of symmetry")
         c = (np.arccos(np.clip(0.5 * np.trace(a), -1.0, 1.0)) / x - 1.0) / x ** 2
         d = (-a[0, 1] / a[1, 0] - 1.0) / x ** 2

@@ -17,6 +17,8 @@ from typing import Iterable, Sequence
 
 import numpy as np
 
+from ..support.errors import InputError
+
 KICK = "kick"
 DRIFT = "drift"
 
@@ -31,10 +33,10 @@ def exact(value) -> Fraction:
         try:
             return Fraction(value.strip())
         except ValueError:
-            raise ValueError(f"coefficient {value!r} is not a number") from None
+            raise InputError(f"coefficient {value!r} is not a number") from None
     value = float(value)
     if not np.isfinite(value):
-        raise ValueError(f"coefficient {value!r} is not finite")
+        raise InputError(f"coefficient {value!r} is not finite")
     return Fraction(value)
 
 
@@ -62,7 +64,7 @@ class Splitting:
     def __init__(self, steps: Iterable):
         merged = merge((label, exact(c)) for label, c in steps)
         if not merged:
-            raise ValueError("a splitting needs at least one sub-flow with a non-zero coefficient")
+            raise InputError("a splitting needs at least one sub-flow with a non-zero coefficient")
         object.__setattr__(self, "steps", tuple(merged))
 
     # -- views --------------------------------------------------------------------------
@@ -150,10 +152,10 @@ def compose(base: Splitting, weights: Sequence) -> Splitting:
     sequences and rigid-body sub-flows alike)."""
     ws = [exact(w) for w in weights]
     if not ws:
-        raise ValueError("composition weights must not be empty")
+        raise InputError("composition weights must not be empty")
     total = sum(ws, Fraction(0))
     if total != 1 and abs(float(total) - 1.0) > 1e-15:
-        raise ValueError(f"composition weights must sum to 1, got {float(total)!r}")
+        raise InputError(f"composition weights must sum to 1, got {float(total)!r}")
     seq = []
     for w in ws:
         seq.extend((label, w * c) for label, c in base.steps)

@@ -18,12 +18,13 @@ from typing import Sequence
 import numpy as np
 
 from .splitting import DRIFT, KICK, Splitting, exact, to_dtype
+from ..support.errors import InputError
 
 #: residual of (6) below which a tableau counts as symplectic (float64 data)
 SYMPLECTIC_TOL = 1e-12
 
 
-class TableauError(ValueError):
+class TableauError(InputError):
     """A tableau that is malformed, inconsistent or not symplectic."""
 
 

@@ -12,6 +12,8 @@ from typing import NamedTuple
 
 import numpy as np
 
+from ..support.errors import InputError
+
 __all__ = ["centre_of_mass", "linear_momentum", "angular_momentum", "inertia_tensor", "kinetic_energy",
            "reference_point", "MoleculeFrames", "molecule_frames"]
 
@@ -25,7 +27,7 @@ def centre_of_mass(x, m) -> np.ndarray:
     x, m = _arrays(x, m)
     total = m.sum()
     if not total > 0:
-        raise ValueError("the particles have no mass (all massless): no centre of mass")
+        raise InputError("the particles have no mass (all massless): no centre of mass")
     return (m[:, None] * x).sum(axis=0) / total
 
 
@@ -36,10 +38,10 @@ def reference_point(x, m, about) -> np.ndarray:
             return centre_of_mass(x, m)
         if about == "origin":
             return np.zeros(3)
-        raise ValueError(f"about must be 'com', 'origin' or a point (nm), got {about!r}")
+        raise InputError(f"about must be 'com', 'origin' or a point (nm), got {about!r}")
     point = np.asarray(about, dtype=np.float64)
     if point.shape != (3,):
-        raise ValueError(f"about must be 'com', 'origin' or a point of 3 coordinates (nm), got {about!r}")
+        raise InputError(f"about must be 'com', 'origin' or a point of 3 coordinates (nm), got {about!r}")
     return point
 
 

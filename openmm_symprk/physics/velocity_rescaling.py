@@ -30,6 +30,7 @@ from typing import NamedTuple
 import numpy as np
 
 from .momenta import angular_momentum, centre_of_mass, inertia_tensor, kinetic_energy, linear_momentum
+from ..support.errors import InputError
 
 __all__ = ["thermostat_dof", "relaxation_factor", "rescaling_factor", "draw_noise", "Resampled", "resample",
            "kept_velocities", "peculiar_kinetic_energy", "ROUNDOFF", "no_peculiar_motion"]
@@ -59,7 +60,7 @@ def thermostat_dof(n_massive: int, n_constraints: int, isolated: bool) -> int:
 def relaxation_factor(interval: float, collision_time: float) -> float:
     """c = exp(-interval / collision_time) (both in ps); 0 for an infinitely strong coupling."""
     if not interval >= 0 or not collision_time > 0:
-        raise ValueError(f"need interval >= 0 and collision_time > 0 (ps), got {interval!r}, {collision_time!r}")
+        raise InputError(f"need interval >= 0 and collision_time > 0 (ps), got {interval!r}, {collision_time!r}")
     return math.exp(-interval / collision_time)
 
 
@@ -84,7 +85,7 @@ def rescaling_factor(kinetic: float, target: float, dof: int, c: float, r1: floa
 def draw_noise(rng: np.random.Generator, dof: int) -> tuple:
     """(R1, S): a standard normal and a chi-squared variable of dof - 1 degrees of freedom (2 Gamma((dof-1)/2))."""
     if dof < 1:
-        raise ValueError(f"the thermostat needs at least one degree of freedom, got {dof}")
+        raise InputError(f"the thermostat needs at least one degree of freedom, got {dof}")
     r1 = float(rng.standard_normal())
     chi2 = 2.0 * float(rng.standard_gamma(0.5 * (dof - 1))) if dof > 1 else 0.0
     return r1, chi2

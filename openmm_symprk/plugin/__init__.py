@@ -20,6 +20,8 @@ import os
 
 import openmm as mm
 
+from ..support.errors import SymprkError
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 KERNEL_NAME = "IntegrateSymPRKStep"
 #: Kernel library per platform name ("Reference" also serves CPU, which derives from it).
@@ -31,7 +33,7 @@ __all__ = ["available", "unavailable_reason", "fix_hint", "platforms", "thermost
            "swig_module", "NativeUnavailableError", "KERNEL_NAME"]
 
 
-class NativeUnavailableError(RuntimeError):
+class NativeUnavailableError(SymprkError, RuntimeError):
     """The native plugin is not built or cannot be loaded here (the message says why and how to fix it)."""
 
 

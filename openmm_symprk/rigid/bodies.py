@@ -30,6 +30,7 @@ from ..methods.resolved import resolve
 from ..methods.splitting import DRIFT, KICK, Splitting
 from ..physics.momenta import molecule_frames
 from .lie_poisson import splitting_of
+from ..support.errors import InputError
 
 __all__ = ["RigidBodies", "rigid_body_state"]
 
@@ -41,7 +42,7 @@ def rigid_body_state(x, v, m, molecules):
     fr = molecule_frames(x, v, m, molecules)
     moments, Q = np.linalg.eigh(fr.inertia)
     if np.any(moments[:, 0] <= 1e-8 * moments[:, 2]):
-        raise ValueError("a molecule is linear (a zero principal moment): this engine needs 3 rotational "
+        raise InputError("a molecule is linear (a zero principal moment): this engine needs 3 rotational "
                          "degrees of freedom per molecule")
     Q[np.linalg.det(Q) < 0, :, 2] *= -1.0
     body = np.einsum("nji,nkj->nki", Q, fr.r)  # b = Q^T r
@@ -60,10 +61,10 @@ class RigidBodies:
     def __init__(self, system: mm.System, positions, velocities, molecules, step_ps: float, method: str = "verlet",
                  platform="CPU", properties=None):
         if not step_ps > 0:
-            raise ValueError(f"step_ps must be positive, got {step_ps!r}")
+            raise InputError(f"step_ps must be positive, got {step_ps!r}")
         resolved = resolve(method)  # rigidity is exact: no constraint steps
         if not resolved.is_splitting or set(resolved.splitting.labels) - {KICK, DRIFT}:
-            raise ValueError(f"method {method!r} is not a kick/drift splitting; use one of "
+            raise InputError(f"method {method!r} is not a kick/drift splitting; use one of "
                              f"{', '.join(m.name for m in catalogue_methods.by_family('splitting'))}")
         self.method, self.h = resolved.name, float(step_ps)
         self.splitting: Splitting = resolved.splitting
@@ -71,11 +72,11 @@ class RigidBodies:
         self.m = np.array([system.getParticleMass(i).value_in_unit(unit.dalton) for i in range(system.getNumParticles())])
         self.idx = np.asarray(molecules, dtype=int)
         if self.idx.ndim != 2 or np.any(self.m[self.idx] <= 0):
-            raise ValueError("molecules must all have the same number of atoms, all with mass")
+            raise InputError("molecules must all have the same number of atoms, all with mass")
         covered = np.zeros(len(self.m), dtype=bool)
         covered[self.idx.ravel()] = True
         if not covered.all():
-            raise ValueError(f"{int((~covered).sum())} particles are in no molecule: every particle must be in one")
+            raise InputError(f"{int((~covered).sum())} particles are in no molecule: every particle must be in one")
         x = np.asarray(positions, dtype=np.float64)
         v = np.asarray(velocities, dtype=np.float64)
         self.X, V, self.Q, self.body, self.moments, self.pi = rigid_body_state(x, v, self.m, self.idx)

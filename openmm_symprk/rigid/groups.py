@@ -46,6 +46,7 @@ import openmm as mm
 import openmm.unit as unit
 
 from ..physics import momenta
+from ..support.errors import InputError
 
 __all__ = ["RigidGroupError", "RigidGroupWarning", "RigidGroup", "make_rigid", "plan_rigid_group", "positions_nm",
            "ANGLE_FORCE_NAME"]
@@ -54,7 +55,7 @@ __all__ = ["RigidGroupError", "RigidGroupWarning", "RigidGroup", "make_rigid", "
 ANGLE_FORCE_NAME = "RigidGroupConstraintAngles"
 
 
-class RigidGroupError(ValueError):
+class RigidGroupError(InputError):
     """A group of atoms that cannot be made rigid as asked."""
 
 
@@ -102,9 +103,9 @@ def positions_nm(positions) -> np.ndarray:
         else:
             pos = np.array([[float(c) for c in row] for row in positions])
     except (TypeError, ValueError):
-        raise ValueError("positions must be an (N, 3) array of nm or a Quantity of positions") from None
+        raise InputError("positions must be an (N, 3) array of nm or a Quantity of positions") from None
     if pos.ndim != 2 or pos.shape[1] != 3 or not np.all(np.isfinite(pos)):
-        raise ValueError(f"positions must be a finite (N, 3) array (nm), got shape {pos.shape}")
+        raise InputError(f"positions must be a finite (N, 3) array (nm), got shape {pos.shape}")
     return pos
 
 
@@ -304,10 +305,10 @@ def make_rigid(system: mm.System, positions, groups, virtual_sites: bool = False
     pos = positions_nm(positions)
     n_part = system.getNumParticles()
     if len(pos) != n_part:
-        raise ValueError(f"positions has {len(pos)} rows but the System has {n_part} particles")
+        raise InputError(f"positions has {len(pos)} rows but the System has {n_part} particles")
     groups = [list(g) for g in groups]
     if not groups:
-        raise ValueError("no groups given")
+        raise InputError("no groups given")
     seen: dict = {}
     for gi, g in enumerate(groups):
         for a in g:

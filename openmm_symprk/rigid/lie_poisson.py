@@ -48,7 +48,7 @@ from ..methods.catalogue import UnknownMethodError, normalise_name
 from ..methods.catalogue import methods as catalogue_methods
 from ..methods.resolved import resolve
 from ..methods.splitting import Splitting, compose
-from ..support import require
+from ..support import InputError, require
 
 __all__ = [
     "METHODS", "RigidBodyMethod", "rigid_body_method", "euler_rhs", "energy", "casimir", "integrate", "step",
@@ -108,11 +108,11 @@ def rigid_body_method(method) -> RigidBodyMethod:
             f"{catalogue_methods.suggest(method, among=_EULER_CATALOGUE, extra=[*EULER_METHODS, *COMPOSITION_NAMES])}"
             f" Known methods: {', '.join(METHODS)}.") from None
     except TypeError:
-        raise ValueError(f"method must be a name (one of {', '.join(METHODS)}) or a catalogue method, got "
+        raise InputError(f"method must be a name (one of {', '.join(METHODS)}) or a catalogue method, got "
                          f"{method!r}") from None
     if entry is None or not _runs_on_euler(entry):
         what = "a user method" if entry is None else f"the catalogue's {entry.name!r} ({entry.family})"
-        raise ValueError(f"{what} has no rigid-body form: Euler's equations run {', '.join(EULER_METHODS)}, the "
+        raise InputError(f"{what} has no rigid-body form: Euler's equations run {', '.join(EULER_METHODS)}, the "
                          f"catalogue's compositions (over splitting-2) and explicit reference methods (rk4)")
     if entry.family == "composition":
         return RigidBodyMethod(shown or entry.name, entry.order, True,
@@ -135,7 +135,7 @@ def _splitting(info: RigidBodyMethod) -> Splitting:
     if info.name == "splitting-2":
         return SPLITTING_2
     if not info.lie_poisson or info.catalogue is None:
-        raise ValueError(f"method {info.name!r} is not a splitting of Euler's equations")
+        raise InputError(f"method {info.name!r} is not a splitting of Euler's equations")
     return compose(SPLITTING_2, catalogue_methods[info.catalogue].weights)
 
 
@@ -148,18 +148,18 @@ def splitting_of(method) -> Splitting:
 def _check_moments(moments) -> np.ndarray:
     m = np.asarray(moments, dtype=float)
     if m.shape != (3,):
-        raise ValueError(f"moments must be 3 principal moments of inertia, got shape {m.shape}")
+        raise InputError(f"moments must be 3 principal moments of inertia, got shape {m.shape}")
     if not np.all(np.isfinite(m)) or np.any(m <= 0):
-        raise ValueError(f"principal moments of inertia must be finite and positive, got {m.tolist()}")
+        raise InputError(f"principal moments of inertia must be finite and positive, got {m.tolist()}")
     return m
 
 
 def _check_x(x0) -> np.ndarray:
     x = np.asarray(x0, dtype=float)
     if x.shape != (3,):
-        raise ValueError(f"x0 must be a body angular momentum vector of shape (3,), got shape {x.shape}")
+        raise InputError(f"x0 must be a body angular momentum vector of shape (3,), got shape {x.shape}")
     if not np.all(np.isfinite(x)):
-        raise ValueError(f"x0 must be finite, got {x.tolist()}")
+        raise InputError(f"x0 must be finite, got {x.tolist()}")
     return x
 
 
@@ -331,9 +331,9 @@ def integrate(x0, moments, h, n_steps, method="splitting-2") -> np.ndarray:
     m = _check_moments(moments)
     h = float(h)
     if not (math.isfinite(h) and h > 0):
-        raise ValueError(f"step size h must be positive and finite, got {h!r}")
+        raise InputError(f"step size h must be positive and finite, got {h!r}")
     if isinstance(n_steps, bool) or int(n_steps) != n_steps or n_steps < 0:
-        raise ValueError(f"n_steps must be a non-negative integer, got {n_steps!r}")
+        raise InputError(f"n_steps must be a non-negative integer, got {n_steps!r}")
     n_steps = int(n_steps)
     info = rigid_body_method(method)
     if info.name == "rattle-1":
@@ -371,7 +371,7 @@ def exact_solution(x0, moments, times) -> np.ndarray:
     M = _check_moments(moments)
     t = np.atleast_1d(np.asarray(times, dtype=float))
     if t.ndim != 1:
-        raise ValueError(f"times must be a 1-D array of times, got shape {t.shape}")
+        raise InputError(f"times must be a 1-D array of times, got shape {t.shape}")
     out = np.empty((t.size, 3))
     if not np.any(x0):
         out[:] = 0.0

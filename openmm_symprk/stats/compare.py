@@ -13,6 +13,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..support.errors import InputError
+
 __all__ = ["Estimate", "combine", "paired", "difference", "agrees", "no_larger"]
 
 
@@ -39,9 +41,9 @@ def combine(means, ses) -> Estimate:
     ses = np.asarray(ses, dtype=np.float64)
     r = len(means)
     if r == 0:
-        raise ValueError("no replicas to combine")
+        raise InputError("no replicas to combine")
     if len(ses) != r:
-        raise ValueError(f"{r} means but {len(ses)} standard errors")
+        raise InputError(f"{r} means but {len(ses)} standard errors")
     within = float(np.sqrt((ses ** 2).sum()) / r)
     between = float(means.std(ddof=1) / np.sqrt(r)) if r > 1 else float("nan")
     se = within if not np.isfinite(between) else max(within, between)

@@ -31,6 +31,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..support.errors import InputError
+
 __all__ = ["Family", "fit", "fit_c", "bootstrap", "equal_accuracy_step", "FrontierPoint", "frontier", "compare"]
 
 
@@ -52,12 +54,12 @@ class Family:
     def __post_init__(self):
         steps = np.asarray(self.steps, dtype=float)
         if steps.ndim != 1 or not len(steps) or not np.all(steps > 0):
-            raise ValueError(f"{self.name}: steps must be a non-empty list of positive steps, got {self.steps!r}")
+            raise InputError(f"{self.name}: steps must be a non-empty list of positive steps, got {self.steps!r}")
         for obs, b in self.bias.items():
             if np.shape(b)[0] != len(steps):
-                raise ValueError(f"{self.name}: {obs} has {np.shape(b)[0]} rows of biases for {len(steps)} steps")
+                raise InputError(f"{self.name}: {obs} has {np.shape(b)[0]} rows of biases for {len(steps)} steps")
         if not self.order >= 1:
-            raise ValueError(f"{self.name}: order must be >= 1, got {self.order!r}")
+            raise InputError(f"{self.name}: order must be >= 1, got {self.order!r}")
 
     @property
     def largest_step(self) -> float:
@@ -100,7 +102,7 @@ def fit(steps, bias, order: int, weights=None, intercept: bool = False) -> tuple
     w = 1.0 / se ** 2 if weights is None else np.asarray(weights, dtype=float)
     a, c = _solve(x, mean, w, intercept)
     if not np.isfinite(c):
-        raise ValueError("no row with a finite mean bias and a positive weight (need at least two replicas in a row"
+        raise InputError("no row with a finite mean bias and a positive weight (need at least two replicas in a row"
                          + (", and two steps for an intercept)" if intercept else ")"))
     return a, c
 

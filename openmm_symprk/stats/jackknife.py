@@ -13,6 +13,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..support.errors import InputError
+
 __all__ = ["jackknife"]
 
 
@@ -26,7 +28,7 @@ def jackknife(per_member, statistic, n_groups: int = 20):
     c = np.asarray(per_member, dtype=np.float64)
     n = c.shape[1] if c.ndim >= 2 else 0
     if n_groups < 2 or n < 2:
-        raise ValueError(f"the jackknife needs n_groups >= 2 and at least 2 members, got {n_groups} and {n}")
+        raise InputError(f"the jackknife needs n_groups >= 2 and at least 2 members, got {n_groups} and {n}")
     groups = np.array_split(np.arange(n), min(int(n_groups), n))
     total = c.sum(axis=1)
     value = statistic(total / n)

@@ -12,6 +12,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..support.errors import InputError
+
 __all__ = ["Moments", "power_sums", "correlation"]
 
 
@@ -37,7 +39,7 @@ class Moments:
         """From ``sums`` = (S1, S2, S3, S4) of (x - shift)^p over ``n`` >= 2 draws (:func:`power_sums`)."""
         n = int(n)
         if n < 2:
-            raise ValueError(f"moments need at least 2 draws, got {n}")
+            raise InputError(f"moments need at least 2 draws, got {n}")
         s1, s2, s3, s4 = (float(s) / n for s in sums)
         mu2 = s2 - s1 * s1
         mu4 = s4 - 4 * s1 * s3 + 6 * s1 * s1 * s2 - 3 * s1 ** 4

@@ -16,6 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .timeseries import statistical_inefficiency
+from ..support.errors import InputError
 
 __all__ = ["Drift", "drift", "RunningLine"]
 
@@ -42,14 +43,14 @@ def drift(t, y) -> Drift:
     t = np.asarray(t, dtype=np.float64)
     y = np.asarray(y, dtype=np.float64)
     if t.shape != y.shape or t.ndim != 1:
-        raise ValueError(f"t and y must be 1-d arrays of one length, got shapes {t.shape} and {y.shape}")
+        raise InputError(f"t and y must be 1-d arrays of one length, got shapes {t.shape} and {y.shape}")
     n = len(t)
     if n < 3:
-        raise ValueError(f"a drift needs at least 3 samples, got {n}")
+        raise InputError(f"a drift needs at least 3 samples, got {n}")
     tc = t - t.mean()
     sxx = float(tc @ tc)
     if not sxx > 0:
-        raise ValueError("a drift needs samples at more than one time")
+        raise InputError("a drift needs samples at more than one time")
     slope = float(tc @ (y - y.mean())) / sxx
     resid = y - y.mean() - slope * tc
     g = statistical_inefficiency(resid)

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..support import require
+from ..support import InputError, require
 
 __all__ = ["statistical_inefficiency", "SeriesStats", "series_stats", "block_stats", "equilibrated_from", "pymbar_timeseries"]
 
@@ -64,7 +64,7 @@ def series_stats(x, dt: float = 1.0) -> SeriesStats:
     """Mean, its standard error and the integrated correlation time of a series sampled every ``dt``."""
     x = np.asarray(x, dtype=np.float64)
     if len(x) < 2:
-        raise ValueError(f"a series needs at least 2 samples, got {len(x)}")
+        raise InputError(f"a series needs at least 2 samples, got {len(x)}")
     g = statistical_inefficiency(x)
     return SeriesStats(float(x.mean()), float(x.std(ddof=1) * np.sqrt(g / len(x))), 0.5 * g * dt, len(x), g)
 
@@ -78,10 +78,10 @@ def block_stats(x, n_blocks: int, dt: float = 1.0) -> SeriesStats:
     ``tau`` are the ones the block error implies (n se^2 / var)."""
     x = np.asarray(x, dtype=np.float64)
     if int(n_blocks) != n_blocks or n_blocks < 2:
-        raise ValueError(f"n_blocks must be an integer >= 2, got {n_blocks!r}")
+        raise InputError(f"n_blocks must be an integer >= 2, got {n_blocks!r}")
     n_blocks = int(n_blocks)
     if len(x) < 2 * n_blocks:
-        raise ValueError(f"{n_blocks} blocks need at least {2 * n_blocks} samples, got {len(x)}")
+        raise InputError(f"{n_blocks} blocks need at least {2 * n_blocks} samples, got {len(x)}")
     blocks = x[:len(x) - len(x) % n_blocks].reshape(n_blocks, -1).mean(axis=1)
     se = float(blocks.std(ddof=1) / np.sqrt(n_blocks))
     var = float(x.var(ddof=1))

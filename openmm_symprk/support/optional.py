@@ -10,14 +10,16 @@ same table as :data:`EXTRAS`)::
     pip install 'openmm_symprk[all]'        # analysis + studies
 
 A module that needs one imports it through :func:`require`, which returns the module or raises
-:class:`MissingDependencyError` (an ImportError) saying which feature needs which package and which extra
-installs it::
+:class:`MissingDependencyError` (an ImportError, and a :class:`~.errors.SymprkError`: the command prints it as
+one line) saying which feature needs which package and which extra installs it::
 
     mda = require("MDAnalysis", "analysis", "openmm_symprk.analysis.universe")
 """
 from __future__ import annotations
 
 import importlib
+
+from .errors import SymprkError
 
 #: The pip requirement of each optional top-level module.
 PACKAGES = {"MDAnalysis": "MDAnalysis", "scipy": "scipy", "matplotlib": "matplotlib", "tqdm": "tqdm",
@@ -32,7 +34,7 @@ EXTRAS = {
 EXTRAS["all"] = tuple(dict.fromkeys(EXTRAS["analysis"] + EXTRAS["studies"]))
 
 
-class MissingDependencyError(ImportError):
+class MissingDependencyError(SymprkError, ImportError):
     """An optional package a feature needs is missing (or fails to import).  ``package`` is its pip
     requirement, ``extra`` the extra of openmm_symprk that installs it, ``feature`` what needed it."""
 

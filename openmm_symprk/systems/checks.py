@@ -13,6 +13,7 @@ import warnings
 import openmm as mm
 
 from .properties import force_names, frozen_particles, virtual_sites
+from ..support.errors import InputError
 
 #: Force classes that act as a thermostat, barostat or velocity editor.
 THERMOSTAT_FORCES = ("AndersenThermostat", "MonteCarloBarostat", "MonteCarloAnisotropicBarostat",
@@ -149,7 +150,7 @@ def validate_system(system, context: str, exact_momentum: bool = False, skip=())
     if exact_momentum:
         bad = [msg for key, msg in issues if key in EXACT_MOMENTUM_FORBIDDEN]
         if bad:
-            raise ValueError(
+            raise InputError(
                 "exact_momentum=True removes the net force and torque of every kick, which is only correct for "
                 "an isolated System (no periodic box, no frozen particles, no external field); here "
                 + " Also, ".join(bad) + " Use exact_momentum=False.")

@@ -8,6 +8,8 @@ from __future__ import annotations
 
 import openmm as mm
 
+from ..support.errors import InputError
+
 __all__ = ["force_groups", "check_groups", "split_forces", "NONBONDED_FORCES"]
 
 #: Forces that act between non-bonded pairs (the slow group of ``split_forces(slow="nonbonded")``).
@@ -43,12 +45,12 @@ def check_groups(system: mm.System, groups) -> None:
     uncovered = {g: names for g, names in present.items() if g not in wanted}
     if uncovered:
         what = "; ".join(f"group {g}: {', '.join(names)}" for g, names in sorted(uncovered.items()))
-        raise ValueError(f"groups={list(groups)} leaves forces out ({what}): every force group of the System needs a "
+        raise InputError(f"groups={list(groups)} leaves forces out ({what}): every force group of the System needs a "
                          f"(group, substeps) entry, or those forces would never act")
     empty = sorted(wanted - set(present))
     if empty:
         have = "; ".join(f"group {g}: {', '.join(n)}" for g, n in sorted(present.items()))
-        raise ValueError(f"force group(s) {', '.join(map(str, empty))} of groups={list(groups)} hold no force of the "
+        raise InputError(f"force group(s) {', '.join(map(str, empty))} of groups={list(groups)} hold no force of the "
                          f"System (its groups: {have})")
 
 
@@ -62,16 +64,16 @@ def split_forces(system: mm.System, slow="reciprocal", substeps: int = 2, fast_g
     costly part); "nonbonded" -- every non-bonded force (bonded terms fast); or a list of Force class names
     or force indices."""
     if isinstance(substeps, bool) or not isinstance(substeps, int) or substeps < 1:
-        raise ValueError(f"substeps must be a whole number >= 1, got {substeps!r}")
+        raise InputError(f"substeps must be a whole number >= 1, got {substeps!r}")
     if fast_group == slow_group or not (0 <= fast_group <= 31 and 0 <= slow_group <= 31):
-        raise ValueError(f"fast_group and slow_group must be two different groups from 0 to 31, got "
+        raise InputError(f"fast_group and slow_group must be two different groups from 0 to 31, got "
                          f"{fast_group} and {slow_group}")
     forces = [system.getForce(i) for i in range(system.getNumForces())]
     if slow == "reciprocal":
         pme = [f for f in forces if isinstance(f, mm.NonbondedForce) and f.getNonbondedMethod() in
                (mm.NonbondedForce.PME, mm.NonbondedForce.LJPME, mm.NonbondedForce.Ewald)]
         if not pme:
-            raise ValueError("slow='reciprocal' needs a NonbondedForce with PME, LJPME or Ewald (this System has no "
+            raise InputError("slow='reciprocal' needs a NonbondedForce with PME, LJPME or Ewald (this System has no "
                              "reciprocal space); use slow='nonbonded' or name the slow forces")
         for f in forces:
             f.setForceGroup(fast_group)
@@ -84,22 +86,22 @@ def split_forces(system: mm.System, slow="reciprocal", substeps: int = 2, fast_g
             try:
                 names = list(slow)
             except TypeError:
-                raise ValueError(f"slow must be 'reciprocal', 'nonbonded' or a list of Force names or indices, "
+                raise InputError(f"slow must be 'reciprocal', 'nonbonded' or a list of Force names or indices, "
                                  f"got {slow!r}") from None
             known = {type(f).__name__ for f in forces}
             bad = [n for n in names if not (isinstance(n, int) and 0 <= n < len(forces)) and n not in known]
             if bad:
-                raise ValueError(f"slow forces {bad} are not in the System (it has {', '.join(sorted(known))}; "
+                raise InputError(f"slow forces {bad} are not in the System (it has {', '.join(sorted(known))}; "
                                  f"or give indices 0-{len(forces) - 1})")
             is_slow = [i in names or type(f).__name__ in names for i, f in enumerate(forces)]
         if not any(s and type(f).__name__ not in NOT_FORCES for f, s in zip(forces, is_slow)):
-            raise ValueError(f"no force of the System is slow under slow={slow!r} ({', '.join(NOT_FORCES[:2])} and "
+            raise InputError(f"no force of the System is slow under slow={slow!r} ({', '.join(NOT_FORCES[:2])} and "
                              f"barostats are not forces on the dynamics and belong to no group)")
         for f, s in zip(forces, is_slow):
             f.setForceGroup(slow_group if s else fast_group)
             if isinstance(f, mm.NonbondedForce):
                 f.setReciprocalSpaceForceGroup(-1)  # follows the force's own group
         if all(is_slow[i] for i, f in enumerate(forces) if type(f).__name__ not in NOT_FORCES):
-            raise ValueError(f"every force of the System is slow under slow={slow!r}: nothing is left for the inner "
+            raise InputError(f"every force of the System is slow under slow={slow!r}: nothing is left for the inner "
                              f"steps")
     return [(slow_group, 1), (fast_group, substeps)]

@@ -12,6 +12,7 @@ import numpy as np
 import openmm as mm
 import openmm.unit as unit
 
+from ..support.errors import InputError
 from .properties import degrees_of_freedom, masses
 
 __all__ = ["mean_square_frequency"]
@@ -49,7 +50,7 @@ def mean_square_frequency(system: mm.System, configurations, temperature: float,
     finally:
         del context
     if not n:
-        raise ValueError("no configuration given: <w^2> is an average over equilibrium configurations")
+        raise InputError("no configuration given: <w^2> is an average over equilibrium configurations")
     out = {"all": total / n / (n_f * kt), "configurations": n}
     if molecules is not None:
         n_trans = 3 * len(molecules)

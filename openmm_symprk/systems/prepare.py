@@ -9,6 +9,7 @@ import openmm.unit as unit
 from ..physics import centre_of_mass
 from ..physics.temperature import R_KJ
 from .properties import has_constraints, masses
+from ..support.errors import InputError
 
 __all__ = ["minimise", "constrain_velocities", "maxwell_boltzmann", "equilibrate", "without_net_momentum", "R_KJ"]
 
@@ -81,9 +82,9 @@ def without_net_momentum(velocities, m) -> np.ndarray:
     m = masses(m) if isinstance(m, mm.System) else np.asarray(m, dtype=np.float64)
     v = np.array(velocities, dtype=np.float64)
     if v.shape != (len(m), 3):
-        raise ValueError(f"velocities must have shape ({len(m)}, 3) (one per particle), got {v.shape}")
+        raise InputError(f"velocities must have shape ({len(m)}, 3) (one per particle), got {v.shape}")
     if not m.sum() > 0:
-        raise ValueError("no particle has mass: the total momentum cannot be set to zero")
+        raise InputError("no particle has mass: the total momentum cannot be set to zero")
     v -= (m[:, None] * v).sum(axis=0) / m.sum()
     v[m == 0] = 0.0
     return v

@@ -20,6 +20,7 @@ import openmm.unit as unit
 
 from ..physics.momenta import molecule_frames
 from .properties import masses
+from ..support.errors import InputError
 
 __all__ = ["repartition_hydrogen_mass", "rigid_velocities_for_masses"]
 
@@ -28,7 +29,7 @@ def repartition_hydrogen_mass(system: mm.System, topology: app.Topology, hydroge
     """A copy of ``system`` with every hydrogen bonded (in ``topology``) to a heavy atom at ``hydrogen_mass`` Da,
     the difference taken from that heavy atom.  ValueError when a heavy atom would be left with less than 1 Da."""
     if isinstance(hydrogen_mass, bool) or not 1.0 <= float(hydrogen_mass) <= 5.0:
-        raise ValueError(f"hydrogen_mass must be between 1 and 5 Da (HMR uses 1.5-4), got {hydrogen_mass!r}")
+        raise InputError(f"hydrogen_mass must be between 1 and 5 Da (HMR uses 1.5-4), got {hydrogen_mass!r}")
     out = mm.XmlSerializer.deserialize(mm.XmlSerializer.serialize(system))
     m = masses(system).copy()
     H = app.element.hydrogen
@@ -42,7 +43,7 @@ def repartition_hydrogen_mass(system: mm.System, topology: app.Topology, hydroge
         m[h.index] += delta
         m[heavy.index] -= delta
         if m[heavy.index] < 1.0:
-            raise ValueError(f"hydrogen mass {hydrogen_mass} Da leaves atom {heavy.index} ({heavy.name}) with "
+            raise InputError(f"hydrogen mass {hydrogen_mass} Da leaves atom {heavy.index} ({heavy.name}) with "
                              f"{m[heavy.index]:.2f} Da: use a smaller hydrogen mass")
     for i, mi in enumerate(m):
         out.setParticleMass(i, mi * unit.dalton)
@@ -59,7 +60,7 @@ def rigid_velocities_for_masses(x, v, m_old, m_new, molecules) -> np.ndarray:
     idx = np.asarray(molecules, dtype=int)
     old, new = molecule_frames(x, v, m_old, idx), molecule_frames(x, v, m_new, idx)
     if not np.allclose(old.M, new.M, rtol=1e-12, atol=0):
-        raise ValueError("the new masses change a molecule's total mass: repartition within each molecule")
+        raise InputError("the new masses change a molecule's total mass: repartition within each molecule")
     w_old = np.linalg.solve(old.inertia, old.L[..., None])[..., 0]
     w_new = np.einsum("nij,njk,nk->ni", _sym_power(new.inertia, -0.5), _sym_power(old.inertia, 0.5), w_old)
     out = v.copy()

@@ -1,6 +1,7 @@
 """The MDAnalysis analyses (openmm_symprk.analysis.universe) on trajectories this package did not write: they give
-the fidelity study's figures (openmm_symprk.studies.fidelity.observables on the same frames kept in memory), and agree with
-what others wrote on the same frames: MDAnalysis' EinsteinMSD, the waterdynamics MDAKit's
+the figures of the package's numpy analyses (openmm_symprk.analysis: diffusion, reorientation, angular, structure;
+openmm_symprk.stats for the temperatures) on the same frames kept in memory, as the fidelity study computes them, and
+agree with what others wrote on the same frames: MDAnalysis' EinsteinMSD, the waterdynamics MDAKit's
 WaterOrientationalRelaxation, transport-analysis' VelocityAutocorr and MDAnalysis' InterRDF."""
 import numpy as np
 import pytest
@@ -8,13 +9,13 @@ import pytest
 mda = pytest.importorskip("MDAnalysis")
 from MDAnalysis.coordinates.memory import MemoryReader  # noqa: E402
 
-from openmm_symprk.analysis import reorientation  # noqa: E402
+from openmm_symprk.analysis import angular, diffusion, reorientation, structure  # noqa: E402
 from openmm_symprk.analysis.angular import angular_velocities  # noqa: E402
 from openmm_symprk.analysis.molecules import centre_of_mass_trajectory  # noqa: E402
-from openmm_symprk.studies.fidelity.observables import observables  # noqa: E402
 from openmm_symprk.analysis.universe import (AngularVelocityCorrelation, KineticTemperatures,  # noqa: E402
                                              RadialDistribution, Reorientation, SelfDiffusion, find_waters)
 from openmm_symprk.physics.temperature import kinetic_temperatures  # noqa: E402
+from openmm_symprk.stats import series_stats  # noqa: E402
 
 pytestmark = [pytest.mark.filterwarnings("ignore::DeprecationWarning"),
               pytest.mark.filterwarnings("ignore:Reader has no dt"), pytest.mark.filterwarnings("ignore:Found no")]
@@ -37,20 +38,35 @@ def _in_memory(plain, velocities=True):
 
 
 @pytest.fixture(scope="module")
-def study(plain_water):
-    """The fidelity study's observables of the in-memory frames, computed as its runs compute them."""
+def figures(plain_water):
+    """The figures of the package's numpy analyses on the in-memory frames (continuous float64 positions and
+    velocities), with the settings of :data:`CFG`: ({name: [value, se]}, {curve name: array})."""
     p = plain_water
-    mols = p.molecules
+    mols, dt = p.molecules, p.dt
+    obs, curves = {}, {}
+    d = diffusion.self_diffusion(centre_of_mass_trajectory(p.x, p.masses, mols), dt, CFG["msd_window_ps"])
+    obs["D"], curves["msd"] = [d.D, d.se], d.msd
+    vectors = {"dip": reorientation.dipole_vectors(p.x, mols, p.charges),
+               "hh": reorientation.atom_vectors(p.x, mols, 1, 2)}
+    for key, u in vectors.items():
+        for order in (1, 2):
+            c, fit = reorientation.reorientation_time(u, order, dt, c_cut=CFG["tau_fit"][0], c_fit=CFG["tau_fit"][1])
+            obs[f"tau{order}_{key}"], curves[f"c{order}_{key}"] = [fit.tau, fit.se], c
+    omega = angular_velocities(p.x, p.v, p.masses, mols)
+    c, w = angular.omega_correlation(omega, dt, max(2, int(round(CFG["omega_max_lag_ps"] / dt))))
+    curves["omega_acf"] = c
+    obs.update(w_zero=[1000 * w.t_zero, 1000 * w.t_zero_se], w_min=[w.c_min, w.c_min_se],
+               w_int=[1000 * w.integral, 1000 * w.integral_se])
     temps = [kinetic_temperatures(x, v, p.masses, mols.tolist(), True, 3 * len(mols)) for x, v in zip(p.x, p.v)]
     t_trans, t_rot = np.array([[t.translational, t.rotational] for t in temps]).T
-    series = {"t": np.arange(len(p.x)) * p.dt, "T_trans": t_trans, "T_rot": t_rot, "pe": np.zeros(len(p.x)),
-              "etot": np.zeros(len(p.x)), "com": centre_of_mass_trajectory(p.x, p.masses, mols),
-              "dip": reorientation.dipole_vectors(p.x, mols, p.charges),
-              "hh": reorientation.atom_vectors(p.x, mols, 1, 2),
-              "oxygen": p.x[:, mols[:, 0]], "omega": angular_velocities(p.x, p.v, p.masses, mols),
-              "dt_omega": p.dt}
-    obs, curves, notes = observables(series, CFG, len(mols), p.box[0], False)
-    return obs, curves, notes
+    for key, series in (("T_trans", t_trans), ("dT", t_rot - t_trans)):
+        s = series_stats(series, dt)
+        obs[key] = [s.mean, s.se]
+    rdf = structure.radial_distribution(p.x[:, mols[:, 0]], p.box, 0.5 * p.box.min(), n_blocks=5)
+    peak = structure.first_peak(rdf, CFG["rdf_r_min_nm"])
+    obs.update(g_r=[peak.r, peak.r_se], g_h=[peak.height, peak.height_se])
+    curves["g_oo"] = rdf.g
+    return obs, curves
 
 
 def test_finds_the_waters_of_an_openmm_pdb(plain_water):
@@ -60,10 +76,10 @@ def test_finds_the_waters_of_an_openmm_pdb(plain_water):
     np.testing.assert_allclose(w.masses, plain_water.masses, rtol=1e-3)  # the PDB's element masses
 
 
-def test_self_diffusion_from_the_wrapped_dcd_is_the_study_figure(plain_water, study):
+def test_self_diffusion_from_the_wrapped_dcd_is_the_study_figure(plain_water, figures):
     """The DCD holds positions wrapped into the box in float32; made whole, unwrapped and fitted they give the
     study's D from the continuous float64 frames (the masses of the PDB's elements move the centres by < 1e-4)."""
-    obs, curves, _ = study
+    obs, curves = figures
     u = _dcd(plain_water)
     d = SelfDiffusion(u, CFG["msd_window_ps"], masses=plain_water.masses, error="molecules").run()
     assert d.results.D == pytest.approx(obs["D"][0], rel=2e-4)
@@ -88,8 +104,8 @@ def test_yeh_hummer_correction_is_added_for_a_cubic_box(plain_water):
     assert d.results.D_infinite == pytest.approx(d.results.D + d.results.correction)
 
 
-def test_reorientation_times_are_the_study_figures(plain_water, study):
-    obs, curves, _ = study
+def test_reorientation_times_are_the_study_figures(plain_water, figures):
+    obs, curves = figures
     r = Reorientation(_dcd(plain_water), c_cut=CFG["tau_fit"][0], c_fit=CFG["tau_fit"][1]).run()
     assert r.results.dipole_from == "bisector"  # a PDB has no charges: SPC/E's dipole lies on the bisector
     for name, key in (("dipole", "dip"), ("HH", "hh")):
@@ -101,8 +117,8 @@ def test_reorientation_times_are_the_study_figures(plain_water, study):
     assert 0.5 < r.results.tau["OH"]["tau2"].tau < 5.0
 
 
-def test_angular_velocity_correlation_is_the_study_figure(plain_water, study):
-    obs, curves, _ = study
+def test_angular_velocity_correlation_is_the_study_figure(plain_water, figures):
+    obs, curves = figures
     lag = int(round(CFG["omega_max_lag_ps"] / plain_water.dt))
     a = AngularVelocityCorrelation(_in_memory(plain_water), max_lag=lag, masses=plain_water.masses).run()
     s = a.results.summary
@@ -112,8 +128,8 @@ def test_angular_velocity_correlation_is_the_study_figure(plain_water, study):
     assert s.c_min == pytest.approx(obs["w_min"][0], rel=1e-3)
 
 
-def test_kinetic_temperatures_are_the_study_figures(plain_water, study):
-    obs, _, _ = study
+def test_kinetic_temperatures_are_the_study_figures(plain_water, figures):
+    obs, _ = figures
     u = _in_memory(plain_water)
     k = KineticTemperatures(u.atoms, masses=plain_water.masses, by="residues", constraints=3 * 64,
                             n_blocks=None).run()
@@ -124,10 +140,10 @@ def test_kinetic_temperatures_are_the_study_figures(plain_water, study):
     assert blocks.results.se_translational > 0 and blocks.results.mean_translational == k.results.mean_translational
 
 
-def test_radial_distribution_is_the_study_figure_and_interrdf(plain_water, study):
+def test_radial_distribution_is_the_study_figure_and_interrdf(plain_water, figures):
     from MDAnalysis.analysis.rdf import InterRDF
 
-    obs, curves, _ = study
+    obs, curves = figures
     u = _dcd(plain_water)
     g = RadialDistribution(u, peak_from=10 * CFG["rdf_r_min_nm"]).run()
     # Angstrom (the study's nm); float32 moves pairs across bin edges, which moved the vertex by 1.5e-4 Angstrom

@@ -6,7 +6,7 @@
    draws fast enough, Var[chi2] = 2 (N_f - 1), E[r1] = 0, Var[r1] = 1, and no correlation of r1 with chi2 or of chi2
    between successive events (a reused or overlapping block of random numbers would show there).
 2. The stationary state of 1000 independent 3-d harmonic oscillators (Verlet, h w = 0.5, both placements; ``symprk nvt
-   known`` prints both tables, :mod:`openmm_symprk.studies.nvt.known`): the
+   known`` prints both tables; the case is :mod:`openmm_symprk.integrators.known_answers`): the
    configurational temperature k<q^2>/kT and the kinetic one at the thermostat point against their exact values
    (ends: 1/(1 - h^2 w^2/4) and 1; middle: 1 and 1), and native (Reference and OpenCL) equal to custom within
    3 combined standard errors (0.1 % for the kinetic temperature, 0.15 % for the configurational one).
@@ -23,7 +23,8 @@ import pytest
 from helpers import COMMON, native_skip_reason
 from openmm_symprk import SymplecticIntegrator, plugin
 from openmm_symprk.integrators.noise import sample_thermostat_noise
-from openmm_symprk.studies.nvt.known import OSCILLATORS, exact_temperatures, noise_draws, stationary_temperatures
+from openmm_symprk.integrators.known_answers import (OSCILLATORS, exact_temperatures, noise_draws,
+                                                   stationary_temperatures)
 
 pytestmark = pytest.mark.filterwarnings("ignore::openmm_symprk.systems.checks.ConservationWarning")
 

@@ -212,13 +212,12 @@ def test_production_scene_measures_drift_fluctuation_and_speed_against_a_baselin
 
 def test_run_keys_of_stored_sweeps_do_not_change():
     """``--resume`` finds a sweep's stored runs by their keys (the row's label, the rest of the spec, the scene's
-    fingerprint); the key the bench used from schema 3 until runs were keyed by their rows' labels is the spec's
-    legacy key, under which a sweep stored then is found."""
-    from openmm_symprk.studies.bench.store import legacy_key, run_key
+    fingerprint), which the one key function of the studies computes."""
+    from openmm_symprk.studies.bench.sweep import run_of
 
     spec = RunSpec("villin-pme", "verlet 2 fs", 12000, 240, "run", timing_s=4.0, threads=2)
-    assert legacy_key(spec, "0123456789abcdef") == "2fb18ad1d6637b608fd2"
-    assert run_key(spec, "0123456789abcdef") == "ef6722c8b8739bc91c96"
+    assert run_of(spec, "0123456789abcdef").key == "ef6722c8b8739bc91c96"
+    assert run_of(spec, "0123456789abcdee").key != "ef6722c8b8739bc91c96"  # another scene's state
 
 
 def test_stored_production_runs_are_summarised_with_the_current_estimator():
@@ -248,17 +247,19 @@ def test_stored_production_runs_are_summarised_with_the_current_estimator():
     assert rows[0]["matches"] and not rows[1]["matches"]  # 2e-5 kJ/mol/ps/DOF = 8e-3 kT/ns/DOF, many SE
 
 
-def test_runs_stored_before_rows_were_labels_keep_their_keys():
-    """A run is keyed by its row's label; the key the bench used before (its spec with the bench's name of the row
-    and the step apart) is the legacy key, so a sweep stored then is resumed, not rerun."""
-    from openmm_symprk.studies.bench.store import legacy_key, run_key
+def test_a_bench_run_is_keyed_by_its_row_label():
+    """A run of the bench is keyed by its row's label (the bench's name and the step written as one row), the rest of
+    its spec and its scene: rows that differ only by their inner method, their thermostat or their step are other
+    runs, a row written another way the same."""
     from openmm_symprk.studies.bench.runs import bench_row
-    from openmm_symprk.support.files import content_key
+    from openmm_symprk.studies.bench.sweep import run_of
 
     scene = scenes.build("harmonic", n=8)
     fp = scene.payload()["fingerprint"]
-    for name, h in (("openmm-langevin", 2.0), ("omelyan-2/verlet@mts2", 4.0), ("verlet", 300.0 / 1234)):
+    keys = {}
+    for name, h in (("openmm-langevin", 2.0), ("omelyan-2/verlet@mts2", 4.0), ("omelyan-2@mts2", 4.0),
+                    ("verlet", 300.0 / 1234), ("verlet", 2.0), ("velocity-verlet", 2.0)):
         spec = RunSpec("harmonic", bench_row(name, h, scene).label, 100, 10, timing_s=0.5)
-        old = {"scene": "harmonic", "method": name, "step_fs": h, "n_steps": 100, "n_samples": 10, "role": "run",
-               "platform": None, "timing_s": 0.5, "threads": 1, "seed": 1}
-        assert legacy_key(spec, fp) == content_key({"spec": old, "scene": fp}, length=20) != run_key(spec, fp)
+        keys[(name, h)] = run_of(spec, fp).key
+    assert keys[("verlet", 2.0)] == keys[("velocity-verlet", 2.0)]
+    assert len(set(keys.values())) == len(keys) - 1

@@ -166,3 +166,85 @@ def test_a_bug_keeps_its_traceback(monkeypatch, capsys):
     with pytest.raises(KeyError, match="a bug"):
         main(["methods"])
     assert capsys.readouterr().err == ""
+
+
+#: The fewest arguments each sub-command's parser takes (the others take none).
+MINIMAL_ARGS = {"check": ["tableau.json"], "observe": ["water.pdb", "water.dcd"], "drift": ["hmr"], "nvt": ["known"]}
+#: Exceptions of a bug's shape: no package error class, raised by Python itself or by a typo.
+BUGS = [ValueError("not enough values to unpack (expected 2, got 1)"),
+        ImportError("cannot import name 'nosuch' from 'openmm_symprk.stats'", name="openmm_symprk.stats")]
+
+
+def _raising(monkeypatch, name, exc):
+    """``symprk <name>``'s action raises ``exc`` once its options are parsed."""
+    import importlib
+
+    from openmm_symprk.cli import COMMANDS
+
+    def run(args):
+        assert args.command == name
+        raise exc
+
+    monkeypatch.setattr(importlib.import_module(COMMANDS[name].module), "run", run)
+    return [name, *MINIMAL_ARGS.get(name, [])]
+
+
+@pytest.mark.parametrize("bug", BUGS, ids=["ValueError", "ImportError"])
+def test_a_bug_keeps_its_traceback_in_every_sub_command(monkeypatch, capsys, bug):
+    """A ValueError or ImportError the package did not raise on purpose is a bug: it leaves the frame (Python prints
+    its traceback), under every sub-command, as much as a user's error stays one line and status 2."""
+    from openmm_symprk.cli import COMMANDS
+    from openmm_symprk.support import InputError, MissingDependencyError
+
+    monkeypatch.delenv("SYMPRK_DEBUG", raising=False)
+    for name in COMMANDS:
+        with pytest.raises(type(bug)) as info:
+            main(_raising(monkeypatch, name, bug))
+        assert info.value is bug, name
+        assert capsys.readouterr().err == "", name
+        for mistake in (InputError("--rows: unknown row 'verlett 2 fs'"),
+                        MissingDependencyError("a chart needs matplotlib", package="matplotlib", extra="studies",
+                                               feature="a chart")):
+            assert main(_raising(monkeypatch, name, mistake)) == 2, name
+            err = capsys.readouterr().err
+            assert err == f"symprk {name}: error: {mistake}\n", (name, err)
+
+
+def test_user_errors_are_the_ones_raised_on_purpose():
+    import openmm as mm
+
+    from openmm_symprk.cli import CommandError, is_user_error
+    from openmm_symprk.integrators import SimulationBlowUpError
+    from openmm_symprk.methods.catalogue import UnknownMethodError
+    from openmm_symprk.methods.tableau import TableauError
+    from openmm_symprk.plugin import NativeUnavailableError
+    from openmm_symprk.studies.core import FolderLockedError
+    from openmm_symprk.support import InputError
+
+    on_purpose = [InputError("x"), TableauError("x"), UnknownMethodError("x"), SimulationBlowUpError("x"),
+                  NativeUnavailableError("x"), FolderLockedError("x"), CommandError("x"),
+                  mm.OpenMMException("Called setPositions() with the wrong number of positions"),
+                  FileNotFoundError(2, "No such file or directory", "water.dcd")]
+    assert all(is_user_error(e) for e in on_purpose)
+    assert all(isinstance(e, ValueError) for e in on_purpose[:3])  # ``except ValueError`` still catches them
+    bugs = [ValueError("x"), ImportError("x"), KeyError("x"), TypeError("x"), RuntimeError("x"), OSError("x")]
+    assert not any(is_user_error(e) for e in bugs)
+
+
+@pytest.mark.parametrize("switch", ["--debug", "SYMPRK_DEBUG"])
+def test_debug_shows_a_user_errors_traceback(monkeypatch, capsys, switch):
+    from openmm_symprk.support import InputError
+
+    monkeypatch.delenv("SYMPRK_DEBUG", raising=False)
+    argv = _raising(monkeypatch, "methods", InputError("unknown method 'verlett'"))
+    if switch == "--debug":
+        argv.append("--debug")
+    else:
+        monkeypatch.setenv("SYMPRK_DEBUG", "1")
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("Traceback (most recent call last):") and "InputError: unknown method 'verlett'" in err
+    assert err.endswith("symprk methods: error: unknown method 'verlett'\n")
+    monkeypatch.setenv("SYMPRK_DEBUG", "0")
+    assert main(argv[:-1] if switch == "--debug" else argv) == 2
+    assert capsys.readouterr().err == "symprk methods: error: unknown method 'verlett'\n"

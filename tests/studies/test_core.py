@@ -8,7 +8,17 @@ import pytest
 
 from openmm_symprk.stats import paired, series_stats
 from openmm_symprk.studies.core import FolderLock, FolderLockedError, Run, RunStore, Study, write_json
-from openmm_symprk.support.files import content_key as run_key
+from openmm_symprk.studies.core.jobs import Job
+from openmm_symprk.studies.core.store import run_key as row_key
+
+SETTINGS = {"length_ps": 1.0}
+#: The toy's rows by name: a run is keyed by its row's label.
+LABELS = {"ref": "verlet 1 fs", "a": "verlet 2 fs", "b": "verlet 3 fs", "c": "verlet 5 fs", "broken": "verlet 4 fs"}
+
+
+def run_key(row, replica):
+    """The key of a toy run: the one key function, as every study's runs have it."""
+    return row_key(LABELS[row], replica, SETTINGS)
 
 
 def toy_work(shared, row, replica):
@@ -17,22 +27,21 @@ def toy_work(shared, row, replica):
         raise RuntimeError("this row always fails")
     rng = np.random.default_rng(1000 * replica + len(row))
     x = shared["offsets"][replica] + shared["shift"][row] + rng.normal(scale=0.1, size=200)
-    return {"x": x}, {"status": "ok"}
+    return {"x": x}, {"status": "ok", "mean": round(float(x.mean()), 6)}
 
 
 class ToyStudy(Study):
     command = "symprk toy"
     work = toy_work
 
-    def __init__(self, out, rows, replicas=4, legacy=False, **kw):
+    def __init__(self, out, rows, replicas=4, **kw):
         super().__init__(out, progress=False, log=lambda *a: None, **kw)
-        self.rows, self.replicas, self.calls, self.legacy = rows, replicas, 0, legacy
+        self.rows, self.replicas, self.calls = rows, replicas, 0
 
     def plan(self):
-        """Runs keyed by {row, replica}; ``legacy``: keyed by {row, replica, "form": 2}, the former key legacy."""
-        return [Run(run_key({"row": row, "replica": r, **({"form": 2} if self.legacy else {})}), "toy", (row, r),
-                    {"row": row, "replica": r}, cost=r, legacy=run_key({"row": row, "replica": r}) if self.legacy
-                    else None) for row in self.rows for r in range(self.replicas)]
+        """One run per row (a label) and replica."""
+        return [Run(LABELS[row], r, SETTINGS, "toy", (row, r), {"row": row, "replica": r}, cost=r)
+                for row in self.rows for r in range(self.replicas)]
 
     def shared(self, runs):
         self.calls += len(runs)
@@ -54,9 +63,9 @@ def test_a_study_runs_stores_reuses_and_pairs(tmp_path):
     # the replicas' offsets (5 units apart) cancel in the paired difference: 0.05 resolved, "a" matches
     assert res["b"].mean == pytest.approx(0.05, abs=0.02) and res["b"].se < 0.02
     assert abs(res["a"].mean) < 3 * res["a"].se
-    key = run_key({"row": "b", "replica": 2})
+    key = run_key("b", 2)
     with open(os.path.join(out, "runs", key + ".json")) as fh:
-        assert json.load(fh) == {"status": "ok", "row": "b", "replica": 2}
+        assert json.load(fh) == {"status": "ok", "mean": pytest.approx(-2.95, abs=0.05), "row": "b", "replica": 2}
     again = ToyStudy(out, ["ref", "a", "b"], replicas=5)  # one more replica per row: only those run
     res5 = again.run()
     assert again.calls == 3 and res5["b"].replicas == 5
@@ -68,8 +77,8 @@ def test_an_exception_in_a_run_stops_the_study_and_keeps_what_finished(tmp_path)
     with pytest.raises(RuntimeError, match="always fails"):
         ToyStudy(out, ["ref", "broken"], replicas=2).run()
     kept = RunStore(out).keys()
-    assert run_key({"row": "ref", "replica": 1}) in kept  # in flight beside the broken run, finished
-    assert not any(run_key({"row": "broken", "replica": r}) in kept for r in range(2))
+    assert run_key("ref", 1) in kept  # in flight beside the broken run, finished
+    assert not any(run_key("broken", r) in kept for r in range(2))
     res = ToyStudy(out, ["ref", "a"], replicas=2).run()  # the next call continues from what was kept
     assert res["a"].replicas == 2
 
@@ -104,22 +113,53 @@ def test_report_only_summarises_what_is_stored_runs_nothing_and_ignores_the_lock
         ToyStudy(out, ["a", "c"], replicas=2).run(report_only=True)
 
 
-def test_runs_stored_under_a_legacy_key_are_found_not_rerun(tmp_path):
-    """A study whose keys changed form finds the runs stored under the former keys (Run.legacy): reused by a run,
-    summarised by a report-only; only the runs missing under both keys run, stored under the new key."""
-    out = str(tmp_path / "toy")
-    first = ToyStudy(out, ["ref", "b"], replicas=2).run()
-    old = RunStore(out).keys()
-    study = ToyStudy(out, ["ref", "b"], replicas=3, legacy=True)
-    again = study.run()
-    assert study.calls == 2  # replica 2 of each row: the only runs stored under neither key
-    kept = RunStore(out).keys()
-    assert old <= kept and len(kept) == 6  # the four under their legacy keys, two under the new form
-    assert set(study.store.aliases.values()) == old
-    report = ToyStudy(out, ["ref", "b"], replicas=3, legacy=True)
-    res = report.run(report_only=True)
-    assert report.calls == 0 and res["b"].replicas == again["b"].replicas == 3 and first["b"].replicas == 2
-    assert res["b"].mean == pytest.approx(again["b"].mean)
+def test_a_run_is_its_row_replica_and_settings():
+    """A run's key is the one key function of its row (however the label is written), its replica, its settings and
+    its context: a change of any of them is another run."""
+    run = Run("verlet 2 fs", 3, {"length_ps": 1.0}, "toy", context={"version": 2})
+    assert run.key == row_key("verlet 2 fs", 3, {"length_ps": 1.0}, version=2) == \
+        Run("verlet  2 fs", 3, {"length_ps": 1.0}, "other", (1,), {"x": 1}, 5.0, {"version": 2}).key
+    others = [Run("verlet 1 fs", 3, {"length_ps": 1.0}, "toy", context={"version": 2}),
+              Run("verlet 2 fs", 2, {"length_ps": 1.0}, "toy", context={"version": 2}),
+              Run("verlet 2 fs", 3, {"length_ps": 2.0}, "toy", context={"version": 2}),
+              Run("verlet 2 fs", 3, {"length_ps": 1.0}, "toy", context={"version": 3})]
+    assert len({run.key} | {o.key for o in others}) == 5
+    assert len(Run("verlet 2 fs", None, {}, "toy", digits=20).key) == 20
+
+
+def search(row, replica):
+    """A job that runs ``row`` on replicas until one's mean exceeds 1 (each run chosen after the one before)."""
+    while True:
+        info = yield Run(LABELS[row], replica, SETTINGS, "toy", (row, replica), {"row": row, "replica": replica})
+        if info["mean"] > 1.0 or replica == 5:
+            return replica
+        replica += 1
+
+
+class SearchStudy(ToyStudy):
+    """Jobs that yield runs (the bench's stability searches), beside plain runs."""
+
+    def plan(self):
+        return [Run(LABELS["ref"], 0, SETTINGS, "toy", ("ref", 0), {"row": "ref", "replica": 0}),
+                Job(search("a", 0), kind="search")]
+
+    def execute(self, todo):
+        self.stats = super().execute(todo)
+        return self.stats
+
+    def summarise(self, planned):
+        return [p.result for p in planned if isinstance(p, Job)]
+
+
+def test_a_study_runs_jobs_that_pick_each_run_from_the_ones_before(tmp_path):
+    """Offsets 0, 5: the search stops at replica 1; called again, it replays its runs from the store."""
+    out = str(tmp_path / "search")
+    study = SearchStudy(out, [])
+    assert study.run() == [1] and len(RunStore(out)) == 3
+    assert study.stats == {"computed": 3, "reused": 0}  # the plain run and the search's two
+    again = SearchStudy(out, [])
+    assert again.run() == [1] and len(RunStore(out)) == 3
+    assert again.stats == {"computed": 0, "reused": 2}  # the search replayed from the store; the plain run skipped
 
 
 def test_json_is_written_atomically_and_plainly(tmp_path):

@@ -173,32 +173,22 @@ def test_cli_errors_name_the_bad_value(tmp_path, capsys):
         main(["energy"])
 
 
-def test_runs_stored_by_earlier_versions_are_found_by_their_legacy_keys(tmp_path):
-    """Rows are keyed by their labels now; a run's legacy key is the one earlier versions stored it under (the row as
-    integrator, step_fs, platform, precision and exact_momentum, and its label only where it says more), so those
-    runs are found again, and every row has a key of its own."""
-    from openmm_symprk.support.files import content_key
+def test_every_row_has_a_key_of_its_own_and_a_stored_run_is_reported(tmp_path):
+    """Rows are keyed by their labels, scenes, platforms and replica states: every row of a study has a key of its own,
+    and a run stored under its key is reported, not run again."""
     from openmm_symprk.studies.core import RunStore
-    from openmm_symprk.studies.drift.study import _RUN_KEYS, DriftStudy, legacy_key, run_key, states_key
+    from openmm_symprk.studies.drift.study import DriftStudy, run_of
 
-    cfg = presets.exact_momentum(quick=True, platforms=("CPU", "OpenCL:mixed"))
-    for row, (platform, precision, exact) in zip(cfg["rows"], [("CPU", None, False), ("CPU", None, True),
-                                                                ("OpenCL", "mixed", False), ("OpenCL", "mixed", True)]):
-        old = {"scene": "villin-vacuum", "integrator": "verlet", "step_fs": 2.0, "platform": platform,
-               "precision": precision, "exact_momentum": exact}
-        expected = content_key({"cfg": {k: cfg[k] for k in _RUN_KEYS}, "row": old, "replica": 1,
-                                "states": states_key(cfg, "villin-vacuum"), "version": 1})
-        assert legacy_key(cfg, row, 1) == expected != run_key(cfg, row, 1)
-    nvt = presets.nvt(quick=True)
-    keys = {run_key(nvt, row, 0) for row in nvt["rows"]} | {legacy_key(nvt, row, 0) for row in nvt["rows"]}
-    assert len(keys) == 2 * len(nvt["rows"])
-    # a run stored under its legacy key is reported, not run again
+    for cfg in (presets.exact_momentum(quick=True, platforms=("CPU", "OpenCL:mixed")), presets.nvt(quick=True),
+                presets.hmr(quick=True)):
+        keys = {run_of(cfg, row, r).key for row in cfg["rows"] for r in range(2)}
+        assert len(keys) == 2 * len(cfg["rows"])
     cfg = presets.exact_momentum(quick=True, platforms=("CPU",))
     cfg["replicas"] = 1
     study = DriftStudy(cfg, str(tmp_path), progress=False, log=lambda *a: None)
     row = cfg["rows"][0]
-    RunStore(str(tmp_path)).put(legacy_key(cfg, row, 0), {"status": "ok", "n_dof": 10, "wall_per_ps": 1.0,
-                                                           "row": row["name"], "replica": 0},
+    RunStore(str(tmp_path)).put(run_of(cfg, row, 0).key, {"status": "ok", "n_dof": 10, "wall_per_ps": 1.0,
+                                                         "row": row["name"], "replica": 0},
                                 {"t": np.arange(4.0), "e": np.array([0.0, 1.0, 2.0, 3.1])})
     summary = study.run(report_only=True)
     assert [r["replicas_done"] for r in summary["rows"]] == [1, 0]

@@ -81,14 +81,18 @@ def test_more_replicas_extend_the_study_and_reuse_every_finished_run(study):
 
 
 def test_a_changed_setting_does_not_reuse_runs():
-    from openmm_symprk.studies.equipartition.study import run_key
+    from openmm_symprk.studies.equipartition.study import run_of
+
+    def key(cfg, model, label, replica):
+        return run_of(cfg, model, label, replica).key
 
     cfg = _tiny()
     other = copy.deepcopy(cfg)
     other["length_ps"] = 0.1
-    assert run_key(cfg, "spce", "verlet 2 fs", 0) != run_key(other, "spce", "verlet 2 fs", 0)
-    assert run_key(cfg, "spce", "verlet 2 fs", 0) != run_key(cfg, "spce", "verlet 2 fs", 1)
-    assert run_key(cfg, "spce", "verlet 2 fs", 0) == run_key(cfg, "spce", "verlet:2", 0)  # one row, two spellings
+    assert key(cfg, "spce", "verlet 2 fs", 0) != key(other, "spce", "verlet 2 fs", 0)
+    assert key(cfg, "spce", "verlet 2 fs", 0) != key(cfg, "spce", "verlet 2 fs", 1)
+    assert key(cfg, "spce", "verlet 2 fs", 0) != key(cfg, "tip3p", "verlet 2 fs", 0)
+    assert key(cfg, "spce", "verlet 2 fs", 0) == key(cfg, "spce", "verlet:2", 0)  # one row, two spellings
 
 
 def test_samples_fall_on_steps():
@@ -127,28 +131,27 @@ def test_runs_on_a_dask_cluster(tmp_path):
 
 def test_run_keys_of_stored_studies_do_not_change():
     """A study's stored runs are found by their keys: a change of the key (or of what it hashes) orphans every
-    stored run, so a re-summary would rerun them all.  Runs are keyed by their rows' labels; the key the study used
-    from run version 3 (the box at 0.997 g/cm^3 and replica states with zero total momentum) to then, with the row as
-    [method, step], is its legacy key (version 2's was 6ad2710190f9cc83)."""
-    from openmm_symprk.studies.equipartition.study import legacy_key, run_key
+    stored run, so a re-summary would rerun them all.  Runs are keyed by their rows' labels (the key of run version
+    3, the box at 0.997 g/cm^3 and replica states with zero total momentum)."""
+    from openmm_symprk.studies.equipartition.study import run_of
 
-    assert legacy_key(presets.full(), "spce", "omelyan-2 4 fs", 3) == "3a5f658bbb3391cd"
-    assert run_key(presets.full(), "spce", "omelyan-2 4 fs", 3) == "404c7b31362732c3"
+    assert run_of(presets.full(), "spce", "omelyan-2 4 fs", 3).key == "404c7b31362732c3"
 
 
-def test_runs_stored_under_the_legacy_key_are_found(tmp_path):
-    """A run stored before rows were keyed by their labels (its info naming method and step) is read back as its
-    row's run; one of other settings is not."""
+def test_stored_runs_are_found_by_their_keys_beyond_the_replicas_asked_for(tmp_path):
+    """Every finished replica made with these settings is read back (also one beyond ``replicas``); a run of other
+    settings, or one stored under a key of another form (the row as [method, step], retired), is not."""
     import numpy as np
 
     from openmm_symprk.studies.core import RunStore
-    from openmm_symprk.studies.equipartition.study import legacy_key, load_runs
+    from openmm_symprk.studies.equipartition.study import load_runs, run_of
+    from openmm_symprk.support.files import content_key
 
     cfg, store = _tiny(), RunStore(str(tmp_path))
     arrays = {k: np.arange(3.0) for k in ("t", "T_trans", "T_rot", "pe", "etot")}
-    info = {"model": "spce", "method": "verlet", "step_fs": 2.0, "replica": 1, "status": "ok"}
-    store.put(legacy_key(cfg, "spce", "verlet 2 fs", 1), info, arrays)
-    other = dict(cfg, length_ps=1.0)
-    store.put(legacy_key(other, "spce", "verlet 2 fs", 0), dict(info, replica=0), arrays)
+    info = {"model": "spce", "row": "verlet 2 fs", "replica": 5, "status": "ok"}
+    store.put(run_of(cfg, "spce", "verlet 2 fs", 5).key, info, arrays)
+    store.put(run_of(dict(cfg, length_ps=1.0), "spce", "verlet 2 fs", 0).key, dict(info, replica=0), arrays)
+    store.put(content_key({"model": "spce", "row": ["verlet", 2.0], "replica": 1}), dict(info, replica=1), arrays)
     found = load_runs(cfg, str(tmp_path))
-    assert [i["replica"] for _, i in found[("spce", "verlet 2 fs")]] == [1] and not found[("spce", "verlet 0.5 fs")]
+    assert [i["replica"] for _, i in found[("spce", "verlet 2 fs")]] == [5] and not found[("spce", "verlet 0.5 fs")]

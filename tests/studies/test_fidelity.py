@@ -14,7 +14,7 @@ from openmm_symprk.cli import main as symprk
 from openmm_symprk.studies.fidelity.observables import OBSERVABLES
 from openmm_symprk.studies.fidelity.report import K_SE, summarise
 from openmm_symprk.studies.fidelity.rowspec import check_row, describe, label
-from openmm_symprk.studies.fidelity.simulation import run_key, run_study
+from openmm_symprk.studies.fidelity.simulation import run_of, run_study
 
 
 def main(argv):
@@ -245,6 +245,10 @@ def test_a_published_effect_is_claimed_only_beyond_three_standard_errors():
 
 
 # -- settings -------------------------------------------------------------------------------------------------------
+def run_key(cfg, row, replica):
+    return run_of(cfg, row, replica).key
+
+
 def test_run_keys_follow_every_setting_and_are_pinned():
     cfg = presets.full()
     row = "omelyan-2 4 fs"
@@ -563,5 +567,19 @@ def test_the_issue_26_study_is_kept_as_it_ran(tmp_path):
     from openmm_symprk.studies.fidelity import presets
     from openmm_symprk.studies.fidelity.simulation import run_study
 
-    with pytest.raises(ValueError, match="issue 26 study is kept as it ran.*--report-only.*--preset frontier"):
+    with pytest.raises(ValueError, match="match-3se study is kept as it ran.*--report-only.*--preset frontier"):
         run_study(presets.full(), str(tmp_path))
+
+
+def test_the_match_3se_preset_is_named_for_what_it_measures_and_reads_its_former_name(tmp_path, capsys):
+    """The default preset is ``match-3se`` (each row within 3 SE of the reference); ``--preset issue26``, its former
+    name, still reads as it with a note; it is kept as it ran, so only --report-only runs it."""
+    from openmm_symprk.studies.fidelity.cli import build_parser
+
+    assert build_parser().parse_args([]).preset == "match-3se"
+    assert build_parser().parse_args(["--preset", "issue26"]).preset == "match-3se"
+    assert "--preset issue26 is now called --preset match-3se" in capsys.readouterr().err
+    assert "issue" not in build_parser().format_help()
+    assert main(["--preset", "issue26", "--out", str(tmp_path / "new"), "--no-progress"]) == 2
+    err = capsys.readouterr().err.splitlines()
+    assert len(err) == 2 and "the match-3se study is kept as it ran" in err[1] and not (tmp_path / "new").exists()

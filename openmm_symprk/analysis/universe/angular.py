@@ -5,6 +5,7 @@ import numpy as np
 
 from .. import angular
 from .base import WaterFrames
+from ...support.errors import InputError
 
 __all__ = ["AngularVelocityCorrelation"]
 
@@ -27,7 +28,7 @@ class AngularVelocityCorrelation(WaterFrames):
                  masses=None, **kwargs):
         super().__init__(atomgroup, masses=masses, **kwargs)
         if frame not in ("space", "body"):
-            raise ValueError(f"frame must be 'space' or 'body', got {frame!r}")
+            raise InputError(f"frame must be 'space' or 'body', got {frame!r}")
         self._frame, self._max_lag, self._n_groups = frame, max_lag, n_groups
 
     def _analyse(self, x, v, box):

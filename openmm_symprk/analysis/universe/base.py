@@ -25,7 +25,7 @@ import inspect
 import numpy as np
 
 from ...conservation.analysis import group_masses
-from ...support import require
+from ...support import InputError, require
 from .checks import describe_steps, geometry_problem, time_steps, wrapped_problem
 
 AnalysisBase = require("MDAnalysis.analysis.base", "analysis", "openmm_symprk.analysis.universe").AnalysisBase
@@ -73,7 +73,7 @@ def find_waters(atomgroup, masses=None) -> Waters:
     except Exception as exc:  # noqa: BLE001 - a topology without masses: say so below
         if masses is not None:
             raise
-        raise ValueError(f"the topology has no masses ({exc}); pass masses=") from exc
+        raise InputError(f"the topology has no masses ({exc}); pass masses=") from exc
     in_group = np.zeros(atomgroup.universe.atoms.n_atoms, dtype=bool)
     in_group[atomgroup.indices] = True
     mols, sizes = [], set()
@@ -89,10 +89,10 @@ def find_waters(atomgroup, masses=None) -> Waters:
         sizes.add(len(idx))
     if not mols:
         names = sorted(set(atomgroup.residues.resnames))[:8]
-        raise ValueError(f"no water in the selection ({atomgroup.n_atoms} atoms, residues {', '.join(names)}): "
+        raise InputError(f"no water in the selection ({atomgroup.n_atoms} atoms, residues {', '.join(names)}): "
                          f"these analyses need water residues of one O and two H atoms (plus massless sites)")
     if len(sizes) != 1:
-        raise ValueError(f"the waters have different numbers of sites {sorted(sizes)}: analyse one water model "
+        raise InputError(f"the waters have different numbers of sites {sorted(sizes)}: analyse one water model "
                          f"at a time (select its residues)")
     flat = np.asarray(mols, dtype=int)
     atoms = atomgroup.universe.atoms[flat.ravel()]
@@ -151,14 +151,14 @@ class WaterFrames(AnalysisBase):
         self._x[i] = self.waters.atoms.positions
         if self._v is not None:
             if not ts.has_velocities:
-                raise ValueError(f"{type(self).__name__} needs velocities and frame {ts.frame} of the trajectory "
+                raise InputError(f"{type(self).__name__} needs velocities and frame {ts.frame} of the trajectory "
                                  f"has none (DCD, XTC and PDB store positions only: use a TRR, NetCDF or H5MD "
                                  f"trajectory written with velocities)")
             self._v[i] = self.waters.atoms.velocities
         dims = ts.dimensions
         if dims is not None and np.all(np.asarray(dims[:3]) > 0):
             if np.any(np.abs(np.asarray(dims[3:]) - 90.0) > 1e-3):
-                raise ValueError(f"frame {ts.frame} has a triclinic box (angles {np.round(dims[3:], 3).tolist()}): "
+                raise InputError(f"frame {ts.frame} has a triclinic box (angles {np.round(dims[3:], 3).tolist()}): "
                                  f"these analyses need an orthorhombic box")
             self._box[i] = dims[:3]
 
@@ -178,7 +178,7 @@ class WaterFrames(AnalysisBase):
         if problem is None:
             problem = geometry_problem(x[0], w.molecules, None if box is None else box[0], residues)
         if problem is not None:
-            raise ValueError(f"{type(self).__name__}: {problem}")
+            raise InputError(f"{type(self).__name__}: {problem}")
 
     def _conclude(self):
         x, v = self._x, self._v
@@ -195,10 +195,10 @@ class WaterFrames(AnalysisBase):
         """The time between analysed frames (ps); ValueError unless they are evenly spaced."""
         t = np.asarray(self.times, dtype=np.float64)
         if len(t) < 2:
-            raise ValueError(f"{type(self).__name__} needs at least 2 frames, got {len(t)}")
+            raise InputError(f"{type(self).__name__} needs at least 2 frames, got {len(t)}")
         dt, irregular = time_steps(t)
         if len(irregular):
-            raise ValueError(f"{describe_steps(t, irregular, self.frames)}: a time correlation needs a constant "
+            raise InputError(f"{describe_steps(t, irregular, self.frames)}: a time correlation needs a constant "
                              f"interval (analyse an evenly spaced piece: .run(start=, stop=))")
         return dt
 

@@ -6,6 +6,7 @@ import numpy as np
 from .. import diffusion
 from ..molecules import centre_of_mass_trajectory
 from .base import ANGSTROM_IN_NM, WaterFrames
+from ...support.errors import InputError
 
 __all__ = ["SelfDiffusion"]
 
@@ -47,9 +48,9 @@ class SelfDiffusion(WaterFrames):
                  temperature_k: float | None = None, masses=None, **kwargs):
         super().__init__(atomgroup, masses=masses, **kwargs)
         if error not in ("blocks", "molecules"):
-            raise ValueError(f"error must be 'blocks' or 'molecules', got {error!r}")
+            raise InputError(f"error must be 'blocks' or 'molecules', got {error!r}")
         if (viscosity_mpas is None) != (temperature_k is None):
-            raise ValueError("the Yeh-Hummer correction needs both viscosity_mpas and temperature_k")
+            raise InputError("the Yeh-Hummer correction needs both viscosity_mpas and temperature_k")
         self._options = dict(window_ps=window_ps, error=error, n_blocks=n_blocks, drift=drift, max_lag=max_lag)
         self._eta, self._temperature = viscosity_mpas, temperature_k
 
@@ -87,10 +88,10 @@ class SelfDiffusion(WaterFrames):
                    "timeseries": "Angstrom^2", "msds_by_particle": "Angstrom^2", "lag_ps": "ps", "window_ps": "ps"}
         if self._eta is not None:
             if box is None:
-                raise ValueError("the Yeh-Hummer correction needs the box: the trajectory has none")
+                raise InputError("the Yeh-Hummer correction needs the box: the trajectory has none")
             edge = box.mean(axis=0)
             if np.ptp(edge) > 0.01 * edge.mean():
-                raise ValueError(f"the Yeh-Hummer correction here is for a cubic box; the mean edges are "
+                raise InputError(f"the Yeh-Hummer correction here is for a cubic box; the mean edges are "
                                  f"{np.round(edge / ANGSTROM_IN_NM, 3).tolist()} Angstrom")
             r.correction = diffusion.yeh_hummer(float(edge.mean()), self._temperature, self._eta)
             r.D_infinite = fit.D + r.correction

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ...support import require
+from ...support import InputError, require
 from .base import find_waters
 from .checks import describe_steps, dt_problem, geometry_problem, longest_piece, time_steps, wrapped_problem
 
@@ -64,7 +64,7 @@ def open_universe(topology: str, trajectories):
                 warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
             return u
         gc.collect()  # the failed reader is freed here, under the quiet hook
-        raise ValueError(message)
+        raise InputError(message)
     finally:
         sys.unraisablehook = hook
 
@@ -130,16 +130,16 @@ def read_waters(universe, select=None, start=None, stop=None, step=None, progres
     tqdm = require("tqdm", "analysis", "symprk observe's progress bar").tqdm
 
     if dt is not None and not (np.isfinite(dt) and dt > 0):
-        raise ValueError(f"--dt must be a positive number of ps (the time between the trajectory's frames), got {dt}")
+        raise InputError(f"--dt must be a positive number of ps (the time between the trajectory's frames), got {dt}")
     if step is not None and (isinstance(step, bool) or int(step) != step or step < 1):
-        raise ValueError(f"--step must be a positive integer (read every step-th frame: 1 reads them all), got {step}")
+        raise InputError(f"--step must be a positive integer (read every step-th frame: 1 reads them all), got {step}")
     group = universe.select_atoms(select) if select else universe.atoms
     if select and group.n_atoms == 0:
-        raise ValueError(f"the selection {select!r} matches no atom")
+        raise InputError(f"the selection {select!r} matches no atom")
     waters = find_waters(group)
     frames = range(*slice(start, stop, step).indices(universe.trajectory.n_frames))
     if len(frames) < 2:
-        raise ValueError(f"{len(frames)} frame(s) selected: the observables need at least 2")
+        raise InputError(f"{len(frames)} frame(s) selected: the observables need at least 2")
     stores_times = _stores_times(universe.trajectory, frames[0])
     n = waters.atoms.n_atoms
     x = np.empty((len(frames), n, 3), dtype=np.float32)
@@ -166,7 +166,7 @@ def read_waters(universe, select=None, start=None, stop=None, step=None, progres
         if stores_times:
             problem, restarts = dt_problem(read_times, dt, frames)
             if problem is not None:
-                raise ValueError(problem)
+                raise InputError(problem)
             if restarts:
                 dt_from += (f"; the file's clock starts again at frame{'s' if len(restarts) > 1 else ''} "
                             f"{', '.join(str(f) for f in restarts[:5])}{' ...' if len(restarts) > 5 else ''}")
@@ -179,7 +179,7 @@ def read_waters(universe, select=None, start=None, stop=None, step=None, progres
     if len(irregular):
         first, stop = longest_piece(frames, irregular)
         restart = dt is None and bool(np.any(np.diff(times)[irregular] <= 0))
-        raise ValueError(f"{describe_steps(times, irregular, frames)}: a time correlation (MSD, reorientation) "
+        raise InputError(f"{describe_steps(times, irregular, frames)}: a time correlation (MSD, reorientation) "
                          f"over them would join what is not joined. Analyse one evenly spaced piece with "
                          f"--start/--stop (the longest: --start {first} --stop {stop})"
                          + (", or, if the frames do follow each other at one interval (a file whose clock starts "
@@ -195,7 +195,7 @@ def read_waters(universe, select=None, start=None, stop=None, step=None, progres
             box_from = f"{where} (for {int(missing.sum())} frames that store none)"
     box = None if np.isnan(dims[:, 0]).any() else dims
     if box is not None and np.any(np.abs(box[:, 3:] - 90.0) > 1e-3):
-        raise ValueError(f"the box is triclinic (angles {np.round(box[0, 3:], 3).tolist()}): these analyses need an "
+        raise InputError(f"the box is triclinic (angles {np.round(box[0, 3:], 3).tolist()}): these analyses need an "
                          f"orthorhombic box")
     residues = [f"residue {r.resname} {r.resid}" for r in waters.atoms[waters.molecules[:, 0]].residues]
     problem = None
@@ -207,7 +207,7 @@ def read_waters(universe, select=None, start=None, stop=None, step=None, progres
     if problem is None:
         problem = geometry_problem(x[0], waters.molecules, None if box is None else box[0, :3], residues)
     if problem is not None:
-        raise ValueError(problem)
+        raise InputError(problem)
     memory = mda.Merge(waters.atoms)
     memory.load_new(x, format=MemoryReader, velocities=v, dimensions=None if box is None else box.astype(np.float32),
                     dt=interval)

@@ -5,6 +5,7 @@ import numpy as np
 
 from .. import reorientation
 from .base import WaterFrames
+from ...support.errors import InputError
 
 __all__ = ["Reorientation", "VECTORS"]
 
@@ -34,7 +35,7 @@ class Reorientation(WaterFrames):
         super().__init__(atomgroup, masses=masses, **kwargs)
         bad = [v for v in vectors if v not in VECTORS] + [o for o in orders if o not in (1, 2)]
         if bad or not vectors or not orders:
-            raise ValueError(f"vectors must be among {VECTORS} and orders among (1, 2); got {list(vectors)}, "
+            raise InputError(f"vectors must be among {VECTORS} and orders among (1, 2); got {list(vectors)}, "
                              f"{list(orders)}")
         self._vectors, self._orders = tuple(vectors), tuple(orders)
         self._options = dict(max_lag=max_lag, c_cut=c_cut, c_fit=c_fit, n_groups=n_groups)

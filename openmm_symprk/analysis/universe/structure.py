@@ -5,6 +5,7 @@ import numpy as np
 
 from .. import structure
 from .base import ANGSTROM_IN_NM, WaterFrames
+from ...support.errors import InputError
 
 __all__ = ["RadialDistribution"]
 
@@ -29,17 +30,17 @@ class RadialDistribution(WaterFrames):
                  peak_from: float = 2.0, masses=None, **kwargs):
         super().__init__(atomgroup, masses=masses, **kwargs)
         if nbins is not None and (int(nbins) != nbins or nbins < 1):
-            raise ValueError(f"nbins must be a positive integer, got {nbins!r}")
+            raise InputError(f"nbins must be a positive integer, got {nbins!r}")
         if range is not None:
             lo, hi = (float(a) for a in range)
             if lo != 0.0 or not hi > 0:
-                raise ValueError(f"range must be (0, r_max) in Angstrom with r_max > 0 (g(r) is binned from 0), got "
+                raise InputError(f"range must be (0, r_max) in Angstrom with r_max > 0 (g(r) is binned from 0), got "
                                  f"{(lo, hi)}")
         self._nbins, self._range, self._n_blocks, self._peak_from = nbins, range, n_blocks, peak_from
 
     def _analyse(self, x, v, box):
         if box is None:
-            raise ValueError("RadialDistribution needs a periodic box: the trajectory has none")
+            raise InputError("RadialDistribution needs a periodic box: the trajectory has none")
         oxygen = x[:, self.waters.molecules[:, 0]]
         r_max = 0.5 * float(box.min()) / ANGSTROM_IN_NM if self._range is None else float(self._range[1])
         nbins = self._nbins if self._nbins is not None else max(1, int(np.floor(r_max / BIN_WIDTH + 1e-9)))

@@ -9,6 +9,7 @@ from ...physics.temperature import kinetic_temperatures
 from ...stats import block_stats, series_stats
 from ...support import require
 from .base import ANGSTROM_IN_NM, AnalysisBase, refuse_unknown_keywords
+from ...support.errors import InputError
 
 __all__ = ["KineticTemperatures", "WholeMolecules"]
 
@@ -67,7 +68,7 @@ class WholeMolecules:
                 try:
                     x[sel] = self._make_whole(self._ag[sel], inplace=False)
                 except ValueError as exc:  # its bonds do not connect it
-                    raise ValueError(f"{self._label(sel)} is split across the box and {exc}: give the topology "
+                    raise InputError(f"{self._label(sel)} is split across the box and {exc}: give the topology "
                                      f"all its bonds (or guess_bonds=True)") from None
         if len(self._loose):
             d = self._minimize(x[self._loose] - x[self._anchor], box)
@@ -75,7 +76,7 @@ class WholeMolecules:
             if far.any():
                 k = int(np.argmax(far))
                 site, first = self._ag[self._loose[k]].index, self._ag[self._anchor[k]].index
-                raise ValueError(f"atom {site} lies beyond {WHOLE_LIMIT} of a box edge from atom {first}, the first "
+                raise InputError(f"atom {site} lies beyond {WHOLE_LIMIT} of a box edge from atom {first}, the first "
                                  f"of {self._label(self._anchor[k])}: without bonds the molecule cannot be made "
                                  f"whole; give the topology its bonds (or guess_bonds=True)")
             x[self._loose] = x[self._anchor] + d
@@ -115,7 +116,7 @@ class KineticTemperatures(AnalysisBase):
         self._ag = atomgroup
         self._m = group_masses(atomgroup, masses)
         if by not in ("residues", "fragments", "segments"):
-            raise ValueError(f"by must be 'residues', 'fragments' or 'segments', got {by!r}")
+            raise InputError(f"by must be 'residues', 'fragments' or 'segments', got {by!r}")
         self._sub = [list(g) for g in subgroups(atomgroup, by)]
         self._whole = WholeMolecules(atomgroup, self._sub)
         self._fixed = momentum_fixed
@@ -123,7 +124,7 @@ class KineticTemperatures(AnalysisBase):
             constraints = masses.getNumConstraints()
         self._constraints = constraints or 0
         if n_blocks is not None and (int(n_blocks) != n_blocks or n_blocks < 2):
-            raise ValueError(f"n_blocks must be an integer >= 2 or None, got {n_blocks!r}")
+            raise InputError(f"n_blocks must be an integer >= 2 or None, got {n_blocks!r}")
         self._n_blocks = n_blocks
 
     def _prepare(self):
@@ -132,7 +133,7 @@ class KineticTemperatures(AnalysisBase):
 
     def _single_frame(self):
         if not self._ts.has_velocities:
-            raise ValueError(f"KineticTemperatures needs velocities and frame {self._ts.frame} of the trajectory "
+            raise InputError(f"KineticTemperatures needs velocities and frame {self._ts.frame} of the trajectory "
                              f"has none (DCD, XTC and PDB store positions only: use a TRR, NetCDF or H5MD "
                              f"trajectory written with velocities)")
         x = self._ag.positions

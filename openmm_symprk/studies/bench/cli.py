@@ -18,6 +18,7 @@ import os
 
 from ..core import platforms
 from ..core.options import positive
+from ...support.errors import InputError
 
 
 def _list(values):
@@ -33,12 +34,12 @@ def _list(values):
 def _check_out(out: str):
     """The output folder must be a folder we can write (not a file, not read-only)."""
     if os.path.exists(out) and not os.path.isdir(out):
-        raise ValueError(f"--out {out} is a file; give a folder for the sweep's results")
+        raise InputError(f"--out {out} is a file; give a folder for the sweep's results")
     parent = out
     while parent and not os.path.exists(parent):
         parent = os.path.dirname(parent)
     if not os.access(parent or ".", os.W_OK):
-        raise ValueError(f"--out {out}: {os.path.abspath(parent or '.')} is not writable")
+        raise InputError(f"--out {out}: {os.path.abspath(parent or '.')} is not writable")
 
 
 def build_parser(prog: str = "symprk bench") -> argparse.ArgumentParser:
@@ -106,10 +107,10 @@ def make_config(args) -> dict:
         try:
             steps = [float(h) for h in _list(args.steps_fs)]
         except ValueError:
-            raise ValueError(f"--steps-fs takes numbers of femtoseconds, got {' '.join(args.steps_fs)}") from None
+            raise InputError(f"--steps-fs takes numbers of femtoseconds, got {' '.join(args.steps_fs)}") from None
         bad = [h for h in steps if not h > 0]
         if bad:
-            raise ValueError(f"--steps-fs must be positive, got {', '.join(f'{h:g}' for h in bad)}")
+            raise InputError(f"--steps-fs must be positive, got {', '.join(f'{h:g}' for h in bad)}")
     if args.platform:
         platforms.check(args.platform)
     cfg = presets.select(base, scenes=scenes, methods=_list(args.methods), steps_fs=steps,
@@ -131,7 +132,7 @@ def run(args):
     if args.summary:
         path = os.path.join(out, "results.json")
         if not os.path.exists(path):
-            raise FileNotFoundError(f"no results in {out} (run 'symprk bench --out {out}' first)")
+            raise InputError(f"no results in {out} (run 'symprk bench --out {out}' first)")
         with open(path) as fh:
             print(format_summary(json.load(fh)))
         return

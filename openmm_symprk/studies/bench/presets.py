@@ -17,6 +17,8 @@ from __future__ import annotations
 
 import copy
 
+from ...support.errors import InputError
+
 
 #: The rows of the default sweep: OpenMM's integrators, then one method per cost/order class.
 DEFAULT_METHODS = ["openmm-verlet", "openmm-langevin", "verlet", "omelyan-2", "yoshida-4", "pefrl",
@@ -149,7 +151,7 @@ def select(config: dict, scenes=None, methods=None, steps_fs=None, length_ps=Non
             extra = {s: known[s] for s in unknown if s in SCENES}
             bad = [s for s in unknown if s not in extra]
             if bad:
-                raise ValueError(f"unknown scene(s) {', '.join(bad)}; known: {', '.join(SCENES)}")
+                raise InputError(f"unknown scene(s) {', '.join(bad)}; known: {', '.join(SCENES)}")
             cfg["scenes"].update(extra)
         cfg["scenes"] = {k: v for k, v in cfg["scenes"].items() if k in scenes}
     if methods:
@@ -175,5 +177,5 @@ def check(config: dict):
         for h in sorted({h for _, h in rows_of(config, name)}):
             n = sc["length_ps"] * 1e3 / h
             if abs(n - round(n)) > 1e-6 * n or round(n) < 1:
-                raise ValueError(f"scene {name}: step {h} fs does not divide the run length "
+                raise InputError(f"scene {name}: step {h} fs does not divide the run length "
                                  f"{sc['length_ps']} ps ({n:.3f} steps); choose steps that divide it")

@@ -11,13 +11,15 @@ from __future__ import annotations
 
 from dataclasses import asdict, dataclass, field, fields
 
+from ...support.errors import InputError
+
 #: Version of the JSON schema of run records, stability records and results.json.
 SCHEMA_VERSION = 3
 
 __all__ = ["SCHEMA_VERSION", "SchemaError", "RunRecord", "StabilityRecord"]
 
 
-class SchemaError(ValueError):
+class SchemaError(InputError):
     """A stored record of another schema version (or not a record of this bench at all)."""
 
 

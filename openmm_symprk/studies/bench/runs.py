@@ -44,6 +44,7 @@ from ..core.rows import Row
 from ..core.timing import time_rows
 from ..core.units import kT, kt_per_ns_per_dof
 from .records import RunRecord
+from ...support.errors import InputError
 
 #: Constraint tolerance for every run (SETTLE ignores it; CCMA iterates to it) ...
 CONSTRAINT_TOLERANCE = 1e-10
@@ -83,8 +84,7 @@ class RunSpec:
         return asdict(self)
 
     def record_fields(self) -> dict:
-        """The record's fields of the run (a row as the bench's name and its step): what a key hashed before runs
-        were keyed by their rows' labels."""
+        """The record's fields of the run: the spec with its row as the bench's name, its step and its seed."""
         row = self.spec_row
         out = {k: v for k, v in asdict(self).items() if k != "row"}
         return dict(out, method=bench_name(row), step_fs=row.step_fs, seed=row.seed)
@@ -130,8 +130,8 @@ def canonical_row(name: str) -> str:
     """The canonical name of a bench row (catalogue aliases resolved); ValueError naming what is accepted."""
     try:
         return bench_name(Row.parse(name, step_fs=1.0))
-    except ValueError as exc:
-        raise ValueError(f"{exc}. Bench rows are catalogue names, openmm-verlet, openmm-langevin, openmm-mts<n> "
+    except InputError as exc:
+        raise InputError(f"{exc}. Bench rows are catalogue names, openmm-verlet, openmm-langevin, openmm-mts<n> "
                          f"(OpenMM's MTSIntegrator) or <method>[/<inner>]@mts<n> (multiple time stepping)") from None
 
 
@@ -341,7 +341,7 @@ def retime(spec: RunSpec, scene: Scene, rec: RunRecord, rounds: int = TIMING_ROU
     measured untouched: for a sweep whose machine was busy while it ran (``symprk bench --retime``).  The
     paired VerletIntegrator is timed in turns with it, as in the run itself."""
     if not rec.wall_per_step:
-        raise ValueError(f"run {rec.method} at {rec.step_fs:g} fs on {rec.scene} has no timing to measure again "
+        raise InputError(f"run {rec.method} at {rec.step_fs:g} fs on {rec.scene} has no timing to measure again "
                          f"(status {rec.status!r})")
     eng = engine(spec.spec_row, scene, spec.platform or scene.platform, spec.threads)
     eng.step(2)  # warm up (kernels, force cache)

@@ -1,4 +1,5 @@
-"""Scenes x methods x step sizes, run in parallel and kept on disk as they finish.
+"""Scenes x methods x step sizes, run in parallel and kept on disk as they finish: the bench on the studies'
+skeleton (:class:`BenchStudy`, a :class:`~..core.study.Study`).
 
     from openmm_symprk.studies.bench import presets
     from openmm_symprk.studies.bench.sweep import run_sweep
@@ -6,9 +7,9 @@
 
 Jobs (:mod:`openmm_symprk.studies.core.jobs`, the machinery every study shares) are generators that yield
 :class:`~.runs.RunSpec` s and receive their records: a plain run is one spec; a stability search
-(:func:`~.stability.driver`) yields probe after probe.  Every record is stored
-(:class:`~.store.Store`) the moment it arrives, before anything else happens, so an interrupted sweep
-(Ctrl-C, a crash, a killed job) keeps every finished run; ``resume=True`` replays the jobs, takes every
+(:func:`~.stability.driver`) yields probe after probe; each spec is a run of the study (:func:`run_of`: its key).
+Every record is stored (:class:`~.store.Store`) the moment it arrives, before anything else happens, so an
+interrupted sweep (Ctrl-C, a crash, a killed job) keeps every finished run; ``resume=True`` replays the jobs, takes every
 stored record from disk instead of recomputing it (a stability search replays its probes in the same
 order, so it continues where it stopped) and submits only what is missing.  Runs whose record says
 "error" (an exception, not an integrator failure) are retried.
@@ -27,17 +28,17 @@ import os
 import time
 import warnings
 
-from ..core import FolderLock, FolderLockedError, progress_bar, write_json, write_text
-from ..core.executors import make_executor
-from ..core.jobs import Job, run_jobs, single
+from ..core import FolderLock, FolderLockedError, Run, Study, progress_bar, write_json, write_text
+from ..core.jobs import Job, single
 from . import presets
 from .records import RunRecord
 from ..core.rows import Row
 from .runs import RunSpec, bench_row, label
-from .store import Store, legacy_key, run_key
+from .store import Store
+from ...support.errors import InputError, SymprkError
 
 
-class SweepExistsError(FileExistsError):
+class SweepExistsError(SymprkError, FileExistsError):
     """The output folder already holds finished runs and resume was not asked for."""
 
 
@@ -140,30 +141,134 @@ def work(payload: dict, spec_dict: dict):
     return run_spec(RunSpec(**spec_dict), _scenes[key])
 
 
-def _key(store, spec, fingerprints) -> str:
-    """The run key of ``spec``, its run found under its legacy key where only that one is stored."""
-    key = run_key(spec, fingerprints[spec.scene])
-    store.adopt(key, legacy_key(spec, fingerprints[spec.scene]))
-    return key
+def run_of(spec: RunSpec, fingerprint: str) -> Run:
+    """The run of ``spec`` on a scene whose initial state has ``fingerprint``: keyed by the spec's row, the rest of
+    the spec and the fingerprint (20 hex digits), so a changed scene never reuses stale runs; executed by
+    :func:`work` on the scene's payload."""
+    settings = {k: v for k, v in spec.to_dict().items() if k != "row"}
+    return Run(spec.row, None, settings, spec.scene, (spec.to_dict(),), context={"scene": fingerprint}, digits=20)
 
 
-def _run_jobs(jobs, store, executor, fingerprints, progress=True, on_result=None):
-    def stored(spec):
-        rec = store.get(_key(store, spec, fingerprints))
+def _runs(gen, fingerprints: dict):
+    """The job ``gen`` (it yields RunSpecs and is sent their records) yielding the specs' runs instead."""
+    try:
+        spec = next(gen)
+        while True:
+            spec = gen.send((yield run_of(spec, fingerprints[spec.scene])))
+    except StopIteration as stop:
+        return stop.value
+
+
+class BenchStudy(Study):
+    """The sweep of ``config`` in ``out`` on the studies' skeleton: its jobs (runs, references, stability searches)
+    yield runs, stored as typed records (:class:`~.store.Store`); a record whose status is "error" (an exception,
+    not an integrator failure) is run again.  Without ``resume`` a folder that holds finished runs is refused
+    (:class:`SweepExistsError`)."""
+
+    command = "symprk bench"
+    locked_error = SweepLockedError
+    work = work
+
+    def __init__(self, config: dict, out: str, workers: int = 2, scheduler: str | None = None, resume: bool = False,
+                 charts: bool = True, progress: bool = True, on_result=None, log=print):
+        super().__init__(out, max(1, int(workers)), scheduler, progress, log)
+        self.config, self.resume, self.charts, self.on_result = config, resume, charts, on_result
+        self.scenes: dict = {}
+        self.payloads: dict = {}
+        self.stats = {"computed": 0, "reused": 0}
+
+    def open_store(self, create: bool = True) -> Store:
+        return Store(self.out, create=create)
+
+    def begin(self):
+        if not self.resume and len(self.store):
+            raise SweepExistsError(f"{self.out} already holds {len(self.store)} finished runs: pass resume=True "
+                                   f"(--resume) to continue that sweep, or choose another output folder")
+
+    def plan(self) -> list:
+        self.scenes = prepare_scenes(self.config, self.out, reuse=self.resume, log=self.log)
+        self.payloads = {name: sc.payload() for name, sc in self.scenes.items()}
+        fingerprints = {name: p["fingerprint"] for name, p in self.payloads.items()}
+        jobs = plan(self.config, self.scenes)
+        for job in jobs:
+            job.gen = _runs(job.gen, fingerprints)
+        return jobs
+
+    def shared(self, runs) -> dict:
+        return self.payloads
+
+    def reused(self, run):
+        rec = self.store.get(run.key)
         return None if rec is None or rec.status == "error" else rec
 
-    def finish(spec, fut):
-        key = _key(store, spec, fingerprints)
-        rec, arrays = _result(fut, spec)
-        store.put(key, rec, arrays)
-        return store.get(key)
+    def keep(self, run, future):
+        rec, arrays = _result(future, RunSpec(**run.args[0]))
+        self.store.put(run.key, rec, arrays)
+        rec = self.store.get(run.key)
+        if self.on_result is not None:
+            self.on_result(rec)
+        return rec
 
-    bar = progress_bar(sum(j.remaining for j in jobs), "bench", progress)
-    try:
-        return run_jobs(jobs, executor, stored, lambda ex, spec: ex.submit(spec.scene, spec.to_dict()), finish, bar,
-                        on_result)
-    finally:
-        bar.close()
+    def execute(self, todo: list) -> dict:
+        t0 = time.perf_counter()
+        try:
+            self.stats = super().execute(todo)
+        except KeyboardInterrupt:
+            self.log(f"interrupted: {len(self.store)} finished runs are kept in {self.out}; rerun with --resume to "
+                     f"continue")
+            raise
+        self.stats["seconds"] = time.perf_counter() - t0
+        return self.stats
+
+    def summarise(self, jobs: list) -> dict:
+        from .aggregate import aggregate, format_summary
+
+        results = aggregate(self.config, self.scenes, jobs, self.store)
+        results["stats"] = self.stats
+        results["out"] = self.out
+        write_json(os.path.join(self.out, "results.json"), results)
+        write_text(os.path.join(self.out, "summary.txt"), format_summary(results) + "\n")
+        if self.charts:
+            from .charts import make_charts
+
+            results["charts"] = make_charts(results, os.path.join(self.out, "charts"))
+            write_json(os.path.join(self.out, "results.json"), results)
+        self.log(f"{self.stats['computed']} runs computed, {self.stats['reused']} taken from {self.out}, "
+                 f"{self.stats.get('seconds', 0.0):.0f} s; results in {os.path.join(self.out, 'results.json')}")
+        return results
+
+    def retime(self, rounds: int = 3):
+        """Time every finished run with a timing again (:func:`.runs.retime`), one at a time in this process,
+        under the folder's lock."""
+        from .runs import retime
+
+        if not len(Store(self.out, create=False)):
+            raise InputError(f"{self.out} holds no finished runs to time again: run the sweep first")
+        lock = FolderLock(self.out, self.command, self.locked_error)
+        try:
+            self.store = self.open_store()
+            resume, self.resume = self.resume, True
+            try:
+                jobs = self.plan()
+            finally:
+                self.resume = resume
+            todo = []
+            for job in jobs:
+                if job.kind != "run":
+                    continue
+                run = next(job.gen)
+                spec, rec = RunSpec(**run.args[0]), self.store.get(run.key)
+                if rec is not None and rec.wall_per_step and spec.timing_s > 0:
+                    todo.append((spec, run.key, rec))
+            bar = progress_bar(len(todo), "retime", self.progress)
+            for spec, key, rec in todo:
+                retime(spec, self.scenes[spec.scene], rec, rounds)
+                self.store.put(key, rec, self.store.arrays(key) if rec.has_arrays else None)
+                bar.update(1)
+            bar.close()
+            self.log(f"timed {len(todo)} runs again")
+        finally:
+            lock.release()
 
 
 def _result(fut, spec):
@@ -185,12 +290,7 @@ def run_sweep(config: dict, out: str, workers: int = 2, scheduler: str | None = 
 
     Returns the results dict (see :func:`.aggregate.aggregate`), with ``stats`` = runs computed now and
     runs taken from disk."""
-    os.makedirs(out, exist_ok=True)
-    lock = FolderLock(out, "symprk bench", SweepLockedError)
-    try:
-        return _sweep(config, out, workers, scheduler, resume, charts, progress, on_result, log)
-    finally:
-        lock.release()
+    return BenchStudy(config, out, workers, scheduler, resume, charts, progress, on_result, log).run()
 
 
 def retime_sweep(config: dict, out: str, rounds: int = 3, workers: int = 1, charts: bool = True,
@@ -199,65 +299,5 @@ def retime_sweep(config: dict, out: str, rounds: int = 3, workers: int = 1, char
     VerletIntegrator, in turns, ``rounds`` rounds), one at a time in this process, keeping everything else
     each run measured; then continue the sweep as ``resume=True`` does and rewrite its results.  For a sweep
     that shared its machine with other work: the ratios are taken in turns, but heavy load still blurs them."""
-    from .runs import retime
-
-    if not os.path.isdir(os.path.join(out, "runs")) or not len(Store(out)):
-        raise ValueError(f"{out} holds no finished runs to time again: run the sweep first")
-    lock = FolderLock(out, "symprk bench", SweepLockedError)
-    try:
-        store = Store(out)
-        scenes = prepare_scenes(config, out, reuse=True, log=log)
-        fingerprints = {name: sc.payload()["fingerprint"] for name, sc in scenes.items()}
-        todo = []
-        for job in plan(config, scenes):
-            if job.kind != "run":
-                continue
-            spec = next(job.gen)
-            key = _key(store, spec, fingerprints)
-            rec = store.get(key)
-            if rec is not None and rec.wall_per_step and spec.timing_s > 0:
-                todo.append((spec, key, rec))
-        bar = progress_bar(len(todo), "retime", progress)
-        for spec, key, rec in todo:
-            retime(spec, scenes[spec.scene], rec, rounds)
-            store.put(key, rec, store.arrays(key) if rec.has_arrays else None)
-            bar.update(1)
-        bar.close()
-        log(f"timed {len(todo)} runs again")
-    finally:
-        lock.release()
+    BenchStudy(config, out, workers, resume=True, charts=charts, progress=progress, log=log).retime(rounds)
     return run_sweep(config, out, workers=workers, resume=True, charts=charts, progress=progress, log=log)
-
-
-def _sweep(config, out, workers, scheduler, resume, charts, progress, on_result, log) -> dict:
-    from .aggregate import aggregate, format_summary
-
-    store = Store(out)
-    if not resume and len(store):
-        raise SweepExistsError(f"{out} already holds {len(store)} finished runs: pass resume=True (--resume) to "
-                               f"continue that sweep, or choose another output folder")
-    scenes = prepare_scenes(config, out, reuse=resume, log=log)
-    payloads = {name: sc.payload() for name, sc in scenes.items()}
-    fingerprints = {name: p["fingerprint"] for name, p in payloads.items()}
-    jobs = plan(config, scenes)
-    executor = make_executor(work, payloads, workers, scheduler)
-    t0 = time.perf_counter()
-    try:
-        stats = _run_jobs(jobs, store, executor, fingerprints, progress, on_result)
-    except KeyboardInterrupt:
-        log(f"interrupted: {len(store)} finished runs are kept in {out}; rerun with --resume to continue")
-        raise
-    stats["seconds"] = time.perf_counter() - t0
-    results = aggregate(config, scenes, jobs, store)
-    results["stats"] = stats
-    results["out"] = out
-    write_json(os.path.join(out, "results.json"), results)
-    write_text(os.path.join(out, "summary.txt"), format_summary(results) + "\n")
-    if charts:
-        from .charts import make_charts
-
-        results["charts"] = make_charts(results, os.path.join(out, "charts"))
-        write_json(os.path.join(out, "results.json"), results)
-    log(f"{stats['computed']} runs computed, {stats['reused']} taken from {out}, {stats['seconds']:.0f} s; "
-        f"results in {os.path.join(out, 'results.json')}")
-    return results

@@ -10,7 +10,8 @@
 * :mod:`.executors` -- where runs execute: this process, spawned worker processes, or a Dask cluster;
 * :mod:`.jobs` -- generators of runs (one run, or a search that picks each run from the results before it)
   driven to their ends, stored results replayed, a bounded number in flight, the most expensive first;
-* :mod:`.study` -- :class:`~.study.Study`: a study plans its runs, runs one, and summarises the stored runs;
+* :mod:`.study` -- :class:`~.study.Study`: a study plans its runs (:class:`~.study.Run`: a row, a replica and the
+  settings it depends on, and its key; or jobs that yield them), runs one, and summarises the stored runs;
   the base class skips what is stored, executes the rest with a progress bar and stores each run the moment it
   finishes, under the folder's lock.
 """

@@ -4,12 +4,13 @@ from __future__ import annotations
 
 import os
 
+from ...support.errors import SymprkError
 from ...support.files import jsonable, write_json, write_npz, write_text
 
 __all__ = ["FolderLock", "FolderLockedError", "write_text", "write_json", "write_npz", "jsonable"]
 
 
-class FolderLockedError(BlockingIOError):
+class FolderLockedError(SymprkError, BlockingIOError):
     """Another process holds the folder's lock (an OSError: the command says so in one line)."""
 
 

@@ -7,6 +7,8 @@ import argparse
 import os
 from importlib import import_module
 
+from ...support.errors import InputError
+
 __all__ = ["positive", "check_settings", "add_study_arguments", "run_study"]
 
 
@@ -30,10 +32,10 @@ def check_settings(cfg: dict, counts=(), positive=()) -> None:
     neither), or among ``positive`` that is not a number > 0, and its value."""
     for k in counts:
         if isinstance(cfg[k], bool) or int(cfg[k]) < 1:
-            raise ValueError(f"{k} must be >= 1, got {cfg[k]!r}")
+            raise InputError(f"{k} must be >= 1, got {cfg[k]!r}")
     for k in positive:
         if not float(cfg[k]) > 0:
-            raise ValueError(f"{k} must be positive, got {cfg[k]!r}")
+            raise InputError(f"{k} must be positive, got {cfg[k]!r}")
 
 
 def add_study_arguments(ap, *, quick: str, out: str | None, workers: str, length: str, default_workers: int = 2,
@@ -67,9 +69,9 @@ def run_study(args, cfg: dict, configure, study: str, report: str) -> None:
         if getattr(args, key, None) is not None:
             cfg[key] = getattr(args, key)
     if args.workers < 1:
-        raise ValueError(f"--workers must be >= 1, got {args.workers}")
+        raise InputError(f"--workers must be >= 1, got {args.workers}")
     if os.path.isfile(args.out):
-        raise ValueError(f"--out {args.out} is a file; give a folder")
+        raise InputError(f"--out {args.out} is a file; give a folder")
     options = {"workers": args.workers, "progress": not args.no_progress, "scheduler": args.scheduler,
                "report_only": args.report_only}
     if hasattr(args, "no_timing"):

@@ -3,6 +3,8 @@ this installation has one, and the Context properties a run sets (the CPU platfo
 precision)."""
 from __future__ import annotations
 
+from ...support.errors import InputError
+
 __all__ = ["PRECISIONS", "split", "names", "available", "check", "properties"]
 
 #: The precision modes of OpenMM's OpenCL, CUDA and HIP platforms.
@@ -13,7 +15,7 @@ def split(spec: str) -> tuple:
     """``"OpenCL:mixed"`` -> ("OpenCL", "mixed"); ``"CPU"`` -> ("CPU", None); ValueError for an unknown precision."""
     name, _, precision = str(spec).partition(":")
     if precision and precision not in PRECISIONS:
-        raise ValueError(f"platform {spec!r}: precision {precision!r} not known; give NAME or NAME:PRECISION with "
+        raise InputError(f"platform {spec!r}: precision {precision!r} not known; give NAME or NAME:PRECISION with "
                          f"PRECISION one of {', '.join(PRECISIONS)}, e.g. CPU,OpenCL:single,OpenCL:mixed,OpenCL:double")
     return name, precision or None
 
@@ -33,7 +35,7 @@ def available(name: str) -> bool:
 def check(name: str) -> str:
     """``name`` if this installation has that platform (a name, no precision); ValueError naming those it has."""
     if name not in names():
-        raise ValueError(f"unknown OpenMM platform {name!r}; this installation has {', '.join(names())}")
+        raise InputError(f"unknown OpenMM platform {name!r}; this installation has {', '.join(names())}")
     return name
 
 

@@ -24,6 +24,7 @@ import openmm as mm
 from ...support.files import content_key, write_npz
 from ...systems.prepare import equilibrate, minimise, without_net_momentum
 from ...systems.scenes import WATER_DENSITY_G_CM3, Scene, load_states, save_states, water_box
+from ...support.errors import InputError
 
 __all__ = ["scene_replicas", "scene_state_key", "water_box_scene", "water_box_replicas", "box_state_key",
            "BOX_STATE_KEYS", "BOX_STATE_VERSION", "EQUILIBRATORS"]
@@ -111,7 +112,7 @@ EQUILIBRATORS = ("langevin", "svr")
 def _equilibrate(cfg, system, x, picoseconds, seed, props):
     how = cfg.get("equilibrator", "langevin")
     if how not in EQUILIBRATORS:
-        raise ValueError(f"equilibrator {how!r}; known: {', '.join(EQUILIBRATORS)}")
+        raise InputError(f"equilibrator {how!r}; known: {', '.join(EQUILIBRATORS)}")
     if how == "langevin":
         return equilibrate(system, x, cfg["temperature"], picoseconds, seed, platform="CPU", properties=props)
     from ...integrators import SymplecticIntegrator

@@ -44,6 +44,7 @@ import warnings
 from dataclasses import dataclass
 
 from ...methods.placement import POSITIONS
+from ...support.errors import InputError
 
 __all__ = ["Row", "OPENMM_KINDS", "ROW_POSITION", "split_groups"]
 
@@ -110,8 +111,8 @@ class Row:
             name = who[len(RIGID_PREFIX):] if who.startswith(RIGID_PREFIX) else who
             try:
                 canonical = get_method(name).name
-            except Exception as exc:
-                raise ValueError(f"row {self.who!r}: {exc} Rows also name OpenMM's integrators: "
+            except InputError as exc:
+                raise InputError(f"row {self.who!r}: {exc} Rows also name OpenMM's integrators: "
                                  f"{', '.join(OPENMM_KINDS)}") from None
             who = RIGID_PREFIX + canonical if who.startswith(RIGID_PREFIX) else canonical
         object.__setattr__(self, "who", who)
@@ -121,16 +122,16 @@ class Row:
             object.__setattr__(self, "inner", get_method(self.inner).name)
         if not (isinstance(self.step_fs, (int, float)) and not isinstance(self.step_fs, bool) and self.step_fs > 0
                 and math.isfinite(self.step_fs)):
-            raise ValueError(f"row {who!r}: the step must be a positive number of fs, got {self.step_fs!r}")
+            raise InputError(f"row {who!r}: the step must be a positive number of fs, got {self.step_fs!r}")
         object.__setattr__(self, "step_fs", float(self.step_fs))
         kind = OPENMM_KINDS.get(who)
         if who in ("openmm-mts", "mts-langevin") and not self.mts:
-            raise ValueError(f"row {who!r}: give the inner steps of group 0 as H/N fs, e.g. '{who} 4/2 fs'")
+            raise InputError(f"row {who!r}: give the inner steps of group 0 as H/N fs, e.g. '{who} 4/2 fs'")
         if self.mts and (self.is_rigid or who in ("openmm-verlet", "langevin", "nose-hoover", "dpd")):
-            raise ValueError(f"row {who!r}: no multiple time stepping (H/N fs) for this integrator; rows with it are "
+            raise InputError(f"row {who!r}: no multiple time stepping (H/N fs) for this integrator; rows with it are "
                              f"catalogue methods, openmm-mts and mts-langevin")
         if self.inner and not self.mts:
-            raise ValueError(f"row {who}/{self.inner}: an inner method needs multiple time stepping (H/N fs)")
+            raise InputError(f"row {who}/{self.inner}: an inner method needs multiple time stepping (H/N fs)")
         if kind == "langevin" or kind == "dpd":
             object.__setattr__(self, "friction_per_ps", 1.0 if self.friction_per_ps is None
                                else float(self.friction_per_ps))
@@ -143,21 +144,21 @@ class Row:
             ("collision", self.collision_per_ps, kind == "nose-hoover"),
             ("cutoff", self.cutoff_nm, kind == "dpd")) if value is not None and not ok]
         if wrong:
-            raise ValueError(f"row {who!r}: {wrong[0][0]} does not apply to it")
+            raise InputError(f"row {who!r}: {wrong[0][0]} does not apply to it")
         for name in ("tau_ps", "friction_per_ps", "collision_per_ps", "cutoff_nm", "hmr_da"):
             value = getattr(self, name)
             if value is not None and not (float(value) > 0 and math.isfinite(float(value))):
-                raise ValueError(f"row {who!r}: {name} must be a positive number, got {value!r}")
+                raise InputError(f"row {who!r}: {name} must be a positive number, got {value!r}")
         if self.position not in POSITIONS:
-            raise ValueError(f"row {who!r}: thermostat position {self.position!r}; known: {', '.join(POSITIONS)}")
+            raise InputError(f"row {who!r}: thermostat position {self.position!r}; known: {', '.join(POSITIONS)}")
         if (self.every != 1 or self.position != ROW_POSITION) and self.tau_ps is None:
-            raise ValueError(f"row {who!r}: 'every' and the thermostat position need a thermostat (SVR TAU ps)")
+            raise InputError(f"row {who!r}: 'every' and the thermostat position need a thermostat (SVR TAU ps)")
         if int(self.every) != self.every or self.every < 1:
-            raise ValueError(f"row {who!r}: every must be a whole number >= 1, got {self.every!r}")
+            raise InputError(f"row {who!r}: every must be a whole number >= 1, got {self.every!r}")
         if self.backend not in ("auto", "native", "custom"):
-            raise ValueError(f"row {who!r}: backend {self.backend!r}; known: auto, native, custom")
+            raise InputError(f"row {who!r}: backend {self.backend!r}; known: auto, native, custom")
         if (self.backend != "auto" or self.exact_momentum) and not self.is_ours:
-            raise ValueError(f"row {who!r}: backend and exact-momentum are options of this package's integrators")
+            raise InputError(f"row {who!r}: backend and exact-momentum are options of this package's integrators")
 
     # -- what the row is ------------------------------------------------------------------------------------------
     @property
@@ -215,7 +216,7 @@ class Row:
         from ...methods.resolved import resolve
 
         if not self.is_ours:
-            raise ValueError(f"row {self.label!r}: OpenMM's integrators have no resolved method")
+            raise InputError(f"row {self.label!r}: OpenMM's integrators have no resolved method")
         if self.mts:
             return resolve(self.method, constraints, groups=split_groups(self.mts), inner_method=self.inner or None)
         return resolve(self.method, constraints)
@@ -227,7 +228,7 @@ class Row:
 
         m = get_method(self.method) if self.is_ours else None
         if m is not None and not m.is_splitting:
-            raise ValueError(f"row {self.label!r}: {m.name} is a {m.family} method; {where} runs kick/drift splittings "
+            raise InputError(f"row {self.label!r}: {m.name} is a {m.family} method; {where} runs kick/drift splittings "
                              f"and compositions only, e.g. verlet, omelyan-2, pefrl, yoshida-4 (symprk methods lists "
                              f"their families)")
 
@@ -286,14 +287,14 @@ class Row:
         rows name the step apart); ``defaults``: fields the label does not set (e.g. ``temperature``).
         ValueError naming the part not understood and the grammar."""
         if not isinstance(text, str) or not text.strip():
-            raise ValueError(f"row {text!r}: empty; write e.g. 'verlet 2 fs' or 'omelyan-2 4 fs SVR 0.1 ps'")
+            raise InputError(f"row {text!r}: empty; write e.g. 'verlet 2 fs' or 'omelyan-2 4 fs SVR 0.1 ps'")
         words = text.split()
         fields = dict(defaults)
         who = words.pop(0)
         m = _OLD_MTS.match(who) or _OLD_OPENMM_MTS.match(who)
         if m:  # the bench's <method>[/<inner>]@mts<n> and openmm-mts<n>
             if int(m["n"]) < 1:
-                raise ValueError(f"row {text!r}: the number of inner steps must be >= 1")
+                raise InputError(f"row {text!r}: the number of inner steps must be >= 1")
             fields["mts"] = int(m["n"])
             who = m.groupdict().get("who") or "openmm-mts"
             if m.groupdict().get("inner"):
@@ -310,7 +311,7 @@ class Row:
             try:
                 value = float(word)
             except (TypeError, ValueError):
-                raise ValueError(f"row {text!r}: {what} needs a number, got {word!r}") from None
+                raise InputError(f"row {text!r}: {what} needs a number, got {word!r}") from None
             return value
 
         i = 0
@@ -346,13 +347,13 @@ class Row:
                     fields["backend"] = w
                     i += 1
                 else:
-                    raise ValueError(f"row {text!r}: {' '.join(words[i:])!r} not understood")
-        except ValueError as exc:
-            raise ValueError(f"{exc}; a row reads WHO[/INNER] [H fs | H/N fs] [SVR TAU ps | friction G/ps | "
+                    raise InputError(f"row {text!r}: {' '.join(words[i:])!r} not understood")
+        except InputError as exc:
+            raise InputError(f"{exc}; a row reads WHO[/INNER] [H fs | H/N fs] [SVR TAU ps | friction G/ps | "
                              f"collision NU/ps] [cutoff C nm] [every K] [{' | '.join(POSITIONS)}; none: "
                              f"{ROW_POSITION}] [T K] [exact-momentum] [HMR M Da] [native|custom] [seed S]") from None
         if "step_fs" not in fields:
-            raise ValueError(f"row {text!r}: no step; write e.g. '{who} 2 fs'")
+            raise InputError(f"row {text!r}: no step; write e.g. '{who} 2 fs'")
         if fields.get("collision_per_ps") is not None and ALIASES.get(who, who) in ("langevin", "mts-langevin", "dpd"):
             fields["friction_per_ps"] = fields.pop("collision_per_ps")
         return cls(who, **fields)
@@ -369,7 +370,7 @@ class Row:
             from ...systems.repartition import repartition_hydrogen_mass
 
             if topology is None:
-                raise ValueError(f"row {self.label!r}: HMR needs the System's topology")
+                raise InputError(f"row {self.label!r}: HMR needs the System's topology")
             out = repartition_hydrogen_mass(out, topology, self.hmr_da)
         if self.mts:
             from ...systems.forcegroups import force_groups, split_forces
@@ -389,7 +390,7 @@ class Row:
         import openmm.unit as unit
 
         if self.is_rigid:
-            raise ValueError(f"row {self.label!r}: rigid bodies run as RigidBodies (openmm_symprk.rigid), not as an "
+            raise InputError(f"row {self.label!r}: rigid bodies run as RigidBodies (openmm_symprk.rigid), not as an "
                              f"OpenMM integrator")
         seed = self.seed if seed is None else int(seed)
         h = self.h_ps * unit.picoseconds

@@ -24,6 +24,7 @@ from ...systems.forcegroups import split_forces
 from ...systems.prepare import equilibrate, maxwell_boltzmann, minimise
 from ...systems.repartition import repartition_hydrogen_mass
 from ...systems.scenes import Scene, openmm_data, protein_vacuum, water_box, water_cluster
+from ...support.errors import InputError
 
 __all__ = ["SCENES", "build", "user_scene"]
 
@@ -196,7 +197,7 @@ def build(name: str, **params) -> Scene:
     try:
         builder = SCENES[name]
     except KeyError:
-        raise ValueError(f"unknown bench scene {name!r}; known: {', '.join(SCENES)} "
+        raise InputError(f"unknown bench scene {name!r}; known: {', '.join(SCENES)} "
                          f"(or pass your own System with --system-xml/--pdb)") from None
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
@@ -245,11 +246,11 @@ def user_scene(name: str = "user", system_xml: str | None = None, state: str | N
         elif state or pdb:
             positions = np.array(app.PDBFile(state or pdb).getPositions(asNumpy=True).value_in_unit(unit.nanometer))
         else:
-            raise ValueError("a System XML needs positions: pass a PDB file or a serialized State XML")
+            raise InputError("a System XML needs positions: pass a PDB file or a serialized State XML")
         minimize = minimize and velocities is None
     elif pdb:
         if not forcefields:
-            raise ValueError("a PDB file needs force-field names (e.g. amber14-all.xml amber14/tip3pfb.xml) "
+            raise InputError("a PDB file needs force-field names (e.g. amber14-all.xml amber14/tip3pfb.xml) "
                              "or a serialized System XML")
         pdbfile = app.PDBFile(pdb)
         ff = app.ForceField(*forcefields)
@@ -258,9 +259,9 @@ def user_scene(name: str = "user", system_xml: str | None = None, state: str | N
                                  constraints=app.HBonds, removeCMMotion=False)
         positions = np.array(pdbfile.getPositions(asNumpy=True).value_in_unit(unit.nanometer))
     else:
-        raise ValueError("a user scene needs --system-xml (with --state or --pdb) or --pdb with --forcefield")
+        raise InputError("a user scene needs --system-xml (with --state or --pdb) or --pdb with --forcefield")
     if system.getNumParticles() != len(positions):
-        raise ValueError(f"the System has {system.getNumParticles()} particles but the positions have "
+        raise InputError(f"the System has {system.getNumParticles()} particles but the positions have "
                          f"{len(positions)}")
     periodic = system.usesPeriodicBoundaryConditions()
     platform = platform or ("CPU" if periodic else "Reference")

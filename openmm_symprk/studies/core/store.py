@@ -1,10 +1,11 @@
 """Finished runs on disk: ``<out>/runs/<key>.json`` (what the run measured, plain data) and, when it has arrays,
 ``<key>.npz``; both written atomically, the arrays first, so a JSON file on disk means a complete run.
 
-Every study keys its runs one way, :func:`run_key`: the row's label (:attr:`~.rows.Row.label`, however the row was
-written), the replica and everything else the run depends on (its settings and the key of its starting states),
-so a study called again finds exactly the runs it already did, and a changed setting never reuses a stale run.
-A run stored under a key of an earlier form is found through its ``legacy`` key (:meth:`RunStore.adopt`).
+Every study keys its runs one way, :func:`run_key`, the one function that computes a run's key
+(:attr:`.study.Run.key` calls it): the row's label (:attr:`~.rows.Row.label`, however the row was written), the
+replica and everything else the run depends on (its settings, the key of its starting states, the version of what
+it stores), so a study called again finds exactly the runs it already did, and a changed setting never reuses a
+stale run.
 """
 from __future__ import annotations
 
@@ -34,19 +35,12 @@ class RunStore:
     def __init__(self, out: str, folder: str = "runs", create: bool = True):
         self.out = out
         self.folder = os.path.join(out, folder)
-        self.aliases: dict = {}  # key -> the legacy key its run is stored under
         if create:
             os.makedirs(self.folder, exist_ok=True)
 
     def path(self, key: str, ext: str) -> str:
-        """Where the run of ``key`` is stored (under its legacy key when adopted so)."""
-        key = self.aliases.get(key, key)
+        """Where the run of ``key`` is stored."""
         return os.path.join(self.folder, f"{key}.{ext}")
-
-    def adopt(self, key: str, legacy: str | None) -> None:
-        """Read the run of ``key`` from ``legacy``, a key of an earlier form, when only that one is stored."""
-        if legacy and key not in self and legacy in self:
-            self.aliases[key] = legacy
 
     def info(self, key: str) -> dict | None:
         """The stored JSON of a run, or None (missing or unreadable)."""
@@ -64,7 +58,6 @@ class RunStore:
             return None
 
     def put(self, key: str, info: dict, arrays: dict | None = None):
-        self.aliases.pop(key, None)
         if arrays:
             write_npz(self.path(key, "npz"), arrays)
         write_json(self.path(key, "json"), info)

@@ -12,6 +12,8 @@ from __future__ import annotations
 import time
 from dataclasses import dataclass, field
 
+from ...support.errors import InputError
+
 __all__ = ["Timing", "interleaved", "time_rows", "seconds_per_ps"]
 
 
@@ -32,14 +34,14 @@ def interleaved(steppers: dict, steps, rounds: int = 3, after=None) -> dict:
     ``steps`` steps each (an int, or {name: steps} when their costs differ).  ``after(name)`` runs after each
     block, outside the timing (e.g. a measurement).  Returns {name: Timing}."""
     if rounds < 1:
-        raise ValueError(f"rounds must be >= 1, got {rounds}")
+        raise InputError(f"rounds must be >= 1, got {rounds}")
     counts = steps if isinstance(steps, dict) else {name: steps for name in steppers}
     out = {name: Timing(float("inf"), 0.0, 0) for name in steppers}
     for _ in range(rounds):
         for name, advance in steppers.items():
             n = int(counts[name])
             if n < 1:
-                raise ValueError(f"{name}: steps per block must be >= 1, got {n}")
+                raise InputError(f"{name}: steps per block must be >= 1, got {n}")
             t0 = time.perf_counter()
             advance(n)
             dt = time.perf_counter() - t0

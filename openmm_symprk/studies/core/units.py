@@ -4,6 +4,7 @@ energy drift (its user guide, "Testing and Validation of OpenMM"), with the pack
 from __future__ import annotations
 
 from ...physics.temperature import R_KJ
+from ...support.errors import InputError
 
 __all__ = ["R_KJ", "kT", "kt_per_ns_per_dof"]
 
@@ -17,5 +18,5 @@ def kt_per_ns_per_dof(rate_kj_per_ps: float, temperature: float, dof: int = 1) -
     """A rate of energy change (kJ/mol per ps; per degree of freedom with ``dof`` = 1) in kT per ns per degree of
     freedom."""
     if dof < 1:
-        raise ValueError(f"dof must be >= 1, got {dof}")
+        raise InputError(f"dof must be >= 1, got {dof}")
     return float(rate_kj_per_ps) * 1e3 / (kT(temperature) * dof)

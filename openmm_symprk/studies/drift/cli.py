@@ -20,6 +20,7 @@ import sys
 from ..core.options import add_study_arguments, run_study
 from ..core.platforms import split
 from . import presets
+from ...support.errors import InputError
 
 
 def build_parser(prog: str = "symprk drift"):
@@ -55,11 +56,11 @@ def _bad_platform(spec: str) -> bool:
 
 def make_config(args) -> dict:
     if args.rows and args.study != "nvt":
-        raise ValueError("--rows applies to the nvt study only")
+        raise InputError("--rows applies to the nvt study only")
     if args.chart and args.study != "nvt":
-        raise ValueError("--chart applies to the nvt study only")
+        raise InputError("--chart applies to the nvt study only")
     if args.study in ("hmr", "nvt") and args.platforms:
-        raise ValueError("--platforms applies to the exact-momentum study only")
+        raise InputError("--platforms applies to the exact-momentum study only")
     if args.study == "nvt":
         cfg = presets.nvt(args.quick, [s.strip() for s in args.rows.split(",") if s.strip()] if args.rows else None)
     elif args.study == "hmr":
@@ -68,14 +69,14 @@ def make_config(args) -> dict:
         platforms = [p for p in (args.platforms or "").split(",") if p] or presets.PRECISION_PLATFORMS
         bad = [p for p in platforms if _bad_platform(p)]
         if bad:
-            raise ValueError(f"--platforms: {', '.join(bad)} not understood; give NAME or NAME:PRECISION, e.g. "
+            raise InputError(f"--platforms: {', '.join(bad)} not understood; give NAME or NAME:PRECISION, e.g. "
                              f"CPU,OpenCL:single,OpenCL:mixed,OpenCL:double")
         cfg = presets.exact_momentum(args.quick, platforms)
     for key in ("sample_ps", "constraint_tolerance", "threads"):
         if getattr(args, key) is not None:
             cfg[key] = getattr(args, key)
     if int(cfg["threads"]) < 1:
-        raise ValueError(f"--threads must be >= 1, got {cfg['threads']}")
+        raise InputError(f"--threads must be >= 1, got {cfg['threads']}")
     return cfg
 
 

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 from ..core.platforms import split
 from ..core.rows import Row
+from ...support.errors import InputError
 
 __all__ = ["hmr", "exact_momentum", "nvt", "nvt_pairs", "PRECISION_PLATFORMS", "OPENMM_PUBLISHED", "STUDIES"]
 
@@ -81,7 +82,7 @@ def nvt_pairs(items) -> list:
     out = []
     for item in items:
         if "@" not in item:
-            raise ValueError(f"row {item!r}: write method@step_fs, e.g. omelyan-2@4 or nosehoover@2")
+            raise InputError(f"row {item!r}: write method@step_fs, e.g. omelyan-2@4 or nosehoover@2")
         row = Row.parse(item)
         h = f"{row.step_fs:g} fs"
         if row.who == "nose-hoover":
@@ -89,9 +90,9 @@ def nvt_pairs(items) -> list:
         elif row.is_ours and not row.is_rigid:
             out.append((f"{row.method} {h}", f"{row.method} {h} SVR 0.1 ps", f"{row.method} {h} NVE", f"{row.method} {h}"))
         else:
-            raise ValueError(f"row {item!r}: the NVT study pairs catalogue methods and nosehoover")
+            raise InputError(f"row {item!r}: the NVT study pairs catalogue methods and nosehoover")
     if not out:
-        raise ValueError("no rows: write method@step_fs,..., e.g. verlet@2,omelyan-2@4")
+        raise InputError("no rows: write method@step_fs,..., e.g. verlet@2,omelyan-2@4")
     return out
 
 

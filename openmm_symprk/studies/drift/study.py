@@ -10,13 +10,13 @@ from __future__ import annotations
 
 import os
 
-from ...support.files import content_key
-from ..core import Run, Study, platforms, run_key as row_run_key, write_json, write_text
+from ..core import Run, Study, platforms, write_json, write_text
 from ..core.options import check_settings
 from ..core.replicas import scene_replicas, scene_state_key
 from .runs import row_of
+from ...support.errors import InputError
 
-__all__ = ["DriftStudy", "run_study", "run_key", "check"]
+__all__ = ["DriftStudy", "run_study", "run_of", "check"]
 
 #: Version of what a run stores (a change never reuses stale runs).
 RUN_VERSION = 1
@@ -34,21 +34,13 @@ def states_of(cfg: dict, scene: str, out: str, log=print) -> dict:
                           int(cfg["seed"]), float(cfg["decorrelate_ps"]), int(cfg.get("threads", 1)), log)
 
 
-def run_key(cfg: dict, row: dict, replica: int) -> str:
-    return row_run_key(row["row"], replica, {k: cfg[k] for k in _RUN_KEYS}, scene=row["scene"],
-                       platform=row["platform"], states=states_key(cfg, row["scene"]), version=RUN_VERSION)
-
-
-def legacy_key(cfg: dict, row: dict, replica: int) -> str:
-    """The key runs had before rows were keyed by their labels: the integrator, step, platform, precision and exact
-    momentum apart, and the label only where the row says more than those (a thermostat, multiple time stepping...)."""
-    r, (name, precision) = row_of(row), platforms.split(row["platform"])
-    old = {"scene": row["scene"], "integrator": r.who, "step_fs": r.step_fs, "platform": name, "precision": precision,
-           "exact_momentum": r.exact_momentum}
-    if r != type(r)(r.who, r.step_fs, exact_momentum=r.exact_momentum):
-        old["row"] = r.label
-    return content_key({"cfg": {k: cfg[k] for k in _RUN_KEYS}, "row": old, "replica": int(replica),
-                        "states": states_key(cfg, row["scene"]), "version": RUN_VERSION})
+def run_of(cfg: dict, row: dict, replica: int, cost: float = 1.0) -> Run:
+    """The NVE run of ``row`` (a config's row: name, row label, scene, platform) from ``replica``: keyed by the row,
+    the replica, the settings of the run, its scene, platform and replica states, and :data:`RUN_VERSION`."""
+    return Run(row["row"], replica, {k: cfg[k] for k in _RUN_KEYS}, row["scene"], (row, replica, cfg),
+               {"row": row["name"], "replica": replica, "scene": row["scene"]}, cost,
+               context={"scene": row["scene"], "platform": row["platform"], "states": states_key(cfg, row["scene"]),
+                        "version": RUN_VERSION})
 
 
 def check(cfg: dict):
@@ -57,21 +49,21 @@ def check(cfg: dict):
 
     check_settings(cfg, ("replicas",), ("length_ps", "sample_ps", "temperature", "constraint_tolerance"))
     if float(cfg["decorrelate_ps"]) < 0:
-        raise ValueError(f"decorrelate_ps must be >= 0, got {cfg['decorrelate_ps']!r}")
+        raise InputError(f"decorrelate_ps must be >= 0, got {cfg['decorrelate_ps']!r}")
     names = [r["name"] for r in cfg["rows"]]
     if len(set(names)) != len(names):
-        raise ValueError(f"row names must be unique, got {names}")
+        raise InputError(f"row names must be unique, got {names}")
     for row in cfg["rows"]:
         if row["scene"] not in SCENES:
-            raise ValueError(f"row {row['name']}: unknown scene {row['scene']!r}; known: {', '.join(SCENES)}")
+            raise InputError(f"row {row['name']}: unknown scene {row['scene']!r}; known: {', '.join(SCENES)}")
         step = row_of(row).step_fs  # ValueError naming the catalogue and OpenMM's integrators
         n = float(cfg["length_ps"]) * 1e3 / step
         if round(n) < 3:
-            raise ValueError(f"row {row['name']}: {cfg['length_ps']} ps is under 3 steps of {step:g} fs")
+            raise InputError(f"row {row['name']}: {cfg['length_ps']} ps is under 3 steps of {step:g} fs")
     for c in cfg["comparisons"]:
         for k in ("row", "ref"):
             if c[k] not in names:
-                raise ValueError(f"comparison {c}: no row named {c[k]!r} (rows: {', '.join(names)})")
+                raise InputError(f"comparison {c}: no row named {c[k]!r} (rows: {', '.join(names)})")
 
 
 _systems: dict = {}
@@ -120,10 +112,7 @@ class DriftStudy(Study):
         runs = []
         for row in rows:
             cost = float(cfg["length_ps"]) * row_of(row).evals_per_ps() * (10.0 if "pme" in row["scene"] else 1.0)
-            for r in range(int(cfg["replicas"])):
-                runs.append(Run(run_key(cfg, row, r), row["scene"], (row, r, cfg),
-                                {"row": row["name"], "replica": r, "scene": row["scene"]}, cost,
-                                legacy_key(cfg, row, r)))
+            runs += [run_of(cfg, row, r, cost) for r in range(int(cfg["replicas"]))]
         return runs
 
     def shared(self, runs) -> dict:

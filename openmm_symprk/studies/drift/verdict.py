@@ -15,6 +15,7 @@ import numpy as np
 
 from ...stats import Estimate, combine, drift, paired
 from ..core.units import kt_per_ns_per_dof
+from ...support.errors import InputError
 
 __all__ = ["run_drift", "row_estimate", "magnitude", "ratio", "claim_verdict", "cost_verdict", "K_SE", "NOT_HALVED"]
 
@@ -27,7 +28,7 @@ NOT_HALVED = 0.5
 def run_drift(t_ps, e_kj, n_dof: int, temperature: float) -> tuple[float, float]:
     """(drift, standard error) in kT per ns per degree of freedom of the energy series e(t) (kJ/mol, ps)."""
     if n_dof < 1:
-        raise ValueError(f"n_dof must be >= 1, got {n_dof}")
+        raise InputError(f"n_dof must be >= 1, got {n_dof}")
     fit = drift(np.asarray(t_ps, dtype=np.float64), np.asarray(e_kj, dtype=np.float64) / n_dof)
     return kt_per_ns_per_dof(fit.slope, temperature), kt_per_ns_per_dof(fit.se, temperature)
 

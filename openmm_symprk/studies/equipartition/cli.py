@@ -6,6 +6,7 @@ import argparse
 from ..core.options import add_study_arguments, run_study
 from ..core.rows import Row
 from . import presets
+from ...support.errors import InputError
 
 
 def _rows(text: str) -> list:
@@ -41,7 +42,7 @@ def run(args):
             wanted = [m.strip() for m in args.models.split(",") if m.strip()]
             unknown = [m for m in wanted if m not in presets.full()["models"]]
             if unknown:
-                raise ValueError(f"unknown water model(s) {', '.join(unknown)}; known: "
+                raise InputError(f"unknown water model(s) {', '.join(unknown)}; known: "
                                  f"{', '.join(presets.full()['models'])}")
             base = presets.full()["models"]
             cfg["models"] = {m: cfg["models"].get(m, base[m]) for m in wanted}

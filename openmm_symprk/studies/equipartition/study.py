@@ -4,7 +4,7 @@
     result = run_study(presets.quick(), "equipartition-quick", workers=2)
 
 ``<out>/states/<model>-<key>.npz`` holds the replica states (:func:`~..core.replicas.water_box_replicas`) and
-``<out>/runs/<key>.npz`` + ``.json`` one finished run each; a key (:func:`~..core.store.run_key`) hashes everything a
+``<out>/runs/<key>.npz`` + ``.json`` one finished run each; a key (:attr:`~..core.study.Run.key`) hashes everything a
 run depends on (model, box, equilibration, row label, replica, lengths), so a second call with the same settings
 reuses every finished run and computes only what is missing, and a changed setting never reuses a stale one.
 Workers are spawned processes (scripts need the ``if __name__ == "__main__":`` guard for ``workers > 1``).
@@ -13,15 +13,15 @@ from __future__ import annotations
 
 import os
 
-from ...support.files import content_key
-from ..core import Run, RunStore, Study, run_key as row_run_key, write_json, write_text
+from ..core import Run, RunStore, Study, write_json, write_text
 from ..core.options import check_settings
 from ..core.replicas import BOX_STATE_KEYS, water_box_replicas, water_box_scene
 from ..core.rows import Row
 from ..core.timing import seconds_per_ps
 from .report import summarise
+from ...support.errors import InputError
 
-__all__ = ["run_study", "run_key", "load_runs", "EquipartitionStudy"]
+__all__ = ["run_study", "run_of", "load_runs", "EquipartitionStudy"]
 
 _RUN_KEYS = BOX_STATE_KEYS + ("settle_ps", "length_ps", "sample_fs")
 
@@ -32,15 +32,13 @@ _RUN_KEYS = BOX_STATE_KEYS + ("settle_ps", "length_ps", "sample_fs")
 RUN_VERSION = 3
 
 
-def run_key(cfg: dict, model: str, label: str, replica: int) -> str:
-    return row_run_key(label, replica, {k: cfg[k] for k in _RUN_KEYS}, model=model, version=RUN_VERSION)
-
-
-def legacy_key(cfg: dict, model: str, label: str, replica: int) -> str:
-    """The key runs had before rows were keyed by their labels (the row as [method, step])."""
-    row = Row.parse(label)
-    return content_key({"cfg": {k: cfg[k] for k in _RUN_KEYS}, "model": model, "row": [row.who, row.step_fs],
-                        "replica": int(replica), "version": RUN_VERSION})
+def run_of(cfg: dict, model: str, label: str, replica: int, cost: float = 1.0) -> Run:
+    """The NVE run of the row ``label`` on ``model``'s box from ``replica``: keyed by the row, the replica, the box's
+    and the run's settings, the model and :data:`RUN_VERSION`."""
+    label = Row.parse(label).label
+    return Run(label, replica, {k: cfg[k] for k in _RUN_KEYS}, model, (label, replica),
+               {"model": model, "row": label, "replica": replica}, cost,
+               context={"model": model, "version": RUN_VERSION})
 
 
 def work(shared: dict, label: str, replica: int):
@@ -59,14 +57,13 @@ def load_runs(cfg: dict, out: str) -> dict:
     for key in sorted(store.keys()):
         info = store.info(key)
         try:
-            row = Row.parse(info["row"]) if "row" in info else Row(info["method"], float(info["step_fs"]))
-            ident, replica = (info["model"], row.label), int(info["replica"])
+            ident, replica = (info["model"], Row.parse(info["row"]).label), int(info["replica"])
         except (TypeError, ValueError, KeyError):
             continue
-        if ident in found and key in (run_key(cfg, *ident, replica), legacy_key(cfg, *ident, replica)):
+        if ident in found and key == run_of(cfg, *ident, replica).key:
             arrays = store.arrays(key)
             if arrays is not None:
-                found[ident].append((arrays, dict(info, row=row.label)))
+                found[ident].append((arrays, dict(info, row=ident[1])))
     for reps in found.values():
         reps.sort(key=lambda rep: rep[1]["replica"])
     return found
@@ -80,7 +77,7 @@ def _check(cfg):
         for row in rows:
             row.require_kick_drift(f"{model}: rigid water (constraints, or the rigid-body engine)")
         if Row.parse(cfg["reference"]) not in rows:
-            raise ValueError(f"{model}: the reference row {cfg['reference']!r} is not among its rows")
+            raise InputError(f"{model}: the reference row {cfg['reference']!r} is not among its rows")
 
 
 class EquipartitionStudy(Study):
@@ -103,10 +100,7 @@ class EquipartitionStudy(Study):
         for model, labels in cfg["models"].items():
             for row in map(Row.parse, labels):
                 cost = row.evals_per_ps(True) * (cfg["length_ps"] + cfg["settle_ps"])
-                for r in range(int(cfg["replicas"])):
-                    runs.append(Run(run_key(cfg, model, row.label, r), model, (row.label, r),
-                                    {"model": model, "row": row.label, "replica": r}, cost,
-                                    legacy_key(cfg, model, row.label, r)))
+                runs += [run_of(cfg, model, row.label, r, cost) for r in range(int(cfg["replicas"]))]
         return runs
 
     def shared(self, runs) -> dict:

@@ -4,9 +4,23 @@ and against Verlet extrapolated to h -> 0."""
 from __future__ import annotations
 
 import argparse
+import sys
 
 from ..core.options import add_study_arguments, run_study
 from . import presets
+from ...support.errors import InputError
+
+
+#: Former names of presets, still read (with a note on stderr): {old: new}.
+RENAMED = {"issue26": "match-3se"}
+
+
+def preset_name(text: str) -> str:
+    """The name of the preset ``text`` names (a former name read as its new one, with a note)."""
+    if text in RENAMED:
+        print(f"symprk fidelity: --preset {text} is now called --preset {RENAMED[text]}", file=sys.stderr)
+        return RENAMED[text]
+    return text
 
 
 def build_parser(prog: str = "symprk fidelity"):
@@ -16,13 +30,14 @@ def build_parser(prog: str = "symprk fidelity"):
                         length="measured length per run (frames every sample_fs)")
     ap.add_argument("--rows", default=None,
                     help="comma-separated labels of the preset rows to run (the reference is always run), "
-                         "e.g. 'verlet 2 fs,omelyan-2 4 fs'; 'deciding': the rows that decide issue 26's answer; "
-                         "default: all")
+                         "e.g. 'verlet 2 fs,omelyan-2 4 fs'; 'deciding': the preset's rows that decide its answer "
+                         "(run first, and on TIP3P); default: all")
     ap.add_argument("--model", choices=("spce", "tip3p"), default=None,
                     help="water model (default spce); its replica states and runs are kept apart")
-    ap.add_argument("--preset", choices=sorted(presets.PRESETS), default="issue26",
-                    help="the study: issue26 (kept as it ran: --report-only remakes its report) or frontier (issue "
-                         "35: equal-accuracy costs with intervals, NVT rows paired by common random numbers)")
+    ap.add_argument("--preset", type=preset_name, choices=sorted(presets.PRESETS), default="match-3se",
+                    help="the study: match-3se (each row against Verlet at 0.5 fs, every observable within 3 standard "
+                         "errors; kept as it ran: --report-only remakes its report) or frontier (equal-accuracy costs "
+                         "with intervals, NVT rows paired by common random numbers)")
     return ap
 
 
@@ -47,7 +62,7 @@ def select_rows(cfg: dict, text: str) -> list:
             named.append(w)
     unknown = [w for w, lab in zip(wanted, named) if lab not in labels]
     if unknown:
-        raise ValueError(f"unknown row(s) {', '.join(repr(u) for u in unknown)}; the rows are: {'; '.join(labels)}")
+        raise InputError(f"unknown row(s) {', '.join(repr(u) for u in unknown)}; the rows are: {'; '.join(labels)}")
     keep = set(named) | {label(r) for r in (cfg.get("references") or {}).values()} | {labels[0]}
     return [r for r, lab in zip(cfg["rows"], labels) if lab in keep]
 

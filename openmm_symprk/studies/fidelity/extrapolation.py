@@ -13,6 +13,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ...support.errors import InputError
+
 __all__ = ["H2Fit", "extrapolate_h2"]
 
 
@@ -39,13 +41,13 @@ def extrapolate_h2(h, y, se) -> H2Fit:
     sizes ``h`` (any unit, e.g. fs; at least 2 distinct)."""
     h, y, se = (np.atleast_1d(np.asarray(a, dtype=np.float64)) for a in (h, y, se))
     if not (h.shape == y.shape == se.shape and h.ndim == 1):
-        raise ValueError(f"h, y and se must be 1-D of one length, got shapes {h.shape}, {y.shape}, {se.shape}")
+        raise InputError(f"h, y and se must be 1-D of one length, got shapes {h.shape}, {y.shape}, {se.shape}")
     if not np.all(np.isfinite(y)) or not np.all(np.isfinite(h)):
-        raise ValueError(f"h and y must be finite, got h={h.tolist()}, y={y.tolist()}")
+        raise InputError(f"h and y must be finite, got h={h.tolist()}, y={y.tolist()}")
     if not np.all((se > 0) & np.isfinite(se)):
-        raise ValueError(f"every standard error must be finite and > 0 (they are the fit's weights), got {se.tolist()}")
+        raise InputError(f"every standard error must be finite and > 0 (they are the fit's weights), got {se.tolist()}")
     if len(np.unique(h ** 2)) < 2:
-        raise ValueError(f"the fit needs at least 2 distinct step sizes, got {h.tolist()}")
+        raise InputError(f"the fit needs at least 2 distinct step sizes, got {h.tolist()}")
     X = np.column_stack([np.ones_like(h), h ** 2])
     w = 1.0 / se ** 2
     cov = np.linalg.inv(X.T @ (w[:, None] * X))

@@ -62,7 +62,7 @@ def full() -> dict:
         "msd_window_ps": [2.0, 8.0], "tau_fit": [0.1, 0.5], "rdf_r_min_nm": 0.2, "timing_fs": 1000.0,
         "rows": list(ROWS), "references": dict(REFERENCES),
         # issue 26's study is kept as it ran (runs of version 2): its report is remade from the stored runs only
-        "run_version": 2, "frozen": "issue 26",
+        "run_version": 2, "frozen": "match-3se",
     }
 
 
@@ -194,4 +194,4 @@ def frontier() -> dict:
 
 
 #: The studies ``symprk fidelity --preset`` runs.
-PRESETS = {"issue26": full, "frontier": frontier}
+PRESETS = {"match-3se": full, "frontier": frontier}

@@ -9,6 +9,7 @@ whether it has a conserved effective energy.
 from __future__ import annotations
 
 from ..core.rows import Row
+from ...support.errors import InputError
 
 __all__ = ["check_row", "describe", "label", "to_row", "is_verlet_limit"]
 
@@ -18,7 +19,7 @@ def to_row(row, temperature: float = 300.0) -> Row:
     if isinstance(row, Row):
         return row
     if not isinstance(row, str):
-        raise ValueError(f"row {row!r}: a row is a label such as 'verlet 2 fs' or 'omelyan-2 4 fs SVR 0.1 ps' "
+        raise InputError(f"row {row!r}: a row is a label such as 'verlet 2 fs' or 'omelyan-2 4 fs SVR 0.1 ps' "
                          f"(the grammar of openmm_symprk.studies.core.rows)")
     return Row.parse(row, temperature=float(temperature))
 
@@ -27,7 +28,7 @@ def check_row(row) -> str:
     """The canonical label of ``row``; ValueError naming the row and what is wrong otherwise."""
     r = to_row(row)
     if r.is_rigid:
-        raise ValueError(f"row {row!r}: the fidelity study runs OpenMM integrators on a constrained System, not "
+        raise InputError(f"row {row!r}: the fidelity study runs OpenMM integrators on a constrained System, not "
                          f"rigid-body engines")
     r.require_kick_drift("rigid water")
     return r.label

@@ -25,6 +25,7 @@ import openmm as mm
 from ..core.engine import RowEngine
 from ..core.timing import time_rows
 from .rows import cost_rows
+from ...support.errors import InputError
 
 BASELINE = "LangevinMiddle"
 
@@ -40,7 +41,7 @@ def scene(name: str, quick: bool):
     elif name == "villin":
         sc = named.villin_pme(equilibrate_ps=0.02 if quick else 0.2)
     else:
-        raise ValueError(f"unknown cost scene {name!r}; known: water, villin")
+        raise InputError(f"unknown cost scene {name!r}; known: water, villin")
     return f"{sc.name}: {sc.description}", sc.system, sc.positions, sc.velocities
 
 

@@ -5,73 +5,20 @@
    values, and the relative standard error of E[chi2] the draws resolve.
 2. The stationary state of N independent 3-d harmonic oscillators under Verlet with the thermostat at the ends or in
    the middle (h w = 0.5): k<q^2>/kT and the kinetic temperature at the thermostat point, in units of the target,
-   against the exact values (ends: 1/(1 - h^2 w^2/4) and 1; middle: 1 and 1).
+   against the exact values (ends: 1/(1 - h^2 w^2/4) and 1; middle: 1 and 1)
+   (:mod:`openmm_symprk.integrators.known_answers`).
 
 The test-suite asserts the same numbers (tests/integrators/test_thermostat_known_answers.py).
 """
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
-import numpy as np
-import openmm.unit as unit
-
+from ...integrators.known_answers import OSCILLATORS, exact_temperatures, noise_draws, stationary_temperatures
 from ...integrators.noise import sample_thermostat_noise
 from ..core.platforms import names
-from ...systems.scenes import harmonic_oscillators
-from ...physics.temperature import R_KJ
-from ...stats import SeriesStats, series_stats
 
-__all__ = ["OSCILLATORS", "stationary_temperatures", "exact_temperatures", "noise_draws", "run"]
-
-#: the oscillators' case: count, temperature (K), step (ps), h w, collision time (ps; c = exp(-h/tau) = 0.018, so the
-#: kinetic energy at the thermostat point is nearly fresh every step)
-OSCILLATORS = dict(n=1000, temperature=300.0, step=0.002, h_omega=0.5, collision_time=0.0005)
-
-
-def exact_temperatures(position: str, h_omega: float = OSCILLATORS["h_omega"]) -> tuple:
-    """(k<q^2>/kT, kinetic temperature at the thermostat point / T) of Verlet with the thermostat at ``position``."""
-    return (1 / (1 - h_omega ** 2 / 4) if position == "ends" else 1.0), 1.0
-
-
-@dataclass(frozen=True)
-class Stationary:
-    backend: str
-    platform: str
-    position: str
-    configurational: SeriesStats  # k<q^2> / ((3N - 3) kT)
-    kinetic: SeriesStats  # 2 K at the thermostat point / ((3N - 3) kT)
-
-
-def stationary_temperatures(backend: str, platform: str, position: str, samples: int, seed: int = 17,
-                            properties: dict | None = None) -> Stationary:
-    """The oscillators of :data:`OSCILLATORS` after 300 steps, sampled every step ``samples`` times (``properties``:
-    the platform's, e.g. {"Precision": "double"})."""
-    from ..core.engine import RowEngine
-    from ..core.rows import Row
-
-    case = OSCILLATORS
-    k = (case["h_omega"] / case["step"]) ** 2
-    system, x, v = harmonic_oscillators(case["n"], k, case["temperature"])
-    precision = (properties or {}).get("Precision")
-    row = Row("verlet", case["step"] * 1e3, tau_ps=case["collision_time"], position=position,
-              temperature=case["temperature"], backend=backend, seed=seed)
-    eng = RowEngine(row, system, x, v, platform=f"{platform}:{precision}" if precision else platform, threads=None)
-    eng.step(300)
-    dof_kT = (3 * case["n"] - 3) * R_KJ * case["temperature"]
-    q, kin = np.empty(samples), np.empty(samples)
-    for i in range(samples):
-        eng.step(1)
-        q[i] = 2 * eng.sample(positions=False, velocities=False).pe / dof_kT
-        kin[i] = 2 * eng.integrator.thermostat_kinetic_energy().value_in_unit(unit.kilojoule_per_mole) / dof_kT
-    del eng
-    return Stationary(backend, platform, position, series_stats(q), series_stats(kin))
-
-
-def noise_draws(k: int, resolution: float = 0.0005) -> int:
-    """Events whose chi2 of ``k`` degrees of freedom resolves E[chi2] to ``resolution`` (one relative standard error)."""
-    return math.ceil(2.0 / (k * resolution ** 2))
+__all__ = ["run"]
 
 
 def run(quick: bool = False, platforms=None, log=print) -> dict:

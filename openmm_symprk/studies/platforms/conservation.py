@@ -28,6 +28,7 @@ from ..core import platforms
 from ..core.engine import RowEngine
 from ..core.rows import Row
 from ..core.timing import time_rows
+from ...support.errors import InputError
 
 DEFAULT_PLATFORMS = ("Reference", "CPU", "OpenCL:single", "OpenCL:mixed", "OpenCL:double")
 DEFAULT_METHODS = ("verlet", "yoshida-4")
@@ -40,7 +41,7 @@ def _scene(name, n_waters):
     builders = {"water": lambda: scenes.water_cluster(n_waters), "protein": scenes.protein_vacuum,
                 "flexible-water": lambda: scenes.water_cluster(n_waters, rigid=False)}
     if name not in builders:
-        raise ValueError(f"unknown scene {name!r} (water, protein, flexible-water)")
+        raise InputError(f"unknown scene {name!r} (water, protein, flexible-water)")
     return builders[name]()
 
 
@@ -51,7 +52,7 @@ def _momenta(ctx):
 def compare(scene, spec, method, steps, step_size=0.002, chunk=None, backend="auto"):
     """Run off and on side by side (``steps`` rounded down to whole chunks); return a dict of figures."""
     if platforms.split(spec)[0] == "OpenCL" and scene.n_atoms < 2:
-        raise ValueError("PoCL crashes on 1-particle systems")
+        raise InputError("PoCL crashes on 1-particle systems")
     row = Row(method, step_size * 1e3, backend=backend)
     engines = {k: RowEngine(r, scene, platform=spec, threads=None, quiet=False)
                for k, r in (("off", row), ("on", row.replace(exact_momentum=True)))}

@@ -23,6 +23,7 @@ import openmm as mm
 from ..core.engine import RowEngine
 from ..core.rows import Row
 from ..core.timing import time_rows
+from ...support.errors import InputError
 
 DEFAULT_METHODS = ("verlet", "omelyan-2", "yoshida-4", "blanes-moan-srkn6b-4", "kahan-li-6")
 
@@ -99,7 +100,7 @@ def run(args):
     if not plugin.available():
         raise plugin.NativeUnavailableError(f"the native backend is unavailable: {plugin.unavailable_reason()}")
     if args.platform not in plugin.platforms():
-        raise ValueError(f"--platform {args.platform}: no native kernel for it (have: {', '.join(plugin.platforms())})")
+        raise InputError(f"--platform {args.platform}: no native kernel for it (have: {', '.join(plugin.platforms())})")
     methods = [m.strip() for m in args.methods.split(",") if m.strip()]
     platform = f"{args.platform}:{args.precision}" if args.precision else args.platform
     import os
@@ -115,7 +116,7 @@ def run(args):
             title, system, pos, vel = water_box_system(args.box_nm)
             steps = args.steps or (20 if args.quick else 100)
         else:
-            raise ValueError(f"--systems: unknown system {which!r}; known: cluster, box")
+            raise InputError(f"--systems: unknown system {which!r}; known: cluster, box")
         if args.no_forces:
             while system.getNumForces():
                 system.removeForce(0)

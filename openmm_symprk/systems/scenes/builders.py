@@ -23,6 +23,7 @@ import openmm.unit as unit
 
 from ..prepare import constrain_velocities, maxwell_boltzmann, minimise
 from .scene import Scene
+from ...support.errors import InputError
 
 #: TIP3P geometry (nm, radians)
 _R_OH = 0.09572
@@ -60,7 +61,7 @@ def water_cluster(n_waters: int = 27, rigid: bool = True, temperature: float = 1
     ``angular_velocity`` (rad/ps) spins the cluster about its centre of mass, so that the angular
     momentum is far from zero and its conservation is a sharp test."""
     if n_waters < 1:
-        raise ValueError(f"n_waters must be at least 1, got {n_waters}")
+        raise InputError(f"n_waters must be at least 1, got {n_waters}")
     rng = np.random.default_rng(seed)
     side = int(np.ceil(n_waters ** (1 / 3)))
     sites = np.array([(i, j, k) for i in range(side) for j in range(side) for k in range(side)], float)[:n_waters]
@@ -201,15 +202,15 @@ def water_box(model: str = "spce", n_waters: int | None = None, cutoff_nm: float
     shape; a ``box_nm`` box is Modeller's filling of that box, unscaled.
     Returns (system, topology, positions in nm); positions are not minimised."""
     if model not in WATER_MODELS:
-        raise ValueError(f"unknown water model {model!r}; known: {', '.join(WATER_MODELS)}")
+        raise InputError(f"unknown water model {model!r}; known: {', '.join(WATER_MODELS)}")
     if box_nm is not None and n_waters is not None:
-        raise ValueError("give n_waters or box_nm, not both")
+        raise InputError("give n_waters or box_nm, not both")
     if box_nm is None and n_waters is None:
         n_waters = 216
     if n_waters is not None and (isinstance(n_waters, bool) or int(n_waters) < 2):
-        raise ValueError(f"n_waters must be >= 2, got {n_waters!r}")
+        raise InputError(f"n_waters must be >= 2, got {n_waters!r}")
     if density_g_cm3 is not None and (isinstance(density_g_cm3, bool) or not 0 < float(density_g_cm3) < 10):
-        raise ValueError(f"density_g_cm3 must be a density in g/cm^3 between 0 and 10 (e.g. 0.997), or None for "
+        raise InputError(f"density_g_cm3 must be a density in g/cm^3 between 0 and 10 (e.g. 0.997), or None for "
                          f"Modeller's own box, got {density_g_cm3!r}")
     ffname, name = WATER_MODELS[model]
     ff = app.ForceField(*(forcefields or (ffname,)))
@@ -223,7 +224,7 @@ def water_box(model: str = "spce", n_waters: int | None = None, cutoff_nm: float
         positions = _scale_to_density(mod.topology, positions, float(density_g_cm3))
     box = min(mod.topology.getUnitCellDimensions().value_in_unit(unit.nanometer))
     if not 2 * cutoff_nm <= box:
-        raise ValueError(f"cutoff {cutoff_nm} nm needs a box at least {2 * cutoff_nm} nm wide; "
+        raise InputError(f"cutoff {cutoff_nm} nm needs a box at least {2 * cutoff_nm} nm wide; "
                          f"{f'{n_waters} waters give' if box_nm is None else 'the box is'} {box:.3f} nm: "
                          f"use more waters or a shorter cutoff")
     extra = {} if ewald_tolerance is None else {"ewaldErrorTolerance": ewald_tolerance}

@@ -20,6 +20,7 @@ import openmm.app as app
 
 from ...support.files import write_json, write_npz, write_text
 from ..properties import constraint_arrays, degrees_of_freedom, masses
+from ...support.errors import InputError
 
 __all__ = ["Scene", "ALL_INVARIANTS", "save_scene", "load_scene", "save_states", "load_states"]
 
@@ -70,7 +71,7 @@ class Scene:
     def molecules(self) -> list:
         """Atom indices of each residue of the topology (e.g. each water)."""
         if self.topology is None:
-            raise ValueError(f"scene {self.name!r} has no topology, so no molecules")
+            raise InputError(f"scene {self.name!r} has no topology, so no molecules")
         return [[a.index for a in r.atoms()] for r in self.topology.residues()]
 
     def context(self, integrator, platform=None, properties=None):

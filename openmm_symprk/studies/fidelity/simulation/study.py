@@ -6,7 +6,7 @@
 
 ``<out>/states/<model>-<key>.npz`` holds the replica states (:func:`~...core.replicas.water_box_replicas`: the same
 file, key and states as ``symprk equipartition`` makes for the same box and equilibration settings),
-``<out>/runs/<key>.json`` (+ .npz) one finished run each; a key (:func:`~...core.store.run_key`) hashes everything a
+``<out>/runs/<key>.json`` (+ .npz) one finished run each; a key (:attr:`~...core.study.Run.key`) hashes everything a
 run depends on (box, states, row label, replica, lengths, the observables' settings), so a second call reuses every
 finished run and a changed setting never reuses a stale one.
 """
@@ -16,12 +16,13 @@ import os
 import warnings
 
 from ....systems.checks import ConservationWarning
-from ...core import Run, Study, run_key as row_run_key, write_json, write_text
+from ...core import Run, Study, write_json, write_text
 from ...core.options import check_settings
 from ...core.replicas import BOX_STATE_KEYS, BOX_STATE_VERSION, water_box_replicas, water_box_scene
 from ..rowspec import check_row, label, to_row
+from ....support.errors import InputError
 
-__all__ = ["FidelityStudy", "run_study", "run_key", "temperature_view", "RUN_KEYS", "RUN_VERSION"]
+__all__ = ["FidelityStudy", "run_study", "run_of", "temperature_view", "RUN_KEYS", "RUN_VERSION"]
 
 #: What a run depends on besides its row and replica (the observables are computed in the run: their settings too).
 RUN_KEYS = BOX_STATE_KEYS + ("model", "settle_ps", "omega_ps", "omega_fs", "omega_max_lag_ps", "length_ps",
@@ -40,10 +41,13 @@ TIMINGS = "timings.json"
 MODEL = "model.json"
 
 
-def run_key(cfg: dict, row, replica: int) -> str:
+def run_of(cfg: dict, row, replica: int, cost: float = 1.0) -> Run:
+    """The run of ``row`` (a label) from ``replica``: keyed by the row, the replica, the settings of
+    :data:`RUN_KEYS` (and the equilibrator, where the config names one), the states' and the runs' versions."""
+    lab = check_row(row)
     keys = RUN_KEYS + (("equilibrator",) if "equilibrator" in cfg else ())
-    return row_run_key(check_row(row), replica, {k: cfg[k] for k in keys}, states=BOX_STATE_VERSION,
-                       version=int(cfg.get("run_version", RUN_VERSION)))
+    return Run(lab, replica, {k: cfg[k] for k in keys}, "box", (lab, replica), {"row": lab, "replica": replica}, cost,
+               context={"states": BOX_STATE_VERSION, "version": int(cfg.get("run_version", RUN_VERSION))})
 
 
 def references(cfg: dict, rows: list) -> dict:
@@ -53,16 +57,16 @@ def references(cfg: dict, rows: list) -> dict:
     out = {}
     for ens, lab in given.items():
         if ens not in ("NVE", "NVT"):
-            raise ValueError(f"references: ensemble {ens!r}; known: NVE, NVT")
+            raise InputError(f"references: ensemble {ens!r}; known: NVE, NVT")
         lab = check_row(lab)
         if lab not in rows:
-            raise ValueError(f"the {ens} reference {lab!r} is not among the rows")
+            raise InputError(f"the {ens} reference {lab!r} is not among the rows")
         r = to_row(lab)
         if r.ensemble != ens or not r.is_ours or r.hmr_da is not None or r.mts:
-            raise ValueError(f"the {ens} reference must be an {ens} row of this package without HMR or MTS, got {lab!r}")
+            raise InputError(f"the {ens} reference must be an {ens} row of this package without HMR or MTS, got {lab!r}")
         out[ens] = lab
     if "NVE" not in out:
-        raise ValueError("references: an NVE reference is needed")
+        raise InputError("references: an NVE reference is needed")
     return out
 
 
@@ -79,17 +83,17 @@ def check(cfg: dict) -> list:
     check_settings(cfg, ("replicas", "n_waters", "rdf_every"),
                    ("length_ps", "sample_fs", "omega_ps", "omega_fs", "equilibrate_ps", "cutoff_nm", "temperature"))
     if float(cfg["omega_fs"]) > 4.0:
-        raise ValueError(f"omega_fs must be <= 4 fs (the angular-velocity correlation falls to zero within "
+        raise InputError(f"omega_fs must be <= 4 fs (the angular-velocity correlation falls to zero within "
                          f"~20 fs), got {cfg['omega_fs']}")
     if cfg.get("model", "spce") not in ("spce", "tip3p"):
-        raise ValueError(f"model {cfg.get('model')!r}; known: spce, tip3p")
+        raise InputError(f"model {cfg.get('model')!r}; known: spce, tip3p")
     rows = [check_row(r) for r in cfg["rows"]]
     if not rows:
-        raise ValueError("no rows")
+        raise InputError("no rows")
     references(cfg, rows)
     dup = sorted({x for x in rows if rows.count(x) > 1})
     if dup:
-        raise ValueError(f"rows given twice: {', '.join(dup)}")
+        raise InputError(f"rows given twice: {', '.join(dup)}")
     return rows
 
 
@@ -118,8 +122,7 @@ class FidelityStudy(Study):
         runs = []
         for row in map(to_row, self.rows):
             cost = row.evals_per_ps(True) * (cfg["settle_ps"] + cfg["omega_ps"] + cfg["length_ps"])
-            runs += [Run(run_key(cfg, row.label, r), "box", (row.label, r), {"row": row.label, "replica": r}, cost)
-                     for r in range(int(cfg["replicas"]))]
+            runs += [run_of(cfg, row.label, r, cost) for r in range(int(cfg["replicas"]))]
         return runs
 
     def shared(self, runs) -> dict:
@@ -263,11 +266,11 @@ def run_study(cfg: dict, out: str, workers: int = 2, timing: bool = True, progre
     and writes ``summary.txt``, ``equipartition.txt`` (:func:`temperature_view`), ``results.json``, ``fidelity.png`` (bias against force evaluations per ps) and,
     with timing, ``fidelity-wall.png`` (against wall time per simulated ps) there."""
     if cfg.get("frozen") and not report_only:
-        raise ValueError(f"the {cfg['frozen']} study is kept as it ran (its runs are of version "
+        raise InputError(f"the {cfg['frozen']} study is kept as it ran (its runs are of version "
                          f"{cfg.get('run_version')}, made by earlier code): remake its report with --report-only; new "
                          f"measurements run with --preset frontier")
     if int(cfg.get("run_version", RUN_VERSION)) != RUN_VERSION and not report_only:
-        raise ValueError(f"runs of version {cfg.get('run_version')} cannot be made any more (this code makes version "
+        raise InputError(f"runs of version {cfg.get('run_version')} cannot be made any more (this code makes version "
                          f"{RUN_VERSION}): use --report-only")
     study = FidelityStudy(cfg, out, workers, timing, progress, log, scheduler)
     study.report_only = bool(report_only)
