@@ -176,6 +176,10 @@ FRONTIER_DECIDING = [
     "verlet 2 fs SVR 0.1 ps every 6", "verlet 3 fs SVR 0.1 ps every 4",
     "verlet 2 fs SVR 0.1 ps every 6 middle", "verlet 3 fs SVR 0.1 ps every 4 middle",
     "langevin 1 fs friction 0.1/ps", "langevin 2 fs friction 0.1/ps", "langevin 3 fs friction 0.1/ps",
+    # the NVT answer: the omelyan-2 family on four steps, LangevinMiddle at both frictions down to the references' step
+    "omelyan-2 3 fs SVR 0.1 ps every 4", "omelyan-2 5 fs SVR 0.1 ps", "langevin 0.5 fs friction 0.1/ps",
+    "langevin 0.5 fs friction 1/ps", "langevin 1 fs friction 1/ps", "langevin 2 fs friction 1/ps",
+    "langevin 3 fs friction 1/ps",
 ]
 
 
