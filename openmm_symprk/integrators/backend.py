@@ -8,7 +8,8 @@ fixes it.  ``symprk info`` lists the same per platform.
 
 The options are checked once, into one :class:`~.options.IntegratorOptions`; each backend's constructor then calls
 :func:`resolve_for_system`, which resolves the method (:func:`openmm_symprk.methods.resolved.resolve`) with the
-System's constraint facts and checks the System against it.
+System's constraint facts and checks the System against it (warning about what breaks the conservation the run asked
+for: an NVT run's periodic box and CMMotionRemover are not warned about).
 """
 from __future__ import annotations
 
@@ -60,7 +61,8 @@ def resolve_for_system(where: str, method, system, options: IntegratorOptions, n
             f"method {resolved.name!r} is a general ({resolved.family or resolved.form}) PRK tableau; "
             f"{splittings_only}")
     if system is not None:
-        validate_system(system, f"{where}({resolved.name})", options.exact_momentum, skip=skip_checks)
+        validate_system(system, f"{where}({resolved.name})", options.exact_momentum, skip=skip_checks,
+                        thermostat=options.thermostat is not None)
         if resolved.groups is not None:
             check_groups(system, resolved.groups)
     return resolved
