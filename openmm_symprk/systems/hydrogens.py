@@ -24,14 +24,18 @@ HYDROGEN_MAX_MASS = 4.5
 
 @dataclass(frozen=True)
 class HydrogenFacts:
-    """``constrained``: bonds to a hydrogen that are constraints; ``unconstrained``: bonds to a hydrogen (bond forces)
-    without a constraint between the same two particles; ``rigid_waters``: three-particle molecules (one heavy atom,
-    two hydrogens) held by three constraints; ``lightest``: the smallest hydrogen mass (Da; 0 without hydrogens)."""
+    """``constrained``: bonds to a hydrogen that are constraints (a rigid water's three among them); ``unconstrained``:
+    bonds to a hydrogen (bond forces) without a constraint between the same two particles; ``rigid_waters``:
+    three-particle molecules (one heavy atom, two hydrogens) held by three constraints; ``solute_constrained``: the
+    constrained bonds to hydrogen outside rigid waters (HBonds of a solute); ``solute_hydrogen_mass``: the smallest
+    mass (Da) of a hydrogen outside rigid waters (0 without one; 1.5-4 after mass repartitioning, which leaves water's
+    hydrogens alone)."""
 
     constrained: int
     unconstrained: int
     rigid_waters: int
-    lightest: float
+    solute_constrained: int
+    solute_hydrogen_mass: float
 
 
 def _bond_pairs(system: mm.System):
@@ -40,6 +44,22 @@ def _bond_pairs(system: mm.System):
             for k in range(force.getNumBonds()):
                 p = force.getBondParameters(k)
                 yield int(p[0]), int(p[1])
+
+
+def _rigid_waters(constraints, hydrogen) -> list:
+    """The (heavy atom, hydrogen, hydrogen) triples that three constraints hold together and to nothing else."""
+    partners: dict = {}
+    for pair in constraints:
+        for i in pair:
+            partners.setdefault(i, set()).update(pair - {i})
+    waters = []
+    for heavy, bound in partners.items():
+        if hydrogen[heavy] or len(bound) != 2 or not all(hydrogen[h] for h in bound):
+            continue
+        h1, h2 = bound
+        if partners.get(h1, set()) == {heavy, h2} and partners.get(h2, set()) == {heavy, h1}:
+            waters.append((heavy, h1, h2))
+    return waters
 
 
 def hydrogen_facts(system: mm.System) -> HydrogenFacts:
@@ -55,18 +75,11 @@ def hydrogen_facts(system: mm.System) -> HydrogenFacts:
     hydrogen = (m > 0) & (m <= HYDROGEN_MAX_MASS) & (degree <= 2)
     constrained = sum(1 for pair in constraints if any(hydrogen[i] for i in pair))
     unconstrained = {pair for pair in bonds if any(hydrogen[i] for i in pair)} - constraints
-    partners: dict = {}
-    for pair in constraints:
-        for i in pair:
-            partners.setdefault(i, set()).update(pair - {i})
-    rigid = 0
-    for heavy, bound in partners.items():
-        if hydrogen[heavy] or len(bound) != 2 or not all(hydrogen[h] for h in bound):
-            continue
-        h1, h2 = bound
-        if partners.get(h1, set()) == {heavy, h2} and partners.get(h2, set()) == {heavy, h1}:
-            rigid += 1
-    return HydrogenFacts(constrained, len(unconstrained), rigid, float(m[hydrogen].min()) if hydrogen.any() else 0.0)
+    waters = _rigid_waters(constraints, hydrogen)
+    solute = hydrogen.copy()
+    solute[[i for water in waters for i in water[1:]]] = False
+    return HydrogenFacts(constrained, len(unconstrained), len(waters), constrained - 3 * len(waters),
+                         float(m[solute].min()) if solute.any() else 0.0)
 
 
 #: From this step (fs) on, a bond to hydrogen left to vibrate is the usual cause of a blow-up: its period of about 9-11

@@ -16,24 +16,26 @@ def clusters():
 def test_rigid_and_flexible_water(clusters):
     rigid, flexible = clusters
     facts = hydrogen_facts(rigid)
-    assert (facts.constrained, facts.unconstrained, facts.rigid_waters) == (12, 0, 4)
-    assert facts.lightest == pytest.approx(1.008, abs=1e-3)
+    assert (facts.constrained, facts.unconstrained, facts.rigid_waters, facts.solute_constrained) == (12, 0, 4, 0)
+    assert facts.solute_hydrogen_mass == 0
     facts = hydrogen_facts(flexible)
     assert (facts.constrained, facts.unconstrained, facts.rigid_waters) == (0, 8, 0)
+    assert facts.solute_hydrogen_mass == pytest.approx(1.008, abs=1e-3)  # (no rigid water: every hydrogen counts)
 
 
-def test_a_protein_with_and_without_hbonds():
-    pdb = app.PDBFile(openmm_data("test.pdb"))  # villin in water, with ions
-    mod = app.Modeller(pdb.topology, pdb.positions)
-    mod.delete([r for r in mod.topology.residues() if r.name == "HOH" or len(list(r.atoms())) == 1])
-    ff = app.ForceField("amber14-all.xml")
-    n_h = sum(1 for a in mod.topology.atoms() if a.element is app.element.hydrogen)
-    none = ff.createSystem(mod.topology, constraints=None)
-    hbonds = ff.createSystem(mod.topology, constraints=app.HBonds)
-    heavy = ff.createSystem(mod.topology, constraints=app.HBonds, hydrogenMass=4 * unit.amu)
-    assert (hydrogen_facts(none).constrained, hydrogen_facts(none).unconstrained) == (0, n_h)
-    assert (hydrogen_facts(hbonds).constrained, hydrogen_facts(hbonds).unconstrained) == (n_h, 0)
-    assert hydrogen_facts(heavy).constrained == n_h and hydrogen_facts(heavy).lightest == pytest.approx(4.0)
+def test_a_solvated_protein_with_and_without_hbonds_and_hmr():
+    pdb = app.PDBFile(openmm_data("test.pdb"))  # villin in water, with a chloride ion
+    ff = app.ForceField("amber14-all.xml", "amber14/tip3p.xml")
+    waters = sum(1 for r in pdb.topology.residues() if r.name == "HOH")
+    n_h = sum(1 for a in pdb.topology.atoms() if a.element is app.element.hydrogen) - 2 * waters
+    none = hydrogen_facts(ff.createSystem(pdb.topology, constraints=None, rigidWater=False))
+    hbonds = hydrogen_facts(ff.createSystem(pdb.topology, constraints=app.HBonds))
+    hmr = hydrogen_facts(ff.createSystem(pdb.topology, constraints=app.HBonds, hydrogenMass=4 * unit.amu))
+    assert (none.constrained, none.unconstrained, none.rigid_waters) == (0, n_h + 2 * waters, 0)
+    assert (hbonds.solute_constrained, hbonds.unconstrained, hbonds.rigid_waters) == (n_h, 0, waters)
+    assert hbonds.solute_hydrogen_mass == pytest.approx(1.008, abs=1e-3)
+    # (a methyl carbon left at 3 Da by repartitioning to 4 Da has four bonds: it is not taken for a hydrogen)
+    assert (hmr.solute_constrained, hmr.rigid_waters, hmr.solute_hydrogen_mass) == (n_h, waters, pytest.approx(4.0))
 
 
 def test_the_hint_names_the_missing_constraints_from_2_fs(clusters):
