@@ -147,25 +147,26 @@ ALWAYS_WARNED = ("virtualsites",)
 ENERGY_ISSUES = tuple(n.lower() for n in THERMOSTAT_FORCES)
 
 
-def asked_for(system: mm.System, exact_momentum: bool = False, thermostat: bool = False) -> tuple:
-    """The kinds of issue (of :func:`conservation_issues`) a run asked for conservation of, so that its integrator warns
-    about them: all of them with ``exact_momentum`` or in an NVE run of a non-periodic System (energy and momenta are
-    what such a run is for); in an NVE run of a periodic System the energy only (a barostat or thermostat force); in
-    an NVT run (``thermostat``) none.  :data:`ALWAYS_WARNED` kinds are warned in every run."""
+def asked_for(system: mm.System, exact_momentum: bool = False, thermostat: bool = False):
+    """The kinds of issue (of :func:`conservation_issues`) that break what a run conserves, so that its integrator warns
+    about them: None (every kind) with ``exact_momentum`` or in an NVE run of a System that is not periodic, where
+    energy and momenta are what the run is for; in an NVE run of a periodic System the kinds that break the energy (a
+    barostat or thermostat force); in an NVT run (``thermostat``) none.  :data:`ALWAYS_WARNED` kinds are warned in
+    every run."""
     if exact_momentum or (not thermostat and not system.usesPeriodicBoundaryConditions()):
-        return tuple(key for key, _ in conservation_issues(system))
+        return None
     return ALWAYS_WARNED + (() if thermostat else ENERGY_ISSUES)
 
 
 def validate_system(system, context: str, exact_momentum: bool = False, skip=(), thermostat: bool = False) -> None:
-    """What every integrator checks of its ``system=``: its type, one warning per kind of conservation issue the run
-    asked for (:func:`asked_for`: a periodic NVT run, ``thermostat``, gets none about its CMMotionRemover or its box),
+    """What every integrator checks of its ``system=``: its type, one warning per kind of conservation issue its run
+    asks about (:func:`asked_for`: a periodic NVT run, ``thermostat``, gets none about its CMMotionRemover or its box),
     less the kinds in ``skip``, and exact momentum refused where the System is not isolated."""
     check_system_type(system)
     issues = conservation_issues(system)
     wanted = asked_for(system, exact_momentum, thermostat)
     for key, msg in issues:
-        if key in wanted and key not in skip:
+        if (wanted is None or key in wanted) and key not in skip:
             warn_once(key, f"{context}: {msg}")
     if exact_momentum:
         bad = [msg for key, msg in issues if key in EXACT_MOMENTUM_FORBIDDEN]
