@@ -3,8 +3,9 @@ built with a larger step for a System of that kind.
 
 The measurements are data (``data/step_limits.toml``, each number with its source): rigid water (the fidelity
 study's 216 SPC/E waters), a solvated protein with HBonds, and the same with hydrogen mass repartitioning (the
-production bench's villin).  A System is of a kind when it has what limited the step there (:func:`system_kinds`): rigid
-waters, or constrained bonds to hydrogen outside them (with repartitioned hydrogens, 1.4 Da or more, or without).  An
+production bench's villin), all periodic boxes of liquid water.  A periodic System is of a kind when it has what limited
+the step there (:func:`system_kinds`): rigid waters, or constrained bonds to hydrogen outside them (with repartitioned
+hydrogens, 1.4 Da or more, or without).  An
 integrator whose method and step go beyond a measurement of its System's kinds (:func:`step_limit_warning`) warns once,
 naming the step measured, the System it was measured on and what to do: a warning only where it applies, so that it can
 be acted on.
@@ -58,8 +59,11 @@ SYSTEMS, STEP_LIMITS = _load()
 
 
 def system_kinds(system) -> tuple:
-    """The kinds of :data:`SYSTEMS` whose measurements apply to ``system``: "rigid-water" with rigid waters, "protein"
-    or "protein-hmr" with constrained bonds to hydrogen outside them and no unconstrained one."""
+    """The kinds of :data:`SYSTEMS` whose measurements apply to ``system``: a periodic System (all were measured in
+    liquid water; a cluster in vacuum takes larger steps, docs/benchmarks.md) with "rigid-water" with rigid waters,
+    "protein" or "protein-hmr" with constrained bonds to hydrogen outside them and no unconstrained one."""
+    if not system.usesPeriodicBoundaryConditions():
+        return ()
     facts = hydrogen_facts(system)
     kinds = ("rigid-water",) if facts.rigid_waters else ()
     if facts.solute_constrained and not facts.unconstrained:

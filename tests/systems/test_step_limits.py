@@ -12,7 +12,8 @@ import openmm.unit as unit
 import pytest
 
 from openmm_symprk import SymplecticIntegrator, plugin
-from openmm_symprk.systems.scenes import morse_molecule, openmm_data, water_box
+from openmm_symprk.systems.hydrogens import hydrogen_facts
+from openmm_symprk.systems.scenes import morse_molecule, openmm_data, water_box, water_cluster
 from openmm_symprk.systems.step_limits import (STEP_LIMITS, SYSTEMS, StepLimitWarning, step_limit_warning,
                                                system_kinds)
 
@@ -60,13 +61,15 @@ def spce_box():
 
 @pytest.fixture(scope="module")
 def villin():
-    """The solute of OpenMM's test.pdb with HBonds, without and with hydrogen mass repartitioning to 1.5 Da."""
+    """The solute of OpenMM's test.pdb in its periodic box (the water left out: it is not what is tested here) with
+    HBonds, without and with hydrogen mass repartitioning to 1.5 Da."""
     pdb = app.PDBFile(openmm_data("test.pdb"))
     mod = app.Modeller(pdb.topology, pdb.positions)
     mod.delete([r for r in mod.topology.residues() if r.name == "HOH" or len(list(r.atoms())) == 1])
     ff = app.ForceField("amber14-all.xml")
-    return (ff.createSystem(mod.topology, constraints=app.HBonds),
-            ff.createSystem(mod.topology, constraints=app.HBonds, hydrogenMass=1.5 * unit.amu))
+    options = dict(nonbondedMethod=app.CutoffPeriodic, constraints=app.HBonds)
+    return (ff.createSystem(mod.topology, **options),
+            ff.createSystem(mod.topology, hydrogenMass=1.5 * unit.amu, **options))
 
 
 def _built(system, method, step_fs, backend="custom", **options):
@@ -108,9 +111,12 @@ def test_a_protein_without_hmr_at_4_fs_is_told_what_was_measured(villin):
 
 
 def test_no_warning_where_the_measurements_do_not_apply():
-    """A System without rigid water or constrained hydrogens (here a Morse molecule in vacuum) is not of the kinds
-    measured: its step is its own business."""
+    """A System without rigid water or constrained hydrogens (a Morse molecule), or not periodic (a cluster of rigid
+    waters in vacuum, whose steps the liquid's do not limit), is not of the kinds measured."""
     assert _built(morse_molecule().system, "yoshida-4", 5) == []
+    cluster = water_cluster(8, minimize=False).system
+    assert hydrogen_facts(cluster).rigid_waters == 8 and system_kinds(cluster) == ()
+    assert _built(cluster, "yoshida-4", 5) == []
 
 
 def test_every_row_names_a_known_system_and_method():
