@@ -8,7 +8,9 @@ fixes it.  ``symprk info`` lists the same per platform.
 
 The options are checked once, into one :class:`~.options.IntegratorOptions`; each backend's constructor then calls
 :func:`resolve_for_system`, which resolves the method (:func:`openmm_symprk.methods.resolved.resolve`) with the
-System's constraint facts and checks the System against it.
+System's constraint facts and checks the System against it (warning about what breaks the conservation the run asked
+for: an NVT run's periodic box and CMMotionRemover are not warned about), and warns once where the step is beyond what
+the method was measured to run on a System of its kind (:mod:`openmm_symprk.systems.step_limits`).
 """
 from __future__ import annotations
 
@@ -16,6 +18,7 @@ from .. import plugin
 from ..methods.resolved import ConstraintSupportError, ResolvedMethod, resolve
 from ..systems.checks import validate_system, warn_once
 from ..systems.forcegroups import check_groups
+from ..systems.step_limits import warn_step_limit
 from .options import NATIVE_OPTIONS, OPTIONS, IntegratorOptions, check_option_names
 from ..support.errors import InputError
 
@@ -61,7 +64,10 @@ def resolve_for_system(where: str, method, system, options: IntegratorOptions, n
             f"method {resolved.name!r} is a general ({resolved.family or resolved.form}) PRK tableau; "
             f"{splittings_only}")
     if system is not None:
-        validate_system(system, f"{where}({resolved.name})", options.exact_momentum, skip=skip_checks)
+        validate_system(system, f"{where}({resolved.name})", options.exact_momentum, skip=skip_checks,
+                        thermostat=options.thermostat is not None)
+        if resolved.entry is not None and not resolved.is_mts:
+            warn_step_limit(system, resolved.entry.name, options.step_size * 1000.0, f"{where}({resolved.name})")
         if resolved.groups is not None:
             check_groups(system, resolved.groups)
     return resolved

@@ -39,6 +39,7 @@ import openmm as mm
 import openmm.unit as unit
 
 from ..physics.temperature import R_KJ
+from ..systems.hydrogens import unconstrained_hydrogen_hint
 from .quantities import positive_quantity
 from .thermostat import check_seed, on_step_temperature
 from ..support.errors import InputError, SymprkError
@@ -159,9 +160,12 @@ class IntegratorBase:
         return "velocities became NaN or infinite"
 
     def _blow_up(self, step: int, what: str) -> SimulationBlowUpError:
+        context = self._bound_context()
+        step_fs = self.getStepSize().value_in_unit(unit.femtoseconds)
+        hint = unconstrained_hydrogen_hint(context.getSystem(), step_fs) if context is not None else ""
         return SimulationBlowUpError(
             f"the simulation blew up at integrator step {step} with method {self.method_name!r} at step size "
-            f"{self.getStepSize()} ({self.backend} backend): {what}. Reduce the step size (largest stable "
+            f"{self.getStepSize()} ({self.backend} backend): {what}.{hint} Reduce the step size (largest stable "
             f"h*omega for this method: {self._stability()}), or minimize the energy first. The Context still "
             f"holds the non-finite state: reload a checkpoint, or positions and velocities saved before this "
             f"call, and go on (the blow-up record is cleared).")

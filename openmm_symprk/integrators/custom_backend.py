@@ -28,6 +28,7 @@ from . import program, thermostat_program
 from .backend import resolve_for_system
 from .base import CheckpointMismatchError, ConvergenceWarning, IntegratorBase, SystemMismatchError
 from .metadata import add_metadata, metadata
+from .mismatch import mismatch_message
 from .options import DEFAULT_MAX_ITERATIONS, DEFAULT_TOLERANCE, OPTIONS, IntegratorOptions, check_option_names
 from .projection import set_masses
 from .symplectic import SymplecticIntegrator
@@ -149,13 +150,10 @@ class PRKIntegrator(IntegratorBase, mm.CustomIntegrator):
             self._check_context()  # per-DOF values set while bound were dropped: set them again before stepping
         stored = self.getGlobalVariable(0)
         if stored != self.program_info.signature:
-            raise CheckpointMismatchError(
-                f"{type(self).__name__}({self.method_name}): the Context holds the state of another integrator "
-                f"program (its signature {stored:.0f} is not this program's {self.program_info.signature}): a "
-                f"checkpoint saved with another method, other options (exact_momentum, constraints, max_speed) or the "
-                f"native backend was loaded. Create the integrator as it was when the checkpoint was saved (a native "
-                f"checkpoint needs backend='native'), load the checkpoint into that one, or load a State "
-                f"(positions and velocities) instead.")
+            context = self._bound_context()
+            raise CheckpointMismatchError(mismatch_message(
+                f"{type(self).__name__}({self.method_name})", self.resolved, self.options, stored,
+                self.program_info.signature, context.getSystem() if context is not None else None))
         if self.thermostat is not None:
             self._keep_thermostat_settings()
 

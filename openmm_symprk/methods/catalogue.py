@@ -2,12 +2,15 @@
 
 ``methods`` maps every name (and alias) to a :class:`Method`.  Splittings and compositions carry an
 exact kick/drift :class:`~openmm_symprk.methods.splitting.Splitting`; implicit and reference methods carry a
-tableau pair only.  Lookups of unknown names raise :class:`UnknownMethodError` with close suggestions.
+tableau pair only.  Lookups of unknown names raise :class:`UnknownMethodError` with close suggestions; the name of
+a thermostat or stochastic integrator (``"langevin"``, ``"baoab"``, ``"nose-hoover"``: ``data/thermostats.toml``) is
+told that the package's NVT is a method with ``temperature=``.
 """
 from __future__ import annotations
 
 import difflib
 import math
+import re
 import tomllib
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -160,6 +163,9 @@ class _Catalogue(Mapping):
             raise UnknownMethodError(f"a method name must be a string, got {name!r}")
         key = self._alias.get(normalise_name(name))
         if key is None:
+            hint = thermostat_hint(name)
+            if hint:
+                raise UnknownMethodError(f"unknown method {name!r}: {hint}")
             raise UnknownMethodError(
                 f"unknown method {name!r}.{self.suggest(name)} Known methods: {', '.join(self._entries)} "
                 f"(or pass your own PRKTableau to PRKIntegrator).")
@@ -199,6 +205,30 @@ def normalise_name(name: str) -> str:
     return name.strip().lower().replace("_", "-").replace(" ", "-")
 
 
+def _thermostat_key(name: str) -> str:
+    """A name as thermostat names are compared: lower case, letters and digits only, no trailing "integrator"."""
+    key = re.sub(r"[^a-z0-9]", "", name.lower())
+    return key[:-len("integrator")] if key.endswith("integrator") and key != "integrator" else key
+
+
+_THERMOSTATS = {_thermostat_key(n): entry for entry in
+                tomllib.loads(resources.files(__package__).joinpath("data", "thermostats.toml").read_text())["thermostat"]
+                for n in entry["names"]}
+
+
+def thermostat_hint(name) -> str:
+    """What to do instead, when ``name`` names a thermostat or stochastic integrator rather than a method ("" if it
+    does not): give a method and ``temperature=`` (or use OpenMM's integrator of that kind)."""
+    entry = _THERMOSTATS.get(_thermostat_key(name)) if isinstance(name, str) else None
+    if entry is None:
+        return ""
+    openmm = f" For {entry['what']} itself, use OpenMM's {entry['openmm']}." if entry["openmm"] else ""
+    return (f"that is {entry['what']}, not a symplectic method. This package's NVT is a method with temperature=, "
+            f"the package's thermostat (stochastic velocity rescaling, docs/thermostat.md), e.g. "
+            f"SymplecticIntegrator(step, \"verlet\", system=system, temperature=300*unit.kelvin); `symprk methods` "
+            f"lists the methods.{openmm}")
+
+
 methods = _Catalogue(_build(_load("splittings.toml") + _load("tableaux.toml")))
 
 
@@ -222,5 +252,5 @@ def format_table(entries=None) -> str:
     return "\n".join(lines)
 
 
-__all__ = ["Method", "methods", "get_method", "format_table", "normalise_name", "UnknownMethodError", "FAMILIES",
-           "HAMILTONIANS", "KICK", "DRIFT"]
+__all__ = ["Method", "methods", "get_method", "format_table", "normalise_name", "thermostat_hint", "UnknownMethodError",
+           "FAMILIES", "HAMILTONIANS", "KICK", "DRIFT"]

@@ -142,11 +142,33 @@ def check_system_type(system) -> None:
         raise TypeError(f"system must be an openmm.System, got {type(system).__name__}{hint}")
 
 
-def validate_system(system, context: str, exact_momentum: bool = False, skip=()) -> None:
-    """What every integrator checks of its ``system=``: its type, one warning per kind of conservation issue
-    (less the kinds in ``skip``), and exact momentum refused where the System is not isolated."""
+#: Issue kinds that say what a run gets wrong, not what it fails to conserve: warned whatever the run asked for.
+ALWAYS_WARNED = ("virtualsites",)
+#: Issue kinds that break the conservation of energy: warned in NVE, where energy is what the run conserves.
+ENERGY_ISSUES = tuple(n.lower() for n in THERMOSTAT_FORCES)
+
+
+def asked_for(system: mm.System, exact_momentum: bool = False, thermostat: bool = False):
+    """The kinds of issue (of :func:`conservation_issues`) that break what a run conserves, so that its integrator warns
+    about them: None (every kind) with ``exact_momentum`` or in an NVE run of a System that is not periodic, where
+    energy and momenta are what the run is for; in an NVE run of a periodic System the kinds that break the energy (a
+    barostat or thermostat force); in an NVT run (``thermostat``) none.  :data:`ALWAYS_WARNED` kinds are warned in
+    every run."""
+    if exact_momentum or (not thermostat and not system.usesPeriodicBoundaryConditions()):
+        return None
+    return ALWAYS_WARNED + (() if thermostat else ENERGY_ISSUES)
+
+
+def validate_system(system, context: str, exact_momentum: bool = False, skip=(), thermostat: bool = False) -> None:
+    """What every integrator checks of its ``system=``: its type, one warning per kind of conservation issue its run
+    asks about (:func:`asked_for`: a periodic NVT run, ``thermostat``, gets none about its CMMotionRemover or its box),
+    less the kinds in ``skip``, and exact momentum refused where the System is not isolated."""
     check_system_type(system)
-    issues = warn_conservation(system, context, skip=skip)
+    issues = conservation_issues(system)
+    wanted = asked_for(system, exact_momentum, thermostat)
+    for key, msg in issues:
+        if (wanted is None or key in wanted) and key not in skip:
+            warn_once(key, f"{context}: {msg}")
     if exact_momentum:
         bad = [msg for key, msg in issues if key in EXACT_MOMENTUM_FORBIDDEN]
         if bad:

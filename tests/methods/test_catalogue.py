@@ -109,6 +109,30 @@ def test_unknown_name_suggests_close_names():
     assert "unknown method 'yoshida-5'" in msg and "'yoshida-4'" in msg and "Known methods" in msg
 
 
+
+@pytest.mark.parametrize("name, openmm", [("langevin", "LangevinMiddleIntegrator"), ("BAOAB", "LangevinMiddleIntegrator"),
+                                          ("langevin-middle", "LangevinMiddleIntegrator"),
+                                          ("LangevinMiddleIntegrator", "LangevinMiddleIntegrator"),
+                                          ("nose_hoover", "NoseHooverIntegrator"), ("brownian", "BrownianIntegrator"),
+                                          ("svr", None)])
+def test_a_thermostat_given_as_a_method_is_pointed_to_temperature(name, openmm):
+    """A thermostat's name is not misspelt: the error says that the package's NVT is a method with temperature=, and
+    names OpenMM's integrator of that kind, instead of suggesting close method names."""
+    from openmm_symprk import SymplecticIntegrator
+
+    with pytest.raises(UnknownMethodError) as info:
+        SymplecticIntegrator(0.002, name)
+    msg = str(info.value)
+    assert msg.startswith(f"unknown method {name!r}: that is ") and "not a symplectic method" in msg
+    assert "temperature=300*unit.kelvin" in msg and "Did you mean" not in msg and "Known methods" not in msg
+    assert (f"use OpenMM's {openmm}" in msg) if openmm else "use OpenMM's" not in msg
+
+
+def test_a_name_that_only_contains_a_thermostat_name_gets_suggestions():
+    with pytest.raises(UnknownMethodError, match="Did you mean 'verlet'") as info:
+        get_method("verlet-langevin")
+    assert "temperature=" not in str(info.value)
+
 def test_families_and_table():
     fams = {m.family for m in catalogue.values()}
     assert fams == {"splitting", "composition", "implicit", "reference"}

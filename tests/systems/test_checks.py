@@ -149,3 +149,60 @@ def test_validate_system(build):
                 warnings.simplefilter("ignore")
                 validate_system(system, "test", exact_momentum=True)
         validate_system(system, "test", exact_momentum=False)  # without exact momentum: a warning only
+
+
+# -- what a run asked for: a production NVT box is not told about its CMMotionRemover and its box --------------------
+@pytest.fixture(scope="module")
+def standard_box():
+    """ForceField.createSystem's defaults on a small TIP3P box: PME, HBonds, and the CMMotionRemover it adds."""
+    import openmm.app as app
+
+    ff = app.ForceField("amber14-all.xml", "amber14/tip3p.xml")
+    mod = app.Modeller(app.Topology(), [])
+    mod.addSolvent(ff, model="tip3p", boxSize=mm.Vec3(2.0, 2.0, 2.0) * unit.nanometer)
+    system = ff.createSystem(mod.topology, nonbondedMethod=app.PME, nonbondedCutoff=0.9 * unit.nanometer,
+                             constraints=app.HBonds)
+    assert {k for k, _ in conservation_issues(system)} == {"cmmotionremover", "periodic"}
+    return system
+
+
+@pytest.mark.parametrize("backend", ["native", "custom"])
+def test_a_standard_pme_box_in_nvt_builds_without_a_conservation_warning(standard_box, backend):
+    from openmm_symprk import SymplecticIntegrator
+
+    caught, _ = _warned(lambda: SymplecticIntegrator(2 * unit.femtoseconds, "verlet", system=standard_box,
+                                                     backend=backend, temperature=300 * unit.kelvin))
+    assert [str(w.message) for w in caught] == []
+
+
+def test_exact_momentum_on_a_standard_pme_box_still_warns_and_refuses(standard_box):
+    from openmm_symprk import SymplecticIntegrator
+
+    def build():
+        with pytest.raises(ValueError, match="only correct for an isolated System.*Use exact_momentum=False"):
+            SymplecticIntegrator(2 * unit.femtoseconds, "verlet", system=standard_box, exact_momentum=True,
+                                 temperature=300 * unit.kelvin)
+
+    caught, _ = _warned(build)  # both kinds, as before: the user asked for conservation
+    messages = " | ".join(str(w.message) for w in caught)
+    assert len(caught) == 2 and "CMMotionRemover" in messages and "periodic boundary conditions" in messages
+
+
+def test_an_nve_run_is_told_what_breaks_the_conservation_it_is_for(build, standard_box):
+    """NVE of an isolated System: every kind, as before; NVE of a periodic box: what breaks its energy (a barostat),
+    not its CMMotionRemover or its box; NVT: none of them."""
+    system = _isolated(build)
+    system.addForce(mm.CMMotionRemover())
+    caught, _ = _warned(lambda: validate_system(system, "nve"))
+    assert len(caught) == 1 and "CMMotionRemover" in str(caught[0].message)
+    warn_once.reset()
+    caught, _ = _warned(lambda: validate_system(system, "nvt", thermostat=True))
+    assert caught == []
+    box = copy.deepcopy(standard_box)
+    caught, _ = _warned(lambda: validate_system(box, "nve"))
+    assert caught == []
+    box.addForce(mm.MonteCarloBarostat(1.0, 300.0))
+    caught, _ = _warned(lambda: validate_system(box, "npt", thermostat=True))
+    assert caught == []
+    caught, _ = _warned(lambda: validate_system(box, "nve"))
+    assert [str(w.message).split(":")[0] for w in caught] == ["nve"] and "MonteCarloBarostat" in str(caught[0].message)

@@ -257,6 +257,10 @@ vector<double> SymPRKIntegrator::computeRescalingFactor(double kinetic, double t
 }
 
 long long SymPRKIntegrator::getProgramSignature() const {
+    return programSignature(exactMomentum);
+}
+
+long long SymPRKIntegrator::programSignature(bool exact) const {
     // FNV-1a over the sub-step kinds, coefficients' bits, force groups and flags, and the exact-momentum option.
     uint64_t hash = 1469598103934665603ULL;
     auto mix = [&] (const void* data, size_t size) {
@@ -281,8 +285,8 @@ long long SymPRKIntegrator::getProgramSignature() const {
         mix(&group, sizeof(group));
         mix(&flag, sizeof(flag));
     }
-    int32_t exact = exactMomentum ? 1 : 0;
-    mix(&exact, sizeof(exact));
+    int32_t exactFlag = exact ? 1 : 0;
+    mix(&exactFlag, sizeof(exactFlag));
     if (thermostat) {
         // the thermostat's settings but its temperature (nothing without one: the NVE signature is unchanged)
         int32_t tag = 0x54686572, interval = thermostatInterval, dof = thermostatDof, keep = keepRotation ? 1 : 0;
@@ -457,10 +461,22 @@ void SymPRKIntegrator::loadCheckpoint(istream& stream) {
                "positions and velocities of the saved run (a State or a PDB/XML file) instead";
         throw OpenMMException(msg.str());
     }
-    if (!stream || (values[0] != CHECKPOINT_MAGIC && !version4))
-        throw OpenMMException("SymPRKIntegrator: the checkpoint was not written by a SymPRKIntegrator (a checkpoint "
-                "of openmm_symprk's CustomIntegrator backend? Load it into SymplecticIntegrator(..., backend='custom') "
-                "with the same method and options as when it was saved)");
+    if (!stream || (values[0] != CHECKPOINT_MAGIC && !version4)) {
+        // A program of openmm_symprk's CustomIntegrator backend writes its globals here, its signature first (an
+        // integer below 2^52, as a double); OpenMM's Verlet and Langevin integrators write nothing of their own.
+        double first = 0;
+        memcpy(&first, &values[0], sizeof(first));
+        const bool customProgram = (stream.gcount() >= (streamsize) sizeof(first) && std::isfinite(first) && first >= 1 &&
+                                    first < 4503599627370496.0 && first == std::floor(first));
+        if (customProgram)
+            throw OpenMMException("SymPRKIntegrator: the checkpoint was not written by a SymPRKIntegrator but, by the "
+                    "look of it, by openmm_symprk's CustomIntegrator backend: load it into SymplecticIntegrator(..., "
+                    "backend='custom') with the same method and options as when it was saved");
+        throw OpenMMException("SymPRKIntegrator: the checkpoint was not written by a SymPRKIntegrator but by another "
+                "integrator (OpenMM's VerletIntegrator, LangevinMiddleIntegrator and the like). A checkpoint continues "
+                "the run of the integrator that wrote it; to go on from that run with this one, save a State there "
+                "(Simulation.saveState) and load it here (Simulation.loadState), or set the positions and velocities");
+    }
     int64_t more[2];
     stream.read((char*) more, sizeof(more));
     string name(more[1] > 0 && more[1] < 4096 ? more[1] : 0, ' ');
@@ -469,10 +485,7 @@ void SymPRKIntegrator::loadCheckpoint(istream& stream) {
     if (!stream)
         throw OpenMMException("SymPRKIntegrator: the checkpoint is truncated");
     if (more[0] != getProgramSignature())
-        throw OpenMMException("SymPRKIntegrator: the checkpoint was written by a SymPRKIntegrator running another program "
-                "(method '"+name+"'; this one runs '"+methodName+"' with exact momentum "+(exactMomentum ? "on" : "off")+
-                (thermostat ? ", with a thermostat" : ", without a thermostat")+"): create the integrator with the same "
-                "method and options as when the checkpoint was saved");
+        throw OpenMMException(checkpointMismatch(stream, more[0], name));
     int64_t hasBath = 0;
     stream.read((char*) &hasBath, sizeof(hasBath));
     SymPRKThermostat::RunState run;
@@ -508,6 +521,36 @@ void SymPRKIntegrator::loadCheckpoint(istream& stream) {
     if (context != NULL)
         kernel.getAs<IntegrateSymPRKStepKernel>().setBlowUpStep(*context, blowUpStep);
     forcesAreValid = false;
+}
+
+string SymPRKIntegrator::checkpointMismatch(istream& stream, long long saved, const string& savedMethod) const {
+    int64_t savedBath = -1;
+    stream.read((char*) &savedBath, sizeof(savedBath));
+    vector<string> differs;
+    bool ensemble = false;
+    if (stream && (savedBath == 0 || savedBath == 1) && (savedBath == 1) != thermostat) {
+        ensemble = true;
+        differs.push_back(string("the ensemble (the checkpoint's run was ")+(savedBath == 1 ? "NVT, with temperature=" :
+                "NVE, without temperature=")+"; this integrator runs "+(thermostat ? "NVT" : "NVE")+")");
+    }
+    if (savedMethod != methodName)
+        differs.push_back("the method (the checkpoint's run used '"+savedMethod+"'; this integrator runs '"+methodName+"')");
+    if (differs.empty() && saved == programSignature(!exactMomentum))
+        differs.push_back(string("exact_momentum (the checkpoint's run had it ")+(exactMomentum ? "off" : "on")+
+                "; this integrator has it "+(exactMomentum ? "on" : "off")+")");
+    if (differs.empty())
+        differs.push_back(thermostat ? "the thermostat's settings other than its temperature (collision_time, "
+                "thermostat_interval, thermostat_position) or the System's degrees of freedom (its constraints)" :
+                "the program's sub-steps (the System's constraints, or groups= and inner_method=)");
+    string what = differs[0];
+    for (size_t i = 1; i < differs.size(); i++)
+        what += " and "+differs[i];
+    string message = "SymPRKIntegrator: the checkpoint was written by a SymPRKIntegrator running another program; what "
+            "differs: "+what+". ";
+    if (ensemble)
+        return message+"A checkpoint continues one run in its ensemble; to change the ensemble, save a State of that "
+                "run (Simulation.saveState) and load it into a Simulation with this integrator (Simulation.loadState)";
+    return message+"Create the integrator with the same method and options as when the checkpoint was saved";
 }
 
 // A State's integrator parameters: the heat-bath energy, so that a State carries the effective energy's offset as the

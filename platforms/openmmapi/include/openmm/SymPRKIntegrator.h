@@ -293,6 +293,11 @@ protected:
     void deserializeParameters(const OpenMM::SerializationNode& node);
 
 private:
+    /** The program signature (getProgramSignature) with the exact-momentum option given. */
+    long long programSignature(bool exact) const;
+    /** Why loadCheckpoint refuses a SymPRKIntegrator checkpoint of another program: what differs (read on from
+     * `stream`, just after the method name), and what to do. */
+    std::string checkpointMismatch(std::istream& stream, long long saved, const std::string& savedMethod) const;
     /** The thermostat's run-time state in the bound Context's kernel (all zero when not bound or without a thermostat). */
     SymPRKThermostat::RunState thermostatRunState() const;
     /** index, after checking that it names a sub-step. */
