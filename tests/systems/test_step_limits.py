@@ -24,7 +24,8 @@ BACKENDS = ["custom", pytest.param("native", marks=pytest.mark.skipif(
 
 def test_the_rigid_water_rows_are_the_committed_runs():
     """Every rigid-water row, derived again from the fidelity study's committed runs of SPC/E: the largest step at which
-    every run of the method was "ok", the smallest at which every run was "unstable at step N", and the runs there."""
+    every run of the method was "ok", the smallest at which every run was "unstable at step N", and the runs there
+    (at least the number the table quotes)."""
     runs: dict = {}
     for path in glob.glob(os.path.join(REPO, "docs", "data", "fidelity", "*spce", "runs", "*.json")):
         with open(path) as fh:
@@ -51,7 +52,8 @@ def test_the_rigid_water_rows_are_the_committed_runs():
     for method, limit in table.items():
         row = derived[method]
         assert (limit.stable_fs, limit.unstable_fs) == (row["stable"], row["unstable"]), method
-        assert limit.runs == row["runs"][limit.unstable_fs or limit.stable_fs], method
+        # the runs the table quotes are committed (a measurement that adds replicas adds to them)
+        assert limit.runs <= row["runs"][limit.unstable_fs or limit.stable_fs], method
 
 
 @pytest.fixture(scope="module")
