@@ -5,18 +5,19 @@ LangevinMiddleIntegrator and of the native integrator's plan shapes, each on the
     python tools/count_launches.py                  # a 2.2 nm TIP3P box, PME, HBonds, OpenCL mixed: the table
     python tools/count_launches.py --kernels        # and each integrator's launches per kernel name
     python tools/count_launches.py --json out.json  # the numbers as JSON (tests/plugin/test_launch_counts.py)
+    python tools/count_launches.py --exec symprk speed --platform OpenCL ...   # any command, counted
 
-It compiles tools/launch_intercept.cpp with g++ (into build/launch-intercept/, or --build-dir) and runs itself again
-with that library preloaded (LD_PRELOAD): every clEnqueueNDRangeKernel, device-side copy and fill counts as a launch,
-every clEnqueueReadBuffer, WriteBuffer and MapBuffer as a host copy (on CUDA: cuLaunchKernel, cuMemcpy*).  For each
-integrator: a Context, ``step(warmup)``, then the counts of one ``step(steps)`` call per step (the issue's measure),
-and of one ``step(steps // 2)`` call, whose difference gives the cost of a step apart from the cost of a call.  The
-native rows also show the plugin's own launches per step (``getKernelLaunches``: its kernels alone).
+It compiles tools/launch_intercept.cpp with g++ (into build/launch-intercept/, or --build-dir) and runs itself (or the
+--exec command) again with that library preloaded (LD_PRELOAD): every clEnqueueNDRangeKernel, device-side copy and
+fill counts as a launch, every clEnqueueReadBuffer, WriteBuffer and MapBuffer as a host copy (on CUDA: cuLaunchKernel,
+cuMemcpy*).  For each integrator: a Context, ``step(warmup)``, then the counts of one ``step(steps)`` call per step
+(the issue's measure), and of ``calls`` calls of ``steps // calls`` steps (the same steps, so that work OpenMM does
+every few steps falls alike), whose difference gives the cost of a call apart from the cost of a step.  The native
+rows also show the plugin's own launches per step (``device_counts()``: its kernels alone).
 """
 from __future__ import annotations
 
 import argparse
-import ctypes
 import json
 import os
 import subprocess
@@ -25,10 +26,6 @@ from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 SOURCE = HERE / "launch_intercept.cpp"
-#: the intercept's counters, in the order of symprk_intercept_count
-COUNTERS = ("kernels", "device_copies", "fills", "reads", "writes", "maps")
-
-
 def build(out_dir: Path) -> Path:
     """Compile the intercept library into out_dir (again only when the source is newer); its path."""
     out_dir.mkdir(parents=True, exist_ok=True)
@@ -37,34 +34,6 @@ def build(out_dir: Path) -> Path:
         subprocess.run([os.environ.get("CXX", "g++"), "-O2", "-shared", "-fPIC", "-o", str(lib), str(SOURCE), "-ldl"],
                        check=True)
     return lib
-
-
-def intercept():
-    """The preloaded intercept library, or None when this process runs without it."""
-    try:
-        lib = ctypes.CDLL(None)
-        lib.symprk_intercept_count.restype = ctypes.c_longlong
-        return lib
-    except AttributeError:
-        return None
-
-
-def snapshot(lib) -> dict:
-    counts = {name: int(lib.symprk_intercept_count(i)) for i, name in enumerate(COUNTERS)}
-    size = lib.symprk_intercept_kernels(None, 0)
-    buf = ctypes.create_string_buffer(size)
-    lib.symprk_intercept_kernels(buf, size)
-    counts["per_kernel"] = {line.rsplit(" ", 1)[0]: int(line.rsplit(" ", 1)[1])
-                            for line in buf.value.decode().splitlines() if line}
-    return counts
-
-
-def launches(c: dict) -> int:
-    return c["kernels"] + c["device_copies"] + c["fills"]
-
-
-def copies(c: dict) -> int:
-    return c["reads"] + c["writes"] + c["maps"]
 
 
 def water_box(box_nm: float):
@@ -77,7 +46,7 @@ def water_box(box_nm: float):
 
 
 def integrators(system):
-    """[(name, force evaluations per step, factory(system) -> (system, integrator))]."""
+    """[(key, name, force evaluations per step, factory(system) -> (system, integrator))]."""
     import openmm as mm
     import openmm.unit as unit
 
@@ -95,23 +64,29 @@ def integrators(system):
         return s, SymplecticIntegrator(dt, "verlet", system=s, backend="native", groups=groups)
 
     return [
-        ("OpenMM VerletIntegrator", 1, lambda s: (s, mm.VerletIntegrator(dt))),
-        ("OpenMM LangevinMiddleIntegrator", 1,
+        ("openmm-verlet", "OpenMM VerletIntegrator", 1, lambda s: (s, mm.VerletIntegrator(dt))),
+        ("openmm-langevin", "OpenMM LangevinMiddleIntegrator", 1,
          lambda s: (s, mm.LangevinMiddleIntegrator(300 * unit.kelvin, 1 / unit.picosecond, dt))),
-        ("native verlet", 1, native()),
-        ("native verlet, thermostat (middle)", 1, native(temperature=300, random_seed=5)),
-        ("native verlet, thermostat (ends)", 1, native(temperature=300, random_seed=5, thermostat_position="ends")),
-        ("native omelyan-2", 2, native("omelyan-2")),
-        ("native verlet, r-RESPA (PME reciprocal / 2)", 2, mts),
+        ("verlet", "native verlet", 1, native()),
+        ("verlet-nvt", "native verlet, thermostat (middle)", 1, native(temperature=300, random_seed=5)),
+        ("verlet-nvt-ends", "native verlet, thermostat (ends)", 1,
+         native(temperature=300, random_seed=5, thermostat_position="ends")),
+        ("omelyan-2", "native omelyan-2", 2, native("omelyan-2")),
+        ("verlet-mts", "native verlet, r-RESPA (PME reciprocal / 2)", 2, mts),
     ]
 
 
-def measure(system, pos, vel, platform, precision, warmup, steps, fusion=None) -> list:
+def measure(system, pos, vel, platform, precision, warmup, steps, calls=4, fusion=None, only=None) -> list:
     import openmm as mm
+
+    from openmm_symprk.studies.platforms.speed import host_copies, intercept, intercept_counts, launches
 
     lib = intercept()
     out = []
-    for name, evals, make in integrators(system):
+    short = steps // calls
+    for key, name, evals, make in integrators(system):
+        if only and key not in only:
+            continue
         s, ig = make(system)
         if fusion is not None and hasattr(ig, "setKernelFusion"):
             ig.setKernelFusion(fusion)
@@ -119,48 +94,49 @@ def measure(system, pos, vel, platform, precision, warmup, steps, fusion=None) -
         ctx.setPositions(pos)
         ctx.setVelocities(vel)
         ig.step(warmup)
-        native = hasattr(ig, "getKernelLaunches")
-        row = {"integrator": name, "force_evaluations": evals}
-        for n, key in ((steps, "long"), (steps // 2, "short")):
+        native = hasattr(ig, "device_counts")
+        row = {"key": key, "integrator": name, "force_evaluations": evals}
+        for key, call_steps in (("one_call", [steps]), ("calls", [short] * calls)):
             lib.symprk_intercept_reset()
-            own = ig.getKernelLaunches() if native else 0
-            ig.step(n)
-            row[key] = snapshot(lib)
+            own = ig.device_counts()[0] if native else 0
+            for n in call_steps:
+                ig.step(n)
+            row[key] = intercept_counts(lib)
             if native:
-                row[key]["own_launches"] = int(ig.getKernelLaunches()) - own
-        long, short = row["long"], row["short"]
-        half = steps - steps // 2
-        row["launches_per_step"] = launches(long) / steps
-        row["copies_per_step"] = copies(long) / steps
-        row["marginal_launches_per_step"] = (launches(long) - launches(short)) / half
-        row["marginal_copies_per_step"] = (copies(long) - copies(short)) / half
-        row["launches_per_call"] = launches(long) - steps * row["marginal_launches_per_step"]
-        row["copies_per_call"] = copies(long) - steps * row["marginal_copies_per_step"]
+                row[key]["own_launches"] = ig.device_counts()[0] - own
+        one, split = row["one_call"], row["calls"]
+        total = short * calls
+        row["launches_per_step"] = launches(one) / steps
+        row["copies_per_step"] = host_copies(one) / steps
+        # (calls - 1) more calls over the same steps (total = steps when calls divides it)
+        row["launches_per_call"] = (launches(split) - launches(one) * total / steps) / (calls - 1)
+        row["copies_per_call"] = (host_copies(split) - host_copies(one) * total / steps) / (calls - 1)
+        row["launches_per_step_beyond_calls"] = (launches(one) - row["launches_per_call"]) / steps
+        row["copies_per_step_beyond_calls"] = (host_copies(one) - row["copies_per_call"]) / steps
         if native:
-            row["own_launches_per_step"] = long["own_launches"] / steps
+            row["own_launches_per_step"] = one["own_launches"] / steps
         out.append(row)
         del ctx
     return out
 
 
-def table(rows, steps) -> str:
-    head = (f"| integrator | force evaluations per step | launches per step (one step({steps}) call) | per force "
-            f"evaluation | host copies per step | launches per step beyond a call's | per call | copies per step "
-            f"beyond a call's | per call | the plugin's own launches per step |")
-    lines = [head, "|" + "---|" * 10]
+def table(rows, steps, calls) -> str:
+    lines = [f"| integrator | force evaluations per step | launches per step | per force evaluation | host copies per "
+             f"step | launches per call | copies per call | the plugin's own launches per step |", "|" + "---|" * 8]
     for r in rows:
         own = f"{r['own_launches_per_step']:.2f}" if "own_launches_per_step" in r else "-"
         lines.append(f"| {r['integrator']} | {r['force_evaluations']} | {r['launches_per_step']:.2f} | "
                      f"{r['launches_per_step'] / r['force_evaluations']:.2f} | {r['copies_per_step']:.2f} | "
-                     f"{r['marginal_launches_per_step']:.2f} | {r['launches_per_call']:.0f} | "
-                     f"{r['marginal_copies_per_step']:.2f} | {r['copies_per_call']:.0f} | {own} |")
+                     f"{r['launches_per_call']:.1f} | {r['copies_per_call']:.1f} | {own} |")
+    lines.append(f"\n(per step: of one step({steps}) call; per call: what {calls} calls of step({steps // calls}) add to "
+                 f"the same steps, per call after the first)")
     return "\n".join(lines)
 
 
 def kernels(rows, steps) -> str:
     lines = []
     for r in rows:
-        per = r["long"]["per_kernel"]
+        per = r["one_call"]["per_kernel"]
         lines.append(f"{r['integrator']}: " + ", ".join(f"{k} {v / steps:g}" for k, v in sorted(per.items(), key=lambda kv: -kv[1])))
     return "\n".join(lines)
 
@@ -172,39 +148,49 @@ def build_parser():
     ap.add_argument("--box-nm", type=float, default=2.2, help="edge of the TIP3P box (default 2.2 nm)")
     ap.add_argument("--warmup", type=int, default=10)
     ap.add_argument("--steps", type=int, default=100)
+    ap.add_argument("--calls", type=int, default=4, help="the calls the steps are split into for the per-call cost")
     ap.add_argument("--fusion", type=int, default=None, choices=(0, 1, 2),
                     help="the native integrators' kernel fusion (SymPRKIntegrator.KernelFusion; default: theirs, 2)")
+    ap.add_argument("--only", help="comma-separated rows to count (keys: openmm-verlet, openmm-langevin, verlet, "
+                    "verlet-nvt, verlet-nvt-ends, omelyan-2, verlet-mts; default all)")
     ap.add_argument("--kernels", action="store_true", help="also each integrator's launches per step per kernel name")
     ap.add_argument("--json", metavar="FILE", help="write the rows as JSON to FILE")
     ap.add_argument("--build-dir", default=str(HERE.parent / "build" / "launch-intercept"),
                     help="where the intercept library is compiled")
+    ap.add_argument("--exec", nargs=argparse.REMAINDER, metavar="COMMAND",
+                    help="run COMMAND (the rest of the line) with the intercept preloaded instead")
     return ap
 
 
 def main(argv=None) -> int:
+    argv = list(sys.argv[1:] if argv is None else argv)
     args = build_parser().parse_args(argv)
-    if intercept() is None:
+    from openmm_symprk.studies.platforms.speed import intercept
+
+    if args.exec or intercept() is None:
         lib = build(Path(args.build_dir))
         env = dict(os.environ)
         env["LD_PRELOAD"] = ":".join(p for p in (str(lib), env.get("LD_PRELOAD", "")) if p)
-        return subprocess.run([sys.executable, str(Path(__file__).resolve()), *(argv if argv is not None else sys.argv[1:])],
-                              env=env).returncode
+        command = args.exec if args.exec else [sys.executable, str(Path(__file__).resolve()), *argv]
+        return subprocess.run(command, env=env).returncode
     import warnings
 
     import openmm as mm
 
     warnings.simplefilter("ignore")
+    if args.steps % args.calls or args.calls < 2:
+        raise SystemExit(f"--calls {args.calls} must be at least 2 and divide --steps {args.steps}")
     system, pos, vel = water_box(args.box_nm)
-    rows = measure(system, pos, vel, args.platform, args.precision, args.warmup, args.steps, args.fusion)
+    only = set(args.only.split(",")) if args.only else None
+    rows = measure(system, pos, vel, args.platform, args.precision, args.warmup, args.steps, args.calls, args.fusion, only)
     print(f"OpenMM {mm.version.full_version}, {args.platform} ({args.precision} precision), TIP3P box {args.box_nm} nm, "
-          f"{system.getNumParticles()} atoms, PME, SETTLE; step({args.warmup}), then one step({args.steps}) call and "
-          f"one step({args.steps // 2}) call\n")
-    print(table(rows, args.steps))
+          f"{system.getNumParticles()} atoms, PME, SETTLE; step({args.warmup}) first\n")
+    print(table(rows, args.steps, args.calls))
     if args.kernels:
         print()
         print(kernels(rows, args.steps))
     if args.json:
-        Path(args.json).write_text(json.dumps({"atoms": system.getNumParticles(), "steps": args.steps,
+        Path(args.json).write_text(json.dumps({"atoms": system.getNumParticles(), "steps": args.steps, "calls": args.calls,
                                                 "platform": args.platform, "precision": args.precision, "rows": rows},
                                                indent=1))
     return 0
