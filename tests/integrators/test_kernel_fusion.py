@@ -11,7 +11,8 @@ the step point), after each of two step() calls, the State read between them:
 * with virtual sites (TIP4P), which the fused kernel places before each force evaluation and at the end of the step
   rather than after every drift: the sites sit on their rule and the trajectory is the plain one's;
 * exact momentum, and the blow-up check naming the same first step;
-* a System with a force that acts between steps (a CMMotionRemover) keeps every step at the step point: bit for bit.
+* a System with a force that acts between steps (a CMMotionRemover) keeps every step at the step point: bit for bit;
+* a periodic box whose atoms OpenMM reorders on the way.
 
 On Reference and CPU the kernel is the plain reading whatever the setting: step(n) is n calls of step(1) bit for bit.
 """
@@ -133,6 +134,22 @@ def test_fused_execution_keeps_the_trajectory(case, request):
         assert launches < plain_launches  # (the counts per plan shape: tests/plugin/test_launch_counts.py)
     if scene == "tip4p":
         assert virtual_site_error(system, fused[-1][0]) < 1e-12
+
+
+@needs_common
+def test_the_atoms_reordered_on_the_way_keep_the_trajectory():
+    """A periodic box with a cutoff: OpenMM reorders the atoms every 250 steps, which the fused kernel lets happen
+    before the step's last force evaluation (where nothing is pending) rather than at the step's end; the two runs
+    cross step 250 within one call and stay at SETTLE's round-off, grown by the dynamics (about 1e-11 nm here)."""
+    from openmm_symprk.systems.prepare import maxwell_boltzmann, minimise
+    from openmm_symprk.systems.scenes import water_box
+
+    system, _, x = water_box("tip3p", box_nm=1.6, cutoff_nm=0.7)
+    x = minimise(system, x, "Reference", tolerance=10.0, max_iterations=100)
+    v = maxwell_boltzmann(system, x, 300.0, seed=2)
+    options = dict(NVT, thermostat_position="middle")
+    _compare(_run(system, x, v, "verlet", options, FUSE_NONE, calls=(270,))[0],
+             _run(system, x, v, "verlet", options, FUSE_ALL, calls=(270,))[0], 1e-9)
 
 
 @needs_common
