@@ -49,8 +49,10 @@ SHAPES = {
     "verlet-nvt-ends": ("verlet", dict(NVT, thermostat_position="ends"), {0: (8, 0), 1: (6, 0), 2: (4, 0)}),
     # [K][D][A][K][D][A][K] / [K+K+D][A][K+D][A]
     "omelyan-2": ("omelyan-2", {}, {0: (7, 0), 1: (4, 1), 2: (4, 1)}),
-    # [Ks][Kf][D][A] c [Kf][D][A] c [Kf] c [Ks] / [Ks+Ks+Kf+D][A] c [Kf+D][A] c [Kf] c  (c: a group's force copy)
-    "mts": ("verlet", {"groups": "split"}, {0: (12, 0), 1: (8, 1), 2: (8, 1)}),
+    # [Ks][Kf][D][A] c [Kf][D][A] c [Kf] c [Ks] (c: a group's force copy, after each evaluation) /
+    # [Ks+Ks+Kf+D][A] [Kf+D][A] [Kf] c (fused, the fast forces are copied only before the slow evaluation overwrites
+    # them: the next step's first fast kick reuses them)
+    "mts": ("verlet", {"groups": "split"}, {0: (12, 0), 1: (6, 1), 2: (6, 1)}),
     # p[K][D] r[A] p[K] [S] r[R] / p[K+K+D] r[A], per call [K+S] r[R] (p: projection, r: rigid sums, S: save, R: apply)
     "exact-momentum": ("verlet", {"exact_momentum": True}, {0: (10, 0), 1: (4, 3), 2: (4, 3)}),
 }

@@ -281,10 +281,8 @@ bool CommonIntegrateSymPRKStepKernel::canFuseAcross(const SymPRKStepPlan& plan, 
         return false;
     bool skipsProjection = false;
     for (int k = 0; k < n; k++) {
-        if (k > head && k < tail)
-            continue;
-        if (k == head || k == tail)
-            continue;
+        if (k >= head && k <= tail)
+            continue;  // the operations between the kicks are this step's own
         const SymPRKStepPlan::Operation& op = ops[k];
         if (op.kind == SymPRKStepPlan::ProjectVelocities)
             skipsProjection = true;
@@ -433,7 +431,8 @@ ArrayInterface& CommonIntegrateSymPRKStepKernel::kickForces(ContextImpl& context
         bool& forcesAreValid, int& evaluated) {
     // The forces of this kick's groups: computed unless the plan lets it reuse cached forces and they are still
     // valid (a multiple-time-step method keeps a copy per group, so that a group is evaluated only where a drift
-    // came between two of its kicks).
+    // came between two of its kicks).  Fused, a group's forces are copied only when another group's evaluation is
+    // about to overwrite them in the force buffer, and read from the buffer until then.
     evaluated = 0;
     if (op.reuseForces && op.keepGroupCopy && groupForcesValid[op.forceGroups])
         return *groupForces[op.forceGroups];
@@ -442,6 +441,10 @@ ArrayInterface& CommonIntegrateSymPRKStepKernel::kickForces(ContextImpl& context
         placeVirtualSites();
         if (reorderBeforeEvaluation)
             reorderAtoms(forcesAreValid);
+        const int held = context.getLastForceGroups();
+        if (op.keepGroupCopy && fusion != SymPRKIntegrator::FuseNone && forcesAreValid && held != op.forceGroups &&
+                groupForcesValid.count(held) != 0 && !groupForcesValid[held])
+            copyGroupForces(held);  // the buffer's forces of another group, which a later kick may reuse
         {
             ContextDeselector deselector(cc);
             context.calcForcesAndEnergy(true, false, op.forceGroups);
@@ -452,7 +455,16 @@ ArrayInterface& CommonIntegrateSymPRKStepKernel::kickForces(ContextImpl& context
     }
     if (!op.keepGroupCopy)
         return cc.getLongForceBuffer();
-    unique_ptr<ComputeArray>& copy = groupForces[op.forceGroups];
+    if (fusion != SymPRKIntegrator::FuseNone) {
+        groupForcesValid.emplace(op.forceGroups, false);  // (known: its forces are copied before they are overwritten)
+        return cc.getLongForceBuffer();
+    }
+    copyGroupForces(op.forceGroups);
+    return *groupForces[op.forceGroups];
+}
+
+void CommonIntegrateSymPRKStepKernel::copyGroupForces(int groups) {
+    unique_ptr<ComputeArray>& copy = groupForces[groups];
     if (!copy) {
         copy.reset(new ComputeArray());
         copy->initialize(cc, cc.getLongForceBuffer().getSize(), cc.getLongForceBuffer().getElementSize(), "symprkGroupForces");
@@ -463,8 +475,7 @@ ArrayInterface& CommonIntegrateSymPRKStepKernel::kickForces(ContextImpl& context
                 flush();  // a pending kick reads the copy's old forces
     cc.getLongForceBuffer().copyTo(*copy);
     launches++;
-    groupForcesValid[op.forceGroups] = true;
-    return *copy;
+    groupForcesValid[groups] = true;
 }
 
 void CommonIntegrateSymPRKStepKernel::ensureProjection(ArrayInterface& forces) {

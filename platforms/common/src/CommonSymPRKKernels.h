@@ -101,6 +101,8 @@ private:
     /** Run operation k of the plan as part of step stepIndex (recorded in the trace as such). */
     void runOperation(OpenMM::ContextImpl& context, const SymPRKIntegrator& integrator, const SymPRKStepPlan& plan, int k,
                       long long stepIndex, bool& forcesAreValid);
+    /** Copy the force buffer, which holds the forces of the force groups `groups`, to their copy (multiple time stepping). */
+    void copyGroupForces(int groups);
     /** Let the Context reorder the atoms (once a step; what it invalidates). */
     void reorderAtoms(bool& forcesAreValid);
     /** Compute the exact-momentum projection of forces at the current positions unless it is still valid. */
