@@ -7,8 +7,8 @@
 #   python3.12 -m pip download --no-deps -d wheels openmm==8.6.1 openmm-cuda-13==8.6.1 pymbar numexpr
 #
 # then on the GPU machine, in the repository root:  WHEELS=wheels OUT=gpucheck-out tools/gpu_check.sh
-# (GPUCHECK_ARGS: e.g. --quick; PYTEST_FILES: what to test, default the ten files of tests/integrators that hold the
-# Common-kernel tests; GPUCHECK_S, PYTEST_S: time limits in seconds).
+# (GPUCHECK_ARGS: e.g. --quick; PYTEST_FILES: what to test, default the files of tests/integrators that hold the
+# Common-kernel tests; GPUCHECK_S, LAUNCHES_S, PYTEST_S: time limits in seconds).
 set -o pipefail
 REPO=$(pwd)
 WHEELS=${WHEELS:-wheels}
@@ -38,6 +38,14 @@ PY
 cd /tmp && timeout "${GPUCHECK_S:-600}" python3 -m openmm_symprk.cli gpucheck $GPUCHECK_ARGS 2>&1 \
     | tee "$OUT/gpucheck.md"
 echo "gpucheck rc=$?" | tee -a "$OUT/gpucheck.md"
+# every launch and host copy per step (the CUDA driver API intercept of tools/count_launches.py; needs g++), mixed
+# precision, the 2.2 nm box of docs/native.md's table and the speed table's 3.9 nm one
+if command -v g++ > /dev/null; then
+    for BOX in 2.2 3.9; do
+        timeout "${LAUNCHES_S:-900}" python3 "$REPO/tools/count_launches.py" --platform CUDA --box-nm $BOX --kernels \
+            --build-dir /tmp/symprk-intercept --json "$OUT/launches-cuda-$BOX.json" 2>&1 | tee "$OUT/launches-cuda-$BOX.md"
+    done
+fi
 # the tests run from a copy beside the installed package, so that `import openmm_symprk` is the wheel's
 rm -rf /tmp/tests && cp -r "$REPO/tests" /tmp/tests && cp "$REPO/pyproject.toml" /tmp/pyproject.toml && cd /tmp/tests
 FILES=${PYTEST_FILES:-$(cd integrators && grep -l "COMMON" test_*.py | sed 's#^#integrators/#' | tr '\n' ' ')}

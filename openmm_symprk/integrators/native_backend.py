@@ -177,6 +177,12 @@ class NativeSymplecticIntegrator(SymplecticIntegrator, _PluginIntegrator, backen
     def force_evals(self) -> int:
         return int(self.getForceEvaluationsPerStep())
 
+    def device_counts(self) -> tuple:
+        """(launches, host transfers) the plugin's kernel has made itself since bound: on OpenCL/CUDA its own kernels
+        and device copies, and its reads and writes (not OpenMM's force and constraint kernels); (0, 0) on
+        Reference/CPU.  How it groups the step's operations into launches: ``setKernelFusion`` (docs/native.md)."""
+        return int(self.getKernelLaunches()), int(self.getHostTransfers())
+
     def substeps(self) -> list:
         """[(label, coefficient)] as the plugin runs them: "drift", "kick", or "kick:<groups>" for a kick of some
         force groups only (multiple time stepping)."""

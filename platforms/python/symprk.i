@@ -122,6 +122,15 @@ public:
     long long getSkippedThermostatEvents() const;
     bool getLastThermostatEventSkipped() const;
     long long getHostTransfers() const;
+    long long getKernelLaunches() const;
+    enum KernelFusion {
+        FuseNone = 0,
+        FuseSegments = 1,
+        FuseAll = 2
+    };
+    void setKernelFusion(int mode);
+    int getKernelFusion() const;
+    static int getKernelFusionBlockAtoms();
     std::vector<double> sampleThermostatNoise(int count);
     static std::vector<double> computeRescalingFactor(double kinetic, double target, int dof, double c, double r1, double chi2);
     static void registerMissingKernelFactories();

@@ -7,12 +7,15 @@ Needs OpenMM's CUDA platform (``pip install "openmm_symprk[cuda12]"`` and an NVI
 For mixed and double precision it prints, as markdown tables:
 
 1. the same program on both backends: max |x_native - x_custom| and |v_native - v_custom| after 200 steps
-   of ``verlet`` and ``yoshida-4`` (rigid-water cluster, SETTLE; villin in vacuum, HBonds: CCMA/SHAKE);
+   of ``verlet`` and ``yoshida-4`` (rigid-water cluster, SETTLE; villin in vacuum, HBonds: CCMA/SHAKE), the native
+   kernel as the plain reading of the plan and fused (:func:`same_program`);
 2. conservation: |dL|/|L| and |dP| after 2,000 steps of ``verlet`` on the cluster, with and without
    ``exact_momentum`` (:mod:`.conservation`'s table);
-3. speed: time per step of the native ``verlet`` and ``yoshida-4`` against OpenMM's VerletIntegrator (ratio per
-   force evaluation, integrators taking turns: :mod:`.speed`'s table) on a periodic rigid TIP3P box with PME and
-   on villin solvated to about 21,000 atoms (PME, HBonds, rigid water).
+3. speed: time per step of the native ``verlet``, ``omelyan-2`` and ``yoshida-4`` against OpenMM's
+   VerletIntegrator, and of the same with the thermostat (SVR, middle) against OpenMM's LangevinMiddleIntegrator
+   (ratio per force evaluation, integrators taking turns: :mod:`.speed`'s table, with the plugin's own launches and
+   host copies per step) on a periodic rigid TIP3P box with PME and on villin solvated to about 21,000 atoms (PME,
+   HBonds, rigid water).
 
 Without a CUDA platform it says why in one line and exits with status 2.  Not a test: nothing is asserted.
 """
@@ -30,8 +33,8 @@ from ..core.engine import RowEngine
 from ..core.rows import Row
 from . import conservation, speed
 
-#: The methods of the speed table.
-SPEED_METHODS = ("verlet", "yoshida-4")
+#: The methods of the speed table (each also with the thermostat).
+SPEED_METHODS = ("verlet", "omelyan-2", "yoshida-4")
 
 
 def cuda_unavailable_reason() -> str:
@@ -68,20 +71,28 @@ def _solvated_villin(n_target: int, seed: int = 7):
 
 
 def same_program(scenes, precisions, steps):
-    rows = ["| scene | precision | method | max abs(dx) nm | max abs(dv) nm/ps |", "|---|---|---|---|---|"]
+    """max |x_native - x_custom| and |v_native - v_custom| after ``steps`` steps, the native kernel run as the plain
+    reading of the plan (FuseNone: the CustomIntegrator program operation for operation) and fused (the default,
+    which leaves out velocity projections a constrained drift makes good to the constraint tolerance)."""
+    rows = ["| scene | precision | method | plain: max abs(dx) nm | max abs(dv) nm/ps | fused: max abs(dx) nm | "
+            "max abs(dv) nm/ps |", "|---|---|---|---|---|---|---|"]
     for scene in scenes:
         for prec in precisions:
             for method in ("verlet", "yoshida-4"):
-                out = []
-                for backend in ("native", "custom"):
+                out = {}
+                for key, backend, fusion in (("plain", "native", 0), ("fused", "native", None), ("custom", "custom", None)):
                     eng = RowEngine(Row(method, 1.0, backend=backend), scene, platform=f"CUDA:{prec}", start=False,
                                     quiet=False)
+                    if fusion is not None:
+                        eng.integrator.setKernelFusion(fusion)
                     eng.step(steps)
-                    out.append(eng.sample(energy=False))
+                    out[key] = eng.sample(energy=False)
                     del eng
-                dx = float(np.abs(out[0].x - out[1].x).max())
-                dv = float(np.abs(out[0].v - out[1].v).max())
-                rows.append(f"| {scene.name} | {prec} | {method} | {dx:.1e} | {dv:.1e} |")
+                cells = []
+                for key in ("plain", "fused"):
+                    cells += [f"{float(np.abs(out[key].x - out['custom'].x).max()):.1e}",
+                              f"{float(np.abs(out[key].v - out['custom'].v).max()):.1e}"]
+                rows.append(f"| {scene.name} | {prec} | {method} | " + " | ".join(cells) + " |")
     return "\n".join(rows)
 
 
@@ -115,6 +126,7 @@ def run(args):
     print("\nSpeed (fastest of the blocks, integrators taking turns):\n")
     for title, system, pos, vel in boxes:
         for p in precisions:
-            best = speed.measure(system, pos, vel, SPEED_METHODS, f"CUDA:{p}", 50 if args.quick else 300,
-                                 2 if args.quick else 4, custom=False)
-            print(speed.format_table(f"{title}, CUDA {p}", best, SPEED_METHODS, system.getNumConstraints() > 0))
+            results = speed.measure(system, pos, vel, SPEED_METHODS, f"CUDA:{p}", 50 if args.quick else 300,
+                                    2 if args.quick else 4, custom=False, thermostat=True)
+            print(speed.format_table(f"{title}, CUDA {p}", results, SPEED_METHODS, system.getNumConstraints() > 0,
+                                     thermostat=True))

@@ -33,7 +33,7 @@ SymPRKIntegrator::SymPRKIntegrator(double stepSize) : exactMomentum(false), forc
         methodName("verlet"), stepsTaken(0), blowUpStep(0), maxSpeed(0.0), expectedParticles(-1),
         expectedConstraints(false),
         thermostat(false), keepRotation(false), thermostatTemperature(0.0), collisionTime(0.0), thermostatInterval(1),
-        thermostatDof(0), randomSeed(0), traceEnabled(false) {
+        thermostatDof(0), randomSeed(0), traceEnabled(false), kernelFusion(FuseAll) {
     setStepSize(stepSize);
     setConstraintTolerance(1e-5);
     setSubsteps({Kick, Drift, Kick}, {0.5, 1.0, 0.5}, {-1, -1, -1}, {ForcesCached, 0, 0});
@@ -44,7 +44,7 @@ SymPRKIntegrator::SymPRKIntegrator(double stepSize, const vector<int>& kinds, co
         exactMomentum(false), forcesAreValid(false), methodName(""), stepsTaken(0), blowUpStep(0), maxSpeed(0.0),
         expectedParticles(-1), expectedConstraints(false),
         thermostat(false), keepRotation(false), thermostatTemperature(0.0), collisionTime(0.0), thermostatInterval(1),
-        thermostatDof(0), randomSeed(0), traceEnabled(false) {
+        thermostatDof(0), randomSeed(0), traceEnabled(false), kernelFusion(FuseAll) {
     setStepSize(stepSize);
     setConstraintTolerance(1e-5);
     setSubsteps(kinds, coefficients, groups, flags);
@@ -237,6 +237,28 @@ long long SymPRKIntegrator::getHostTransfers() const {
     return const_cast<Kernel&>(kernel).getAs<IntegrateSymPRKStepKernel>().getHostTransfers();
 }
 
+long long SymPRKIntegrator::getKernelLaunches() const {
+    if (context == NULL)
+        return 0;
+    return const_cast<Kernel&>(kernel).getAs<IntegrateSymPRKStepKernel>().getKernelLaunches();
+}
+
+void SymPRKIntegrator::setKernelFusion(int mode) {
+    if (mode != FuseNone && mode != FuseSegments && mode != FuseAll) {
+        stringstream msg;
+        msg << "SymPRKIntegrator: kernel fusion " << mode << " is not one of " << FuseNone << " (none), " << FuseSegments
+            << " (segments) and " << FuseAll << " (all)";
+        throw OpenMMException(msg.str());
+    }
+    kernelFusion = mode;
+    if (context != NULL)
+        kernel.getAs<IntegrateSymPRKStepKernel>().setKernelFusion(mode);
+}
+
+int SymPRKIntegrator::getKernelFusionBlockAtoms() {
+    return 4096;
+}
+
 vector<double> SymPRKIntegrator::sampleThermostatNoise(int count) {
     if (!thermostat)
         throw OpenMMException("SymPRKIntegrator::sampleThermostatNoise: the integrator has no thermostat (setThermostat)");
@@ -360,6 +382,7 @@ void SymPRKIntegrator::initialize(ContextImpl& contextRef) {
     k.setBlowUpStep(contextRef, blowUpStep);
     k.initializeThermostat(randomSeed);
     k.getTrace().setEnabled(traceEnabled);
+    k.setKernelFusion(kernelFusion);
     stepsTaken = 0;  // a new run (also after Context::reinitialize, as the CustomIntegrator backend counts it)
     forcesAreValid = false;
 }
@@ -421,7 +444,7 @@ void SymPRKIntegrator::step(int steps) {
     const SymPRKStepPlan& stepPlan = currentPlan();
     for (int i = 0; i < steps; ++i) {
         stepsTaken++;
-        k.execute(*context, *this, stepPlan, forcesAreValid, stepsTaken);
+        k.execute(*context, *this, stepPlan, forcesAreValid, stepsTaken, i+1 < steps);
     }
 }
 

@@ -354,7 +354,8 @@ void ReferenceIntegrateSymPRKStepKernel::checkVelocities(const SymPRKIntegrator&
 }
 
 void ReferenceIntegrateSymPRKStepKernel::execute(ContextImpl& context, const SymPRKIntegrator& integrator, const SymPRKStepPlan& plan,
-        bool& forcesAreValid, long long stepIndex) {
+        bool& forcesAreValid, long long stepIndex, bool nextStepFollows) {
+    // (nextStepFollows is ignored: this kernel is the plain reading of the plan, every step ends at the step point)
     const double dt = integrator.getStepSize();
     const double tol = integrator.getConstraintTolerance();
     const bool exact = integrator.getExactMomentum();

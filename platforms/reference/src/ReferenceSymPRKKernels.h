@@ -22,7 +22,7 @@ public:
     }
     void initialize(const OpenMM::System& system, const SymPRKIntegrator& integrator, const SymPRKStepPlan& plan);
     void execute(OpenMM::ContextImpl& context, const SymPRKIntegrator& integrator, const SymPRKStepPlan& plan,
-                 bool& forcesAreValid, long long stepIndex);
+                 bool& forcesAreValid, long long stepIndex, bool nextStepFollows);
     double computeKineticEnergy(OpenMM::ContextImpl& context, const SymPRKIntegrator& integrator);
     bool energyEvaluationKeepsForces() const {
         return true;

@@ -99,105 +99,174 @@ inline DEVICE void symprkCheckVelocity(mixed4 v, int checkStep, GLOBAL int* REST
         badStep[0] = checkStep;
 }
 
-/** kick: v += (c*dt)*F/m. */
-KERNEL void symprkKick(mixed cdt, GLOBAL mixed4* RESTRICT velm, GLOBAL const mm_long* RESTRICT force,
-        int checkStep, GLOBAL int* RESTRICT badStep) {
-    const mixed scale = cdt/(mixed) 0x100000000;
-    for (int index = GLOBAL_ID; index < NUM_ATOMS; index += GLOBAL_SIZE) {
-        mixed4 v = velm[index];
-        if (v.w != 0) {
-            v.x += scale*force[index]*v.w;
-            v.y += scale*force[index+PADDED_NUM_ATOMS]*v.w;
-            v.z += scale*force[index+2*PADDED_NUM_ATOMS]*v.w;
-            velm[index] = v;
-            symprkCheckVelocity(v, checkStep, badStep);
-        }
-    }
+/*
+ * The per-atom operations of the step, run as segments: a segment is up to four operations applied to each atom in
+ * turn, in one launch (the host groups consecutive operations of the step plan that nothing global separates:
+ * CommonSymPRKKernels.cpp).  An operation is an int4 (kind, argument, check step, 0) and a coefficient c:
+ *   SYMPRK_OP_KICK            v += c F/m with the forces of slot `argument` (0: force0, 1: force1)
+ *   SYMPRK_OP_KICK_PROJECTED  v += c (F/m - a_cm - alpha x (r - r_cm)), projection[] from symprkProjection
+ *   SYMPRK_OP_DRIFT           x += c v (no constraints)
+ *   SYMPRK_OP_DRIFT_DELTA     posDelta = c v (a constrained drift, part 1: the constraint algorithms correct it)
+ *   SYMPRK_OP_DRIFT_APPLY     x += posDelta, v += (posDelta - c v)/c (part 2), plus the rigid velocity of rigid[]
+ *                             (symprkRigidSums mode 0) when `argument` is 1
+ *   SYMPRK_OP_EVENT_APPLY     v <- u + alpha (v - u), the thermostat event symprkEventSums left in event[]
+ *   SYMPRK_OP_SAVE_VELOCITIES vBefore = v (before a velocity projection with exact momentum)
+ *   SYMPRK_OP_RIGID_APPLY     v += the rigid velocity of rigid[] (symprkRigidSums mode 1) at x
+ * A kick, a drift's apply check the velocities for a blow-up when their check step is > 0.  Each operation does
+ * the arithmetic of its own launch: a position changed and then read again is stored and read back in between,
+ * so that a segment gives, bit for bit, what its operations give one launch each.  Massless particles (velm.w 0)
+ * never move; a drift's delta is 0 for them.
+ */
+#define SYMPRK_BUFFER_PARAMS GLOBAL real4* RESTRICT posq, GLOBAL real4* RESTRICT posqCorrection, GLOBAL mixed4* RESTRICT velm, \
+        GLOBAL mixed4* RESTRICT posDelta, GLOBAL const mm_long* RESTRICT force0, GLOBAL const mm_long* RESTRICT force1, \
+        GLOBAL const mixed* RESTRICT projection, GLOBAL symprk_acc* RESTRICT event, GLOBAL const mixed* RESTRICT rigid, \
+        GLOBAL mixed4* RESTRICT vBefore, GLOBAL int* RESTRICT badStep, int withPositions
+#define SYMPRK_BUFFER_ARGS posq, posqCorrection, velm, posDelta, force0, force1, projection, event, rigid, vBefore, badStep, \
+        withPositions
+#define SYMPRK_SEGMENT_PARAMS(P) int P##count, int4 P##op0, mixed P##c0, int4 P##op1, mixed P##c1, int4 P##op2, mixed P##c2, \
+        int4 P##op3, mixed P##c3
+#define SYMPRK_SEGMENT_ARGS(P) P##count, P##op0, P##c0, P##op1, P##c1, P##op2, P##c2, P##op3, P##c3
+
+/** The position of atom index for an operation that reads it: loaded once, and stored and loaded again after a change. */
+inline DEVICE void symprkReadPos(GLOBAL real4* RESTRICT posq, GLOBAL real4* RESTRICT posqCorrection, int index, mixed4* p,
+        int* state) {
+    // state: 0 not loaded, 1 loaded, 2 changed since loaded
+    if (*state == 2)
+        symprkStorePos(posq, posqCorrection, index, *p);
+    if (*state != 1)
+        *p = symprkLoadPos(posq, posqCorrection, index);
+    *state = 1;
 }
 
-/** kick with the exact-momentum projection: v += (c*dt)*(F/m - a_cm - alpha x (r - r_cm)). */
-KERNEL void symprkKickProjected(mixed cdt, GLOBAL mixed4* RESTRICT velm, GLOBAL const mm_long* RESTRICT force,
-        GLOBAL const real4* RESTRICT posq, GLOBAL const real4* RESTRICT posqCorrection, GLOBAL const mixed* RESTRICT projection,
-        int checkStep, GLOBAL int* RESTRICT badStep) {
-    const mixed fscale = 1/(mixed) 0x100000000;
-    const mixed3 com = make_mixed3(projection[0], projection[1], projection[2]);
-    const mixed3 acm = make_mixed3(projection[3], projection[4], projection[5]);
-    const mixed3 alpha = make_mixed3(projection[6], projection[7], projection[8]);
-    for (int index = GLOBAL_ID; index < NUM_ATOMS; index += GLOBAL_SIZE) {
-        mixed4 v = velm[index];
-        if (v.w != 0) {
-            mixed4 p = symprkLoadPos(posq, posqCorrection, index);
-            mixed3 r = make_mixed3(p.x-com.x, p.y-com.y, p.z-com.z);
-            mixed ax = fscale*force[index]*v.w - acm.x - (alpha.y*r.z - alpha.z*r.y);
-            mixed ay = fscale*force[index+PADDED_NUM_ATOMS]*v.w - acm.y - (alpha.z*r.x - alpha.x*r.z);
-            mixed az = fscale*force[index+2*PADDED_NUM_ATOMS]*v.w - acm.z - (alpha.x*r.y - alpha.y*r.x);
-            v.x += cdt*ax;
-            v.y += cdt*ay;
-            v.z += cdt*az;
-            velm[index] = v;
-            symprkCheckVelocity(v, checkStep, badStep);
-        }
+/** One operation on atom index (which has mass), its velocity in *v and its position in *p (see symprkReadPos). */
+inline DEVICE void symprkAtomOp(int4 op, mixed c, int index, mixed4* v, mixed4* p, int* posState, SYMPRK_BUFFER_PARAMS) {
+    const int kind = op.x;
+    if (kind == SYMPRK_OP_KICK) {
+        GLOBAL const mm_long* RESTRICT force = (op.y == 0 ? force0 : force1);
+        const mixed scale = c/(mixed) 0x100000000;
+        v->x += scale*force[index]*v->w;
+        v->y += scale*force[index+PADDED_NUM_ATOMS]*v->w;
+        v->z += scale*force[index+2*PADDED_NUM_ATOMS]*v->w;
+        symprkCheckVelocity(*v, op.z, badStep);
     }
-}
-
-/** drift without constraints: x += (c*dt)*v. */
-KERNEL void symprkDrift(mixed cdt, GLOBAL real4* RESTRICT posq, GLOBAL real4* RESTRICT posqCorrection, GLOBAL const mixed4* RESTRICT velm) {
-    for (int index = GLOBAL_ID; index < NUM_ATOMS; index += GLOBAL_SIZE) {
-        mixed4 v = velm[index];
-        if (v.w != 0) {
-            mixed4 p = symprkLoadPos(posq, posqCorrection, index);
-            p.x += cdt*v.x;
-            p.y += cdt*v.y;
-            p.z += cdt*v.z;
-            symprkStorePos(posq, posqCorrection, index, p);
-        }
+    else if (kind == SYMPRK_OP_KICK_PROJECTED) {
+        GLOBAL const mm_long* RESTRICT force = (op.y == 0 ? force0 : force1);
+        const mixed fscale = 1/(mixed) 0x100000000;
+        const mixed3 com = make_mixed3(projection[0], projection[1], projection[2]);
+        const mixed3 acm = make_mixed3(projection[3], projection[4], projection[5]);
+        const mixed3 alpha = make_mixed3(projection[6], projection[7], projection[8]);
+        symprkReadPos(posq, posqCorrection, index, p, posState);
+        mixed3 r = make_mixed3(p->x-com.x, p->y-com.y, p->z-com.z);
+        mixed ax = fscale*force[index]*v->w - acm.x - (alpha.y*r.z - alpha.z*r.y);
+        mixed ay = fscale*force[index+PADDED_NUM_ATOMS]*v->w - acm.y - (alpha.z*r.x - alpha.x*r.z);
+        mixed az = fscale*force[index+2*PADDED_NUM_ATOMS]*v->w - acm.z - (alpha.x*r.y - alpha.y*r.x);
+        v->x += c*ax;
+        v->y += c*ay;
+        v->z += c*az;
+        symprkCheckVelocity(*v, op.z, badStep);
     }
-}
-
-/** drift with constraints, part 1: the unconstrained displacement (c*dt)*v, which the constraint algorithms
- * then correct with the current (pre-drift) positions as reference. */
-KERNEL void symprkDriftDelta(mixed cdt, GLOBAL const mixed4* RESTRICT velm, GLOBAL mixed4* RESTRICT posDelta) {
-    for (int index = GLOBAL_ID; index < NUM_ATOMS; index += GLOBAL_SIZE) {
-        mixed4 v = velm[index];
-        if (v.w != 0)
-            posDelta[index] = make_mixed4(cdt*v.x, cdt*v.y, cdt*v.z, 0);
-        else
-            posDelta[index] = make_mixed4(0, 0, 0, 0);
+    else if (kind == SYMPRK_OP_DRIFT) {
+        symprkReadPos(posq, posqCorrection, index, p, posState);
+        p->x += c*v->x;
+        p->y += c*v->y;
+        p->z += c*v->z;
+        *posState = 2;
     }
-}
-
-/** drift with constraints, part 2: x += constrained displacement, v += (x - x_unconstrained)/(c*dt). */
-KERNEL void symprkDriftApply(mixed cdt, GLOBAL real4* RESTRICT posq, GLOBAL real4* RESTRICT posqCorrection,
-        GLOBAL mixed4* RESTRICT velm, GLOBAL const mixed4* RESTRICT posDelta, int checkStep, GLOBAL int* RESTRICT badStep,
-        int useRigid, GLOBAL const mixed* RESTRICT rigid) {
+    else if (kind == SYMPRK_OP_DRIFT_DELTA)
+        posDelta[index] = make_mixed4(c*v->x, c*v->y, c*v->z, 0);
+    else if (kind == SYMPRK_OP_DRIFT_APPLY) {
 #ifdef SUPPORTS_DOUBLE_PRECISION
-    const double invCdt = 1.0/(double) cdt;
+        const double invCdt = 1.0/(double) c;
 #else
-    const float invCdt = 1.0f/cdt;
+        const float invCdt = 1.0f/c;
 #endif
-    for (int index = GLOBAL_ID; index < NUM_ATOMS; index += GLOBAL_SIZE) {
-        mixed4 v = velm[index];
-        if (v.w != 0) {
-            mixed4 p = symprkLoadPos(posq, posqCorrection, index);
-            mixed4 d = posDelta[index];
-            p.x += d.x;
-            p.y += d.y;
-            p.z += d.z;
-            v.x += (mixed) ((d.x-cdt*v.x)*invCdt);
-            v.y += (mixed) ((d.y-cdt*v.y)*invCdt);
-            v.z += (mixed) ((d.z-cdt*v.z)*invCdt);
-            if (useRigid) {
-                mixed rx = p.x-rigid[0], ry = p.y-rigid[1], rz = p.z-rigid[2];
-                v.x += rigid[3] + (rigid[7]*rz - rigid[8]*ry);
-                v.y += rigid[4] + (rigid[8]*rx - rigid[6]*rz);
-                v.z += rigid[5] + (rigid[6]*ry - rigid[7]*rx);
+        symprkReadPos(posq, posqCorrection, index, p, posState);
+        mixed4 d = posDelta[index];
+        p->x += d.x;
+        p->y += d.y;
+        p->z += d.z;
+        *posState = 2;
+        v->x += (mixed) ((d.x-c*v->x)*invCdt);
+        v->y += (mixed) ((d.y-c*v->y)*invCdt);
+        v->z += (mixed) ((d.z-c*v->z)*invCdt);
+        if (op.y) {
+            mixed rx = p->x-rigid[0], ry = p->y-rigid[1], rz = p->z-rigid[2];
+            v->x += rigid[3] + (rigid[7]*rz - rigid[8]*ry);
+            v->y += rigid[4] + (rigid[8]*rx - rigid[6]*rz);
+            v->z += rigid[5] + (rigid[6]*ry - rigid[7]*rx);
+        }
+        symprkCheckVelocity(*v, op.z, badStep);
+    }
+    else if (kind == SYMPRK_OP_EVENT_APPLY) {
+        if (event[0] != 0) {
+            const mixed alpha = event[1];
+            mixed ux = event[2], uy = event[3], uz = event[4];
+            if (withPositions) {
+                const symprk_acc Rx = event[5], Ry = event[6], Rz = event[7];
+                const mixed wx = event[8], wy = event[9], wz = event[10];
+                symprkReadPos(posq, posqCorrection, index, p, posState);
+                mixed rx = (mixed) (p->x-Rx), ry = (mixed) (p->y-Ry), rz = (mixed) (p->z-Rz);
+                ux += wy*rz-wz*ry;
+                uy += wz*rx-wx*rz;
+                uz += wx*ry-wy*rx;
             }
-            symprkStorePos(posq, posqCorrection, index, p);
-            velm[index] = v;
-            symprkCheckVelocity(v, checkStep, badStep);
+            v->x = ux+alpha*(v->x-ux);
+            v->y = uy+alpha*(v->y-uy);
+            v->z = uz+alpha*(v->z-uz);
         }
     }
+    else if (kind == SYMPRK_OP_SAVE_VELOCITIES)
+        vBefore[index] = *v;
+    else if (kind == SYMPRK_OP_RIGID_APPLY) {
+        symprkReadPos(posq, posqCorrection, index, p, posState);
+        mixed rx = p->x-rigid[0], ry = p->y-rigid[1], rz = p->z-rigid[2];
+        v->x += rigid[3] + (rigid[7]*rz - rigid[8]*ry);
+        v->y += rigid[4] + (rigid[8]*rx - rigid[6]*rz);
+        v->z += rigid[5] + (rigid[6]*ry - rigid[7]*rx);
+    }
 }
+
+/** The operations of one segment on atom index, in order; velocity and position written back once. */
+inline DEVICE void symprkAtomSegment(int index, SYMPRK_SEGMENT_PARAMS(s), SYMPRK_BUFFER_PARAMS) {
+    mixed4 v = velm[index];
+    if (v.w == 0) {
+        for (int k = 0; k < scount; k++) {
+            const int kind = (k == 0 ? sop0.x : k == 1 ? sop1.x : k == 2 ? sop2.x : sop3.x);
+            if (kind == SYMPRK_OP_DRIFT_DELTA)
+                posDelta[index] = make_mixed4(0, 0, 0, 0);
+            else if (kind == SYMPRK_OP_SAVE_VELOCITIES)
+                vBefore[index] = v;
+        }
+        return;
+    }
+    int changesVelocity = 0;
+    for (int k = 0; k < scount; k++) {
+        const int kind = (k == 0 ? sop0.x : k == 1 ? sop1.x : k == 2 ? sop2.x : sop3.x);
+        if (kind != SYMPRK_OP_DRIFT && kind != SYMPRK_OP_DRIFT_DELTA && kind != SYMPRK_OP_SAVE_VELOCITIES)
+            changesVelocity = 1;
+    }
+    mixed4 p = make_mixed4(0, 0, 0, 0);
+    int posState = 0;
+    if (scount > 0)
+        symprkAtomOp(sop0, sc0, index, &v, &p, &posState, SYMPRK_BUFFER_ARGS);
+    if (scount > 1)
+        symprkAtomOp(sop1, sc1, index, &v, &p, &posState, SYMPRK_BUFFER_ARGS);
+    if (scount > 2)
+        symprkAtomOp(sop2, sc2, index, &v, &p, &posState, SYMPRK_BUFFER_ARGS);
+    if (scount > 3)
+        symprkAtomOp(sop3, sc3, index, &v, &p, &posState, SYMPRK_BUFFER_ARGS);
+    if (posState == 2)
+        symprkStorePos(posq, posqCorrection, index, p);
+    if (changesVelocity)
+        velm[index] = v;
+}
+
+/** One segment over all atoms, on the whole grid. */
+KERNEL void symprkSegment(SYMPRK_SEGMENT_PARAMS(s), SYMPRK_BUFFER_PARAMS) {
+    for (int index = GLOBAL_ID; index < NUM_ATOMS; index += GLOBAL_SIZE)
+        symprkAtomSegment(index, SYMPRK_SEGMENT_ARGS(s), SYMPRK_BUFFER_ARGS);
+}
+
 
 /**
  * The exact-momentum projection, run as one block of WORK_GROUP_SIZE threads: centre of mass r_cm, net force,
@@ -362,22 +431,6 @@ KERNEL void symprkRigidSums(int mode, mixed cdt, GLOBAL const real4* RESTRICT po
     }
 }
 
-/** Add the rigid-body velocity of symprkRigidSums (mode 1) at the current positions. */
-KERNEL void symprkRigidApply(GLOBAL const real4* RESTRICT posq, GLOBAL const real4* RESTRICT posqCorrection,
-        GLOBAL mixed4* RESTRICT velm, GLOBAL const mixed* RESTRICT rigid) {
-    for (int index = GLOBAL_ID; index < NUM_ATOMS; index += GLOBAL_SIZE) {
-        mixed4 v = velm[index];
-        if (v.w != 0) {
-            mixed4 p = symprkLoadPos(posq, posqCorrection, index);
-            mixed rx = p.x-rigid[0], ry = p.y-rigid[1], rz = p.z-rigid[2];
-            v.x += rigid[3] + (rigid[7]*rz - rigid[8]*ry);
-            v.y += rigid[4] + (rigid[8]*rx - rigid[6]*rz);
-            v.z += rigid[5] + (rigid[6]*ry - rigid[7]*rx);
-            velm[index] = v;
-        }
-    }
-}
-
 /*
  * Thermostat (stochastic velocity rescaling), the whole event on the device (no host transfer): the operations of
  * the host's SymPRKThermostat::event and rescalingFactor.  One block of WORK_GROUP_SIZE threads, sums in symprk_acc
@@ -386,7 +439,7 @@ KERNEL void symprkRigidApply(GLOBAL const real4* RESTRICT posq, GLOBAL const rea
  * centre of mass R: sum m |v - V|^2 and, when the rotation is kept (withPositions), the second moments and
  * L = sum m r x (v - V).  The noise: the dof standard normals n_k (k < dof) from OpenMM's generator,
  * component k%4 of random[randomIndex + k/4]: r1 = n_0, chi2 = sum_{k=1}^{dof-1} n_k^2.
- * Writes event[] = {apply, alpha, V (3), R (3), w (3)} for symprkThermostatApply and updates
+ * Writes event[] = {apply, alpha, V (3), R (3), w (3)} for the apply (SYMPRK_OP_EVENT_APPLY) and updates
  * state[] = {heat-bath energy, total kinetic energy after the event, skipped events, 1 if this event was skipped else 0,
  * peculiar kinetic energy after the event}
  * (SymPRKThermostat::RunState).
@@ -429,11 +482,10 @@ KERNEL void symprkThermostatNoise(GLOBAL const float4* RESTRICT random, int rand
     }
 }
 
-KERNEL void symprkThermostatEvent(GLOBAL const real4* RESTRICT posq, GLOBAL const real4* RESTRICT posqCorrection,
+inline DEVICE void symprkEventSums(GLOBAL const real4* RESTRICT posq, GLOBAL const real4* RESTRICT posqCorrection,
         GLOBAL const mixed4* RESTRICT velm, int withPositions, GLOBAL const float4* RESTRICT random, int randomIndex, int dof,
-        symprk_acc target, symprk_acc c, GLOBAL symprk_acc* RESTRICT event, GLOBAL symprk_acc* RESTRICT state) {
-    LOCAL symprk_acc partial[10*WORK_GROUP_SIZE];
-    LOCAL symprk_acc total[10];
+        symprk_acc target, symprk_acc c, GLOBAL symprk_acc* RESTRICT event, GLOBAL symprk_acc* RESTRICT state,
+        LOCAL_ARG symprk_acc* partial, LOCAL_ARG symprk_acc* total) {
     const int tid = LOCAL_ID;
     const mixed4 origin = symprkLoadPos(posq, posqCorrection, 0);
     symprk_acc s[10];
@@ -541,32 +593,27 @@ KERNEL void symprkThermostatEvent(GLOBAL const real4* RESTRICT posq, GLOBAL cons
 }
 
 /**
- * Thermostat, part 2: v <- u + alpha (v - u) for particles with mass, with the kept field u = V + w x (x - R)
- * (w = 0 unless the rotation is kept: then withPositions), as symprkThermostatEvent left it in event[].
+ * A thermostat event in one launch of one block of WORK_GROUP_SIZE threads: the segment `pre` on every atom, the
+ * event's sums and factor (symprkEventSums, into event[] and state[]), then the segment `post` (the event's apply and
+ * what follows it up to the next operation that needs the whole device: constraints, forces, another reduction).
+ * Each thread takes the same atoms in every pass.  With both segments empty it is the event's reduction alone, and
+ * the apply runs in the grid segment after it (systems above the host's one-block limit).
  */
-KERNEL void symprkThermostatApply(GLOBAL const real4* RESTRICT posq, GLOBAL const real4* RESTRICT posqCorrection,
-        GLOBAL mixed4* RESTRICT velm, int withPositions, GLOBAL const symprk_acc* RESTRICT event) {
-    if (event[0] == 0)
-        return;
-    const mixed alpha = event[1];
-    const mixed Vx = event[2], Vy = event[3], Vz = event[4];
-    const symprk_acc Rx = event[5], Ry = event[6], Rz = event[7];
-    const mixed wx = event[8], wy = event[9], wz = event[10];
-    for (int index = GLOBAL_ID; index < NUM_ATOMS; index += GLOBAL_SIZE) {
-        mixed4 v = velm[index];
-        if (v.w != 0) {
-            mixed ux = Vx, uy = Vy, uz = Vz;
-            if (withPositions) {
-                mixed4 p = symprkLoadPos(posq, posqCorrection, index);
-                mixed rx = (mixed) (p.x-Rx), ry = (mixed) (p.y-Ry), rz = (mixed) (p.z-Rz);
-                ux += wy*rz-wz*ry;
-                uy += wz*rx-wx*rz;
-                uz += wx*ry-wy*rx;
-            }
-            v.x = ux+alpha*(v.x-ux);
-            v.y = uy+alpha*(v.y-uy);
-            v.z = uz+alpha*(v.z-uz);
-            velm[index] = v;
-        }
+KERNEL void symprkEventBlock(SYMPRK_SEGMENT_PARAMS(pre), SYMPRK_SEGMENT_PARAMS(post), SYMPRK_BUFFER_PARAMS,
+        GLOBAL const float4* RESTRICT random, int randomIndex, int dof, symprk_acc target, symprk_acc decay,
+        GLOBAL symprk_acc* RESTRICT state) {
+    LOCAL symprk_acc partial[10*WORK_GROUP_SIZE];
+    LOCAL symprk_acc total[10];
+    if (precount > 0) {
+        for (int index = LOCAL_ID; index < NUM_ATOMS; index += WORK_GROUP_SIZE)
+            symprkAtomSegment(index, SYMPRK_SEGMENT_ARGS(pre), SYMPRK_BUFFER_ARGS);
+        SYNC_THREADS;  // the sums read the first atom's position (every thread) after it
+    }
+    symprkEventSums(posq, posqCorrection, velm, withPositions, random, randomIndex, dof, target, decay,
+                    event, state, partial, total);
+    if (postcount > 0) {
+        SYNC_THREADS;  // event[] is written by thread 0
+        for (int index = LOCAL_ID; index < NUM_ATOMS; index += WORK_GROUP_SIZE)
+            symprkAtomSegment(index, SYMPRK_SEGMENT_ARGS(post), SYMPRK_BUFFER_ARGS);
     }
 }

@@ -232,6 +232,36 @@ public:
      */
     long long getHostTransfers() const;
     /**
+     * Device launches (kernels and device-side copies) this integrator's kernel has enqueued itself since bound: 0 on
+     * Reference/CPU.  OpenMM's constraint, virtual-site, random-number and force kernels are not counted (an intercept
+     * of the OpenCL or CUDA API, tools/count_launches.py, counts everything a step launches).
+     */
+    long long getKernelLaunches() const;
+    /**
+     * How the Common platforms' kernel (OpenCL, CUDA, HIP) groups the step plan's operations into device launches;
+     * the trajectory is the same (bit for bit without constraints; with them within the constraint tolerance, as a
+     * velocity projection whose velocities the next constrained drift projects again may be left out), the launches
+     * fewer.  Reference/CPU always run the plan one operation at a time.
+     */
+    enum KernelFusion {
+        /** One or a few launches per operation, every step ending at the step point: the plain reading of the plan. */
+        FuseNone = 0,
+        /** Consecutive per-atom operations in one launch; within one step() call, the last kick of a step and the first
+         *  of the next as one launch where nothing reads the state between; a thermostat event as a reduction launch
+         *  whose apply joins the next launch. */
+        FuseSegments = 1,
+        /** As FuseSegments, and a thermostat event with the per-atom operations around it in one launch of one block
+         *  of threads, up to getKernelFusionBlockAtoms() atoms (the default). */
+        FuseAll = 2
+    };
+    /** For tests and measurements: set the KernelFusion (FuseAll by default; kept across Contexts, not saved in XML). */
+    void setKernelFusion(int mode);
+    int getKernelFusion() const {
+        return kernelFusion;
+    }
+    /** The largest System (atoms) whose thermostat events FuseAll runs in one block of threads. */
+    static int getKernelFusionBlockAtoms();
+    /**
      * For tests of the thermostat's random numbers: the noise of `count` events (r1 ~ N(0,1), chi2 ~ chi^2(dof-1)
      * with this integrator's degrees of freedom; 2*count values, r1 and chi2 of each event in turn), drawn by the bound
      * Context's kernel exactly as its events draw it and from the same stream, which it advances (Reference/CPU: the
@@ -317,6 +347,7 @@ private:
     double thermostatTemperature, collisionTime;
     int thermostatInterval, thermostatDof, randomSeed;
     bool traceEnabled;
+    int kernelFusion;
     SymPRKStepPlan plan;
     OpenMM::Kernel kernel;
 };

@@ -55,9 +55,12 @@ public:
      * Advance one step: run the operations of plan.  forcesAreValid says whether the Context's forces belong to the
      * current positions (and the integrator's force groups); the kernel updates it.  stepIndex is the 1-based number
      * of this step: it decides which thermostat events run, and is recorded as the first non-finite one.
+     * nextStepFollows: the same SymPRKIntegrator::step call runs step stepIndex+1 right after this one, with nothing
+     * outside the Context's own updateContextState between them, so a kernel may begin that step's operations at the
+     * end of this one (the Common kernel's fusion across steps); when false the step must end at the step point.
      */
     virtual void execute(OpenMM::ContextImpl& context, const SymPRKIntegrator& integrator, const SymPRKStepPlan& plan,
-                         bool& forcesAreValid, long long stepIndex) = 0;
+                         bool& forcesAreValid, long long stepIndex, bool nextStepFollows) = 0;
     /** Kinetic energy of the current (full-step) velocities. */
     virtual double computeKineticEnergy(OpenMM::ContextImpl& context, const SymPRKIntegrator& integrator) = 0;
     /**
@@ -106,6 +109,14 @@ public:
     /** Host-device transfers the kernel has made (0 where the data is on the host). */
     virtual long long getHostTransfers() {
         return 0;
+    }
+    /** Device launches (kernels and device-side copies) the kernel has enqueued itself (0 where it runs on the host). */
+    virtual long long getKernelLaunches() {
+        return 0;
+    }
+    /** How a kernel that launches device work groups the plan's operations into launches (SymPRKIntegrator::KernelFusion);
+     *  a kernel that runs on the host ignores it. */
+    virtual void setKernelFusion(int mode) {
     }
     SymPRKExecutionTrace& getTrace() {
         return trace;
