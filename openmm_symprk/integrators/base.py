@@ -89,7 +89,7 @@ class IntegratorBase:
     program_info = None  # the ProgramInfo of its compiled program (.program)
     _thermostat = None  # the one holder of the thermostat's settings (ThermostatSettings; None: NVE)
     #: attributes a copy does not carry (the C++ object, per-Context handles)
-    _transient: tuple = ("this", "thisown", "_context_ref")
+    _transient: tuple = ("this", "thisown", "_context_ref", "_wrapped")
 
     # -- what it runs -----------------------------------------------------------------------------------
     @property
@@ -336,10 +336,9 @@ class IntegratorBase:
         return {k: v for k, v in self.__dict__.items() if k not in self._transient}
 
     def _adopt(self, other):
-        """Take over the C++ object of ``other`` (an openmm.Integrator of the same C++ class)."""
+        """Wrap the C++ object of ``other`` (an openmm.Integrator of the same C++ class), which stays valid: both
+        wrappers share SWIG's handle of the object, which deletes it once neither is left."""
         self.this = other.this
-        other.thisown = False
-        self.thisown = True
 
     def _reset_binding(self):
         """Forget per-Context facts (a copy is not bound to any Context)."""

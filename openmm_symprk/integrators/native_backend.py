@@ -115,12 +115,13 @@ class NativeSymplecticIntegrator(SymplecticIntegrator, _PluginIntegrator, backen
                 asked.position if asked is not None else (self.resolved.thermostat_position or "ends"))
 
     def _adopt(self, other):
-        """Take over a deserialized SymPRKIntegrator (XmlSerializer gives it as a base openmm.Integrator)."""
+        """Wrap a deserialized SymPRKIntegrator (XmlSerializer gives it as a base openmm.Integrator), which stays valid:
+        the cast gives a second SWIG handle that does not own the C++ object, so ``other`` keeps owning it and this
+        wrapper keeps ``other`` alive (dropping either one leaves the other usable)."""
         typed = _swig.SymPRKIntegrator.cast(other)
-        own = bool(getattr(other, "thisown", False))
-        other.thisown = False
+        typed.thisown = False
         self.this = typed.this
-        self.thisown = own
+        self._wrapped = other
 
     # -- the thermostat: the plugin is given the settings the integrator holds ----------------------------------------
     def plugin_thermostat_settings(self, position: str):

@@ -40,8 +40,9 @@ def deserialize(xml: str):
 
 
 def restore(integrator):
-    """The package's integrator class around ``integrator`` (an OpenMM integrator from XML), which it takes
-    over; an integrator that already is one is returned as it is."""
+    """The package's integrator class around ``integrator`` (an OpenMM integrator from XML); an integrator that
+    already is one is returned as it is.  Both wrap the same C++ integrator and ``integrator`` stays valid whether
+    the result is kept or not (using it directly only skips the package's checks); keep the result to have them."""
     if isinstance(integrator, IntegratorBase):
         return integrator
     if isinstance(integrator, mm.CustomIntegrator):
