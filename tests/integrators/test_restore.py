@@ -109,12 +109,14 @@ def test_options_are_built_once_and_frozen(water8):
     opts = ig.options
     assert isinstance(opts, IntegratorOptions) and ig.program_info.method is ig.resolved
     assert (opts.step_size, opts.max_speed, opts.groups, opts.system.n_particles) == (0.002, 40.0, ((0, 1),), 24)
-    assert opts.thermostat == ig.thermostat and opts.thermostat.temperature == 300.0
     assert (opts.check_finite, opts.exact_momentum, opts.constraints, opts.tolerance) == (True, False, None, 1e-12)
     with pytest.raises(AttributeError):
         opts.max_speed = 1.0
-    assert IntegratorOptions.build("X", 0.002, water8.system, max_speed=40.0, groups=[(0, 1)],
-                                   temperature=300) == opts
+    assert IntegratorOptions.build("X", 0.002, water8.system, max_speed=40.0, groups=[(0, 1)]) == opts
+    # the thermostat's settings live in one holder, which setTemperature replaces: no construction-time copy
+    assert not hasattr(opts, "thermostat") and ig.thermostat.temperature == 300.0
+    ig.setTemperature(310)
+    assert ig.thermostat.temperature == 310.0 and deserialize(mm.XmlSerializer.serialize(ig)).thermostat == ig.thermostat
 
 
 _RESTORE_AND_DROP = """
