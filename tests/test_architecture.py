@@ -288,3 +288,24 @@ def test_nothing_under_integrators_decides_a_thermostat_schedule():
     assert not wrong, "\n".join(wrong)
     # and the rule sees a decision where there is one
     assert _schedule_decisions(ast.parse("if position == 'middle': k = (n - 1) // 2"))
+
+
+#: The calls that walk the interpreter's heap to find objects.
+HEAP_SCANS = ("get_objects", "get_referrers", "get_referents")
+
+
+def _heap_scans(tree) -> list:
+    """(line, call) of every ``gc.get_objects`` (or ``get_referrers``, ``get_referents``) in ``tree``."""
+    return [(node.lineno, f"gc.{node.func.attr}") for node in ast.walk(tree)
+            if isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute) and node.func.attr in HEAP_SCANS
+            and getattr(node.func.value, "id", None) == "gc"]
+
+
+def test_nothing_in_the_package_scans_the_python_heap():
+    """No module finds an object by walking the Python heap (the integrators once found their Context so, at a cost
+    that grows with everything the process holds): what an object needs, it is given or keeps."""
+    wrong = [f"{path}:{line}: {call}" for name, path in MODULES.items()
+             for line, call in _heap_scans(ast.parse(open(path).read()))]
+    assert not wrong, "\n".join(wrong)
+    # and the rule sees a scan where there is one
+    assert _heap_scans(ast.parse("import gc\nfound = [o for o in gc.get_objects() if o]"))

@@ -15,7 +15,7 @@ and the method resolved once for the System (:func:`.backend.resolve_for_system`
 from .backend import BackendWarning, NativeMethodError, NativeUnavailableError, choose_backend
 from .base import (CheckpointMismatchError, ConvergenceWarning, IntegratorBase, SimulationBlowUpError,
                    SystemMismatchError, step_size_in_ps)
-from .custom_backend import CustomSymplecticIntegrator, PRKIntegrator, TimeWarning
+from .custom_backend import CustomSymplecticIntegrator, PRKIntegrator, TimeWarning, VirtualSitesError
 from .native_backend import NativeSymplecticIntegrator, native_available
 from ..methods.resolved import ConstraintSupportError
 from .options import IntegratorOptions
@@ -26,4 +26,4 @@ __all__ = ["SymplecticIntegrator", "PRKIntegrator", "CustomSymplecticIntegrator"
            "IntegratorBase", "choose_backend", "native_available", "restore", "deserialize", "SimulationBlowUpError",
            "ConvergenceWarning", "SystemMismatchError", "CheckpointMismatchError", "ConstraintSupportError",
            "BackendWarning", "NativeMethodError", "NativeUnavailableError", "TimeWarning", "step_size_in_ps",
-           "IntegratorOptions"]
+           "IntegratorOptions", "VirtualSitesError"]

@@ -38,20 +38,21 @@ class NativeMethodError(InputError):
 
 
 def resolve_for_system(where: str, method, system, options: IntegratorOptions, name: str | None = None,
-                       splittings_only: str | None = None, skip_checks=()) -> ResolvedMethod:
+                       splittings_only: str | None = None, skip_checks=(), thermostat=None) -> ResolvedMethod:
     """``method`` resolved as it will run on ``system`` (the System of the checked ``options``), the System checked.
 
     The constraint facts come from ``options.constraints``, else from the System (without one kick/drift methods
     keep RATTLE steps); the System is checked for anything that breaks conservation (one warning per kind, less
-    ``skip_checks``) and against the force groups of multiple time stepping.  With a thermostat, the method is
-    resolved with its placement (``options.thermostat.position``: a "middle" one is a THERMOSTAT sub-step).  ``name`` overrides the method's name.
+    ``skip_checks``) and against the force groups of multiple time stepping.  With a ``thermostat`` (its
+    :class:`~.thermostat.ThermostatSettings`), the method is resolved with the placement asked for
+    (``thermostat.position``: the events become THERMOSTAT sub-steps).  ``name`` overrides the method's name.
     ``splittings_only``: the backend runs kick/drift methods only; a general PRK pair raises NativeMethodError with
     this hint."""
     facts = options.system
     constraints = options.constraints
     if constraints is None and facts is not None:
         constraints = facts.constraints
-    position = options.thermostat.position if options.thermostat is not None else None
+    position = thermostat.position if thermostat is not None else None
     try:
         resolved = resolve(method, constraints=constraints, groups=options.groups, inner_method=options.inner_method,
                            name=name, thermostat_position=position)

@@ -20,8 +20,11 @@ program of :mod:`.custom_backend` or the plugin's SymPRKIntegrator of :mod:`.nat
   (:meth:`IntegratorBase._set_thermostat`, which gives the backend's program or plugin the new value); and its
   accessors in OpenMM's idiom: ``getTemperature``/``setTemperature``, ``getCollisionTime``/``setCollisionTime``,
   ``getThermostatInterval``, ``setRandomNumberSeed`` (checked), ``computeHeatBathEnergy``,
-  ``thermostat_kinetic_energy`` (the kinetic energy at the thermostat point), ``computeSystemTemperature``,
-  ``thermostat_position``, ``thermostat_dof`` / ``getThermostatDegreesOfFreedom``.
+  ``thermostat_kinetic_energy`` (the kinetic energy at the thermostat point), ``computeSystemTemperature`` (only
+  with a thermostat), ``thermostat_position``, ``thermostat_dof`` / ``getThermostatDegreesOfFreedom``.
+
+An integrator never looks up its Context (OpenMM gives it no way to, short of scanning the Python heap): what it
+reports comes from its own program or plugin.
 
 Backends implement the hooks ``_blowup_step()``, ``_clear_blowup()``, ``_raw_steps_taken()`` and may
 override ``_before_step()`` / ``_after_step()``; with a thermostat, ``_heat_bath_energy()`` (kJ/mol),
@@ -41,7 +44,7 @@ import openmm.unit as unit
 from ..physics.temperature import R_KJ
 from ..systems.hydrogens import unconstrained_hydrogen_hint
 from .quantities import positive_quantity
-from .thermostat import check_seed, on_step_temperature
+from .thermostat import check_seed
 from ..support.errors import InputError, SymprkError
 
 __all__ = ["IntegratorBase", "SimulationBlowUpError", "ConvergenceWarning", "SystemMismatchError",
@@ -91,7 +94,7 @@ class IntegratorBase:
     program_info = None  # the ProgramInfo of its compiled program (.program)
     _thermostat = None  # the one holder of the thermostat's settings (ThermostatSettings; None: NVE)
     #: attributes a copy does not carry (the C++ object, per-Context handles)
-    _transient: tuple = ("this", "thisown", "_context_ref")
+    _transient: tuple = ("this", "thisown", "_wrapped")
 
     # -- what it runs -----------------------------------------------------------------------------------
     @property
@@ -269,36 +272,42 @@ class IntegratorBase:
 
     def thermostat_kinetic_energy(self):
         """The kinetic energy (a Quantity in kJ/mol) of the velocities just after the last thermostat event: the
-        temperature the thermostat samples.  A State holds the on-step velocities; with the thermostat in the middle
-        of the step (``thermostat_position="middle"``) these are not Maxwell-Boltzmann, and a stiff mode of angular
-        frequency w reads T (1 - h^2 w^2/4) there, while the velocities at the thermostat point (between the two
-        half drifts) read T.  With the ends placement both agree.  0 before the first event."""
+        temperature the thermostat samples.  Those are the velocities a State holds after the step of that event, with
+        either placement (the middle one runs the step from its closing kicks, so that the State holds the velocities
+        of the thermostat point: docs/thermostat.md, "What a user reads as the temperature"), up to the constraint
+        corrections of the drift after a middle event.  0 before the first event."""
         self._require_thermostat("thermostat_kinetic_energy()")
         return float(self._thermostat_kinetic_energy()) * unit.kilojoule_per_mole
 
+    @property
     def computeSystemTemperature(self):
-        """The temperature (a Quantity in K) OpenMM's reporters print: StateDataReporter asks an integrator that has
-        this method instead of computing one from the State's kinetic energy and its own count of degrees of freedom.
+        """The thermostat's temperature (a Quantity in K) as OpenMM's reporters print it: StateDataReporter asks an
+        integrator that has this method instead of computing one from the State's kinetic energy and its own count of
+        degrees of freedom, as it does for NoseHooverIntegrator.
 
-        With a thermostat it is the temperature the thermostat samples: 2 K' / (N_f R) from the peculiar kinetic energy
-        K' just after the last event and the thermostat's degrees of freedom N_f (:attr:`thermostat_dof`); with
-        ``thermostat_interval`` n > 1 that event may lie up to n - 1 steps back, and reports more frequent than every n
-        steps repeat it.  With the
-        thermostat in the middle of the step the on-step velocities are not the canonical ones (a stiff mode of angular
-        frequency w reads T (1 - h^2 w^2/4) there), so a temperature computed from a State reads low; this one does
-        not.  Without a thermostat, and before the first event, it is the kinetic temperature of the Context's current
-        velocities with the same count: the peculiar kinetic energy (less the centre-of-mass motion, and the rigid
-        rotation of an isolated System) over 3 per particle with mass - constraints - 3 (- 3)."""
-        if self.thermostat is not None:
-            self._sync_run_state()
-            kinetic = float(self._thermostat_peculiar_kinetic_energy())
-            if kinetic > 0:
-                return 2 * kinetic / (self.thermostat.dof * R_KJ) * unit.kelvin
-        context = self._bound_context()
-        if context is None:
-            raise RuntimeError(f"{type(self).__name__}({self.method_name}).computeSystemTemperature(): the integrator is "
-                               f"not bound to a Context (create one, or a Simulation, first)")
-        return on_step_temperature(context) * unit.kelvin
+        It is 2 K' / (N_f R): K' the peculiar kinetic energy (without the centre-of-mass motion, and the rigid rotation
+        of an isolated System) the last thermostat event left, N_f the thermostat's degrees of freedom
+        (:attr:`thermostat_dof`).  Those are the velocities a State holds after the step of that event, with either
+        placement (docs/thermostat.md, "What a user reads as the temperature"); with ``thermostat_interval`` n > 1 the
+        event may lie up to n - 1 steps back, and reports more frequent than every n steps repeat it.  Velocities set
+        since (``setVelocities``, ``setVelocitiesToTemperature``) are read at the next event: the integrator cannot
+        reach its Context to read them; a checkpoint or a State with integrator parameters brings back the value it
+        was saved with.  NaN before the first event of a run.
+
+        Only an integrator with a thermostat has it (``hasattr`` is False for an NVE one), so OpenMM's reporters
+        compute an NVE run's temperature from the State, as for VerletIntegrator."""
+        if self.__dict__.get("_thermostat") is None:
+            raise AttributeError(f"{type(self).__name__}({self.method_name}) runs NVE, without a thermostat, so it has "
+                                 f"no computeSystemTemperature: compute the temperature from a State's kinetic energy "
+                                 f"(OpenMM's StateDataReporter does so itself)")
+        return self._system_temperature
+
+    def _system_temperature(self):
+        self._sync_run_state()
+        kinetic = float(self._thermostat_peculiar_kinetic_energy())
+        if kinetic <= 0:
+            return math.nan * unit.kelvin
+        return 2 * kinetic / (self.thermostat.dof * R_KJ) * unit.kelvin
 
     def _thermostat_peculiar_kinetic_energy(self) -> float:
         """K' (kJ/mol) of the last thermostat event: the peculiar kinetic energy it left (0 before the first)."""
@@ -307,9 +316,7 @@ class IntegratorBase:
     @property
     def thermostat_position(self) -> str | None:
         """Where the thermostat sits in the step as it runs: "ends" or "middle" (None without a thermostat)."""
-        if self.thermostat is None:
-            return None
-        return self.resolved.thermostat_position or "ends"
+        return None if self.thermostat is None else self.resolved.thermostat_position
 
     def _heat_bath_energy(self) -> float:
         raise NotImplementedError
@@ -320,31 +327,15 @@ class IntegratorBase:
     def _apply_thermostat(self, settings):
         raise NotImplementedError
 
-    # -- the Context ---------------------------------------------------------------------------------------------
-    _context_ref = None
-
-    def _bound_context(self):
-        """The Context this integrator is bound to (found once among the live Contexts, then kept weakly), or None."""
-        context = self._context_ref() if self._context_ref is not None else None
-        if context is None:
-            import gc
-            import weakref
-
-            context = next((o for o in gc.get_objects()
-                            if isinstance(o, mm.Context) and getattr(o, "_integrator", None) is self), None)
-            self._context_ref = weakref.ref(context) if context is not None else None
-        return context
-
     # -- copies ---------------------------------------------------------------------------------------
     def _python_state(self) -> dict:
         """The Python attributes a copy needs (everything but the C++ object and per-Context handles)."""
         return {k: v for k, v in self.__dict__.items() if k not in self._transient}
 
     def _adopt(self, other):
-        """Take over the C++ object of ``other`` (an openmm.Integrator of the same C++ class)."""
+        """Wrap the C++ object of ``other`` (an openmm.Integrator of the same C++ class), which stays valid: both
+        wrappers share SWIG's handle of the object, which deletes it once neither is left."""
         self.this = other.this
-        other.thisown = False
-        self.thisown = True
 
     def _reset_binding(self):
         """Forget per-Context facts (a copy is not bound to any Context)."""

@@ -23,21 +23,52 @@ import openmm.unit as unit
 
 from ..physics.velocity_rescaling import no_peculiar_motion
 from ..systems.checks import warn_once
-from ..systems.properties import masses
+from ..systems.properties import masses, virtual_sites
 from . import program, thermostat_program
 from .backend import resolve_for_system
 from .base import CheckpointMismatchError, ConvergenceWarning, IntegratorBase, SystemMismatchError
-from .metadata import add_metadata, metadata
+from .metadata import add_metadata, massless_particles, metadata
 from .mismatch import mismatch_message
 from .options import DEFAULT_MAX_ITERATIONS, DEFAULT_TOLERANCE, OPTIONS, IntegratorOptions, check_option_names
+from .thermostat import thermostat_settings
 from .projection import set_masses
 from .symplectic import SymplecticIntegrator
 
-__all__ = ["PRKIntegrator", "CustomSymplecticIntegrator", "TimeWarning"]
+__all__ = ["PRKIntegrator", "CustomSymplecticIntegrator", "TimeWarning", "VirtualSitesError"]
 
 
 class TimeWarning(UserWarning):
     """OpenMM's CustomIntegrator keeps the Context's time on the old step size after setStepSize."""
+
+
+class VirtualSitesError(ValueError):
+    """The CustomIntegrator backend was asked to run a System with virtual sites, which it cannot keep right."""
+
+
+def _refuse_virtual_sites(where: str, system: mm.System) -> None:
+    """VirtualSitesError for a System with virtual sites.  OpenMM's CustomIntegrator places them only at the end of a
+    step on the Reference and CPU platforms (its ConstrainPositions leaves them where they are; only the Common
+    platforms place them there), so every force evaluated inside a step sees each site where the previous step left
+    it, one drift behind its molecule: 215 TIP4P-Ew waters with PME at 2 fs gain 238 kJ/mol in 1 ps of NVE where
+    OpenMM's VerletIntegrator and the native backend stay within 8.  The integrator cannot know its platform before
+    it runs, so the System is refused on every platform."""
+    sites = virtual_sites(system)
+    if not sites:
+        return
+    from .. import plugin
+
+    if plugin.available():
+        use = "Use the native backend, which places them after every drift: SymplecticIntegrator(..., backend='native')"
+    else:
+        use = (f"The native backend, which places them after every drift, is unavailable here "
+               f"({plugin.unavailable_reason()}); to fix it, {plugin.fix_hint()}")
+    raise VirtualSitesError(
+        f"{where}: the System has {len(sites)} virtual site(s) (e.g. particle {sites[0]}), which the CustomIntegrator "
+        f"backend cannot keep right: OpenMM's CustomIntegrator places them only at the end of each step on the "
+        f"Reference and CPU platforms, so every force inside the step sees them one drift behind and the system heats "
+        f"(215 TIP4P-Ew waters with PME at 2 fs: +238 kJ/mol in 1 ps of NVE, against 8 for VerletIntegrator). {use}; "
+        f"or use a water model without virtual sites (TIP3P, SPC/E). Implicit and general PRK tableaux, which only the "
+        f"CustomIntegrator backend runs, cannot run such a System.")
 
 
 class PRKIntegrator(IntegratorBase, mm.CustomIntegrator):
@@ -89,24 +120,29 @@ class PRKIntegrator(IntegratorBase, mm.CustomIntegrator):
         check_option_names(unknown, OPTIONS | {"name"}, type(self).__name__)
         options = IntegratorOptions.build(
             type(self).__name__, stepSize, system, exact_momentum=exact_momentum, check_finite=check_finite,
-            max_speed=max_speed, groups=groups, inner_method=inner_method, temperature=temperature,
-            collision_time=collision_time, thermostat_interval=thermostat_interval, random_seed=random_seed,
-            thermostat_position=thermostat_position, constraints=constraints, allow_nonsymplectic=allow_nonsymplectic,
-            tolerance=tolerance, max_iterations=max_iterations)
-        self._compile(tableau, system, options, name)
+            max_speed=max_speed, groups=groups, inner_method=inner_method, constraints=constraints,
+            allow_nonsymplectic=allow_nonsymplectic, tolerance=tolerance, max_iterations=max_iterations)
+        settings = thermostat_settings(system, temperature=temperature, collision_time=collision_time,
+                                       thermostat_interval=thermostat_interval, random_seed=random_seed,
+                                       thermostat_position=thermostat_position)
+        self._compile(tableau, system, options, settings, name)
 
-    def _compile(self, method, system, options: IntegratorOptions, name: str | None = None):
-        """Resolve ``method`` for ``system``, compile its program with ``options`` and record its metadata."""
-        r = resolve_for_system(type(self).__name__, method, system, options, name=name)
+    def _compile(self, method, system, options: IntegratorOptions, settings=None, name: str | None = None):
+        """Resolve ``method`` for ``system``, compile its program with ``options`` and the thermostat's ``settings``
+        (None: NVE), and record its metadata."""
+        if system is not None:
+            _refuse_virtual_sites(type(self).__name__, system)
+        r = resolve_for_system(type(self).__name__, method, system, options, name=name, thermostat=settings)
         r.check_symplectic(options.allow_nonsymplectic)
         has_sites = options.system.virtual_sites if options.system is not None else True
         mm.CustomIntegrator.__init__(self, options.step_size)
-        self._set_program(r, options, program.compile_program(self, r, options, has_sites))
-        self._masses = masses(system) if options.exact_momentum or options.thermostat is not None else None
-        if options.thermostat is not None:
-            self._set_thermostat(options.thermostat)
+        self._set_program(r, options, program.compile_program(self, r, options, has_sites, settings))
+        self._masses = masses(system) if options.exact_momentum else None
+        self._massless = massless_particles(system) if system is not None else ()
+        if settings is not None:
+            self._set_thermostat(settings)
         self._reset_binding()
-        add_metadata(self, metadata(type(self).__name__, method, r, options))
+        add_metadata(self, metadata(type(self).__name__, method, r, options, settings, self._massless))
 
     def _set_program(self, r, options, info):
         """Record the resolved method, the options and the facts of the compiled program."""
@@ -121,7 +157,7 @@ class PRKIntegrator(IntegratorBase, mm.CustomIntegrator):
         options = self.options
         has_sites = options.system.virtual_sites if options.system is not None else True
         fresh = mm.CustomIntegrator(options.step_size)
-        program.compile_program(fresh, self.resolved, options, has_sites)
+        program.compile_program(fresh, self.resolved, options, has_sites, self.thermostat)
         kept = {program.SIGNATURE_VAR, thermostat_program.TEMPERATURE_VAR, thermostat_program.COLLISION_TIME_VAR}
         for i in range(fresh.getNumGlobalVariables()):
             name = fresh.getGlobalVariableName(i)
@@ -131,23 +167,25 @@ class PRKIntegrator(IntegratorBase, mm.CustomIntegrator):
             self.setPerDofVariableByName(fresh.getPerDofVariableName(i), fresh.getPerDofVariable(i))
 
     # -- per-Context checks ----------------------------------------------------------------------------
+    # OpenMM gives an integrator no way to its Context, so the checks below read only the integrator's own variables.
+    # A Context made anew for it (Context.reinitialize(), which keeps the program's global variables) drops the
+    # per-DOF values set while bound, the thermostat's mask and exact momentum's masses: their absence marks a run
+    # the Context no longer holds, also in a State or checkpoint taken from such a Context before its first step.
 
     def _reset_binding(self):
-        self._context_ref = None
-        # the step size (ps), and the one the Context's time is known to advance by
-        self._dt = self._time_dt = self.getStepSize().value_in_unit(unit.picosecond)
+        self._dt = self.getStepSize().value_in_unit(unit.picosecond)  # the step size (ps)
         self._checked_context = False
+        self._n_particles = None  # the Context's, once checked
         self._checked_probe = False
         self._nonconverged_seen = 0
-        self._step_count = None  # the Context's step count after the last call (thermostat, exact_momentum)
         self._warned_no_peculiar = False
 
     def _before_step(self):
+        if not self._is_bound():
+            return  # (the step raises OpenMM's "not bound to a context")
         if not self._checked_context:
             self._check_context()
-        elif self._bound_values_may_be_lost():
-            self._start_new_run_if_reinitialized()
-            self._check_context()  # per-DOF values set while bound were dropped: set them again before stepping
+        self._start_new_run_where_lost()
         stored = self.getGlobalVariable(0)
         if stored != self.program_info.signature:
             context = self._bound_context()
@@ -157,34 +195,63 @@ class PRKIntegrator(IntegratorBase, mm.CustomIntegrator):
         if self.thermostat is not None:
             self._keep_thermostat_settings()
 
-    def _start_new_run_if_reinitialized(self):
-        """Context.reinitialize() (its step count back at 0, and the per-DOF values set while bound dropped): a new run,
-        as on the native backend, whose kernel is made anew (heat bath, step counter, thermostat counters and
-        first-step probe as a fresh integrator has them; the random stream starts again from the seed).  A step count
-        set to 0 alone (``Simulation.currentStep = 0``) keeps the run, as on the native backend.  Idempotent until the
-        next step."""
-        if self._bound_context().getStepCount() == 0 and not self._bound_values_intact():
+    def _start_new_run_where_lost(self):
+        """Where the per-DOF values set while bound are missing (a reinitialized Context, or a State or checkpoint
+        taken from one before its first step), the Context no longer holds the run its global variables describe:
+        start a new one, as the native backend, whose kernel is made anew (heat bath, step counter, thermostat
+        counters and first-step probe as a fresh integrator has them), and set those values again.  A step count
+        set to 0 alone (``Simulation.currentStep = 0``), ``reinitialize(preserveState=True)``, a checkpoint and a
+        State of a running Context keep the run.  (NVE programs without ``exact_momentum`` set nothing while bound:
+        their step counter goes on.)"""
+        if self._bound_values_intact():
+            return
+        if self.getGlobalVariableByName(program.PROBED_VAR) > 0.5:  # a run had begun
             self._forget_run_state(per_dof=False)
+        self._set_bound_values()
 
     def _bound_values_intact(self) -> bool:
-        """Whether the per-DOF values set while bound are still in the Context (a reinitialized one drops them): the
-        thermostat's mask with its dof - 1 ones, exact momentum's masses not all zero."""
+        """Whether the per-DOF values set while bound are in the Context: the thermostat's mask with its dof - 1 ones,
+        exact momentum's masses not all zero (True for a program that sets none)."""
         if self.thermostat is not None:
             mask = self.getPerDofVariableByName(thermostat_program.MASK_VAR)
-            if sum(sum(vec) for vec in mask) != self.thermostat.dof - 1:
+            if len(mask) != self._n_particles or sum(sum(vec) for vec in mask) != self.thermostat.dof - 1:
                 return False
-        if self.options.exact_momentum:
+        if self._masses is not None:
             from .projection import MASS_VAR
 
             if not any(vec[0] for vec in self.getPerDofVariableByName(MASS_VAR)):
                 return False
         return True
 
+    def _set_bound_values(self):
+        """Set the per-DOF values a bound program needs: exact momentum's masses, the thermostat's mask."""
+        if self._masses is not None:
+            set_masses(self, self._masses)
+        if self.thermostat is not None:
+            self.setPerDofVariableByName(thermostat_program.MASK_VAR,
+                                         thermostat_program.mask_values(self._has_mass(), self.thermostat.dof))
+
+    def _has_mass(self) -> list:
+        """1 for each particle with mass, 0 for the massless ones (of ``system=``, or of the metadata of an integrator
+        read from XML)."""
+        massless = set(self._massless)
+        return [0.0 if i in massless else 1.0 for i in range(self._n_particles)]
+
+    def _is_bound(self) -> bool:
+        """Whether a Context holds the integrator now (OpenMM's step(0) does nothing else than check it)."""
+        try:
+            mm.CustomIntegrator.step(self, 0)
+        except mm.OpenMMException:
+            return False
+        return True
+
     def _sync_run_state(self):
-        """Between steps, what the native backend reports at once: after Context.reinitialize() the values of a new run
-        (else they would change only at the next step)."""
-        if self._bound_values_may_be_lost():
-            self._start_new_run_if_reinitialized()
+        """Between steps, what the native backend reports at once: where the Context no longer holds the run (see
+        :meth:`_start_new_run_where_lost`) the values of a new run (else they would change only at the next step)."""
+        if (self.thermostat is not None or self._masses is not None) and self._is_bound():
+            if not self._checked_context:
+                self._check_context()
+            self._start_new_run_where_lost()
 
     def _keep_thermostat_settings(self):
         """Give the program the integrator's current temperature and collision time if a checkpoint (or a State's
@@ -197,57 +264,19 @@ class PRKIntegrator(IntegratorBase, mm.CustomIntegrator):
                    zip(held, (self.thermostat.temperature, self.thermostat.collision_time))):
             self._apply_thermostat(self.thermostat)
 
-    def _bound_values_may_be_lost(self) -> bool:
-        """Whether the Context may have dropped the per-DOF values set while bound (the thermostat's mask,
-        exact_momentum's masses): ``Context.reinitialize()`` keeps the integrator's global variables but not those,
-        and sets the Context's step count to 0.  So: the step count is not the one the last call left (also after
-        setStepCount, a checkpoint or a State: then the check finds the values in place and changes nothing)."""
-        if self._step_count is None:
-            return False
-        context = self._bound_context()
-        return context is not None and context.getStepCount() != self._step_count
-
-    def _remember_step_count(self):
-        if self._masses is not None:  # only the thermostat and exact_momentum set per-DOF values while bound
-            context = self._bound_context()
-            self._step_count = context.getStepCount() if context is not None else None
-
     def _check_context(self):
         """First step on a Context: its particle count against ``system=`` (read from a per-DOF variable the
-        Context sized), then the exact masses for the projection."""
+        Context sized)."""
         n = len(self.getPerDofVariableByName(program.PROBE_PER_DOF))
         expected = self.options.system.n_particles if self.options.system is not None else None
-        if n == 1 and expected not in (None, 1):
-            super().step(0)  # raises "not bound to a context" if that is why only one value came back
         if expected is not None and n != expected:
             raise SystemMismatchError(
                 f"{type(self).__name__}({self.method_name}) was compiled for a System of {expected} particles, but "
                 f"its Context's System has {n}: create the integrator with system= the System you simulate")
-        if self._masses is not None and self.options.exact_momentum:
-            set_masses(self, self._masses)
-        if self.thermostat is not None:
-            self._set_thermostat_mask(n)
+        self._n_particles = n
         self._checked_context = True
 
     # -- the thermostat (see IntegratorBase for the accessors) ---------------------------------------------
-    def _set_thermostat_mask(self, n: int):
-        """Check, once the Context is known to have the System's particle count, that the per-DOF mask of the
-        chi-squared sum holds dof - 1 ones for n particles, and fill it if not: from the masses of system=, or
-        (an integrator read from XML without it) those of its Context's System."""
-        ones = self.thermostat.dof - 1
-        current = self.getPerDofVariableByName(thermostat_program.MASK_VAR)
-        if len(current) == n and sum(sum(vec) for vec in current) == ones:
-            return
-        m = self._masses
-        if m is None:
-            context = self._bound_context()
-            if context is None:
-                raise RuntimeError(f"{type(self).__name__}({self.method_name}): the thermostat's mask could not be "
-                                   f"set (its Context was not found); create the integrator with system=")
-            m = masses(context.getSystem())
-        self.setPerDofVariableByName(thermostat_program.MASK_VAR,
-                                     thermostat_program.mask_values(m, self.thermostat.dof))
-
     def program_thermostat_settings(self, settings):
         """``settings`` with the temperature, collision time and seed this program holds (an integrator read from XML:
         as they were last set, where its metadata has them as created)."""
@@ -281,16 +310,14 @@ class PRKIntegrator(IntegratorBase, mm.CustomIntegrator):
         return self.getGlobalVariableByName(thermostat_program.NEW_KINETIC_VAR)
 
     def _after_step(self):
-        self._remember_step_count()
         if self.thermostat is not None and self.getGlobalVariableByName(thermostat_program.LOST_MASK_VAR):
-            # the Context was reinitialized without its state (per-DOF values set while bound are lost): the
-            # events of this call did nothing (alpha = 1); fill the mask again for the next steps
+            # the events found the mask without its dof - 1 ones and did nothing (alpha = 1): per-DOF values were
+            # replaced during the call (the checks before it found the mask in place); fill it again
             self.setGlobalVariableByName(thermostat_program.LOST_MASK_VAR, 0.0)
-            self._set_thermostat_mask(len(self.getPerDofVariableByName(program.PROBE_PER_DOF)))
-            warnings.warn(f"{type(self).__name__}({self.method_name}): the thermostat's per-DOF mask was lost (the "
-                          f"Context was reinitialized without preserving its state, and the integrator could not find "
-                          f"its Context to notice before stepping), so the steps of this call ran without the "
-                          f"thermostat; it is restored for the next steps.", RuntimeWarning, stacklevel=3)
+            self._set_bound_values()
+            warnings.warn(f"{type(self).__name__}({self.method_name}): the thermostat's per-DOF mask was lost during "
+                          f"this step() call, so its steps ran without the thermostat; it is restored for the next "
+                          f"steps.", RuntimeWarning, stacklevel=3)
         if not self._checked_probe:
             self._checked_probe = True
             if self.getGlobalVariableByName(program.PROBE_CONSTRAINTS_VAR) > 0 and not self.program_info.rattle:
@@ -319,40 +346,21 @@ class PRKIntegrator(IntegratorBase, mm.CustomIntegrator):
     def _raw_steps_taken(self) -> int:
         return int(self.getGlobalVariableByName(program.STEP_VAR))
 
-    # -- the Context's time -------------------------------------------------------------------------------
-    def step(self, steps):
-        """Advance ``steps`` steps (see :meth:`IntegratorBase.step`), keeping the Context's time right after a
-        change of step size: OpenMM's CustomIntegrator on Reference and CPU advances the time by the step size
-        the Context was created with, whatever setStepSize said since; the time is then set to what the steps
-        took (read before and after, only while the step size differs from the one the time is known to follow)."""
-        dt = self._dt
-        if dt == self._time_dt:
-            return super().step(steps)
-        context = self._bound_context()
-        if context is None:
-            warn_once("custom-setstepsize-time",
-                      f"{type(self).__name__}: the step size changed since the integrator was created, and its "
-                      f"Context could not be found to keep its time right (on Reference and CPU OpenMM's "
-                      f"CustomIntegrator advances the time by the step size the Context was created with). Call "
-                      f"context.reinitialize(preserveState=True) after setStepSize, or use the native backend.",
-                      TimeWarning)
-            return super().step(steps)
-        t0 = context.getState().getTime().value_in_unit(unit.picosecond)
-        n0 = self._raw_steps_taken()
-        try:
-            return super().step(steps)
-        finally:
-            taken = self._raw_steps_taken() - n0
-            expected = t0 + taken * dt
-            t1 = context.getState().getTime().value_in_unit(unit.picosecond)
-            if abs(t1 - expected) > 1e-9 * max(taken, 1) * dt:
-                context.setTime(expected)
-            elif taken:
-                self._time_dt = dt  # this platform's time follows the step size
-
+    # -- the step size --------------------------------------------------------------------------------------
     def setStepSize(self, size):
+        """Set the step size (checked).  On a bound integrator it warns once: OpenMM's CustomIntegrator on the Reference
+        and CPU platforms goes on advancing the Context's time by the step size the Context was created with (the
+        steps themselves take the new one), and the integrator cannot reach its Context to set the time."""
         result = super().setStepSize(size)
-        self._dt = self.getStepSize().value_in_unit(unit.picosecond)
+        dt = self.getStepSize().value_in_unit(unit.picosecond)
+        if dt != self._dt and self._is_bound():
+            warn_once("custom-setstepsize-time",
+                      f"{type(self).__name__}({self.method_name}): the step size changed from {self._dt:g} to {dt:g} ps "
+                      f"while the integrator runs a Context; on the Reference and CPU platforms OpenMM's "
+                      f"CustomIntegrator goes on advancing the Context's time by the step size the Context was created "
+                      f"with (the steps take the new one). Call context.reinitialize(preserveState=True) after "
+                      f"setStepSize, or use the native backend, whose time follows the step size.", TimeWarning)
+        self._dt = dt
         return result
 
     def describe(self) -> str:

@@ -16,6 +16,7 @@ from __future__ import annotations
 import json
 
 import openmm as mm
+import openmm.unit as unit
 
 from ..methods.description import describe, from_description
 from ..methods.resolved import ResolvedMethod, resolve
@@ -24,15 +25,24 @@ from .options import DEFAULT_MAX_ITERATIONS, DEFAULT_TOLERANCE, IntegratorOption
 from .thermostat import ThermostatSettings
 from ..support.errors import InputError
 
-__all__ = ["META_PREFIX", "metadata", "add_metadata", "read_metadata", "methods_of", "options_of"]
+__all__ = ["META_PREFIX", "metadata", "add_metadata", "read_metadata", "methods_of", "options_of", "thermostat_of",
+           "massless_particles", "massless_of"]
 
 #: Prefix of the global variable whose name carries the program's metadata (hex JSON).
 META_PREFIX = "symprk_meta_"
 
 
-def metadata(class_name: str, method, resolved: ResolvedMethod, options: IntegratorOptions) -> dict:
+def massless_particles(system: mm.System) -> tuple:
+    """The indices of the System's massless particles (virtual sites, frozen atoms)."""
+    return tuple(i for i in range(system.getNumParticles()) if system.getParticleMass(i).value_in_unit(unit.dalton)
+                 == 0)
+
+
+def metadata(class_name: str, method, resolved: ResolvedMethod, options: IntegratorOptions,
+             thermostat: ThermostatSettings | None = None, massless=()) -> dict:
     """The metadata of a program of ``class_name`` compiled from ``method`` (as given), resolved as ``resolved``,
-    with ``options``."""
+    with ``options``, the ``thermostat``'s settings as created and the System's ``massless`` particles (written where
+    there are some: the thermostat's per-DOF mask leaves them out)."""
     sig = options.system
     meta = {"class": class_name, "method": resolved.name,
             "catalogue": resolved.entry.name if resolved.entry is not None else None,
@@ -47,8 +57,10 @@ def metadata(class_name: str, method, resolved: ResolvedMethod, options: Integra
              "max_iterations": (options.max_iterations, DEFAULT_MAX_ITERATIONS),
              "allow_nonsymplectic": (options.allow_nonsymplectic, False)}
     meta["options"].update({k: value for k, (value, default) in given.items() if value != default})
-    if options.thermostat is not None:
-        meta["thermostat"] = options.thermostat.as_dict()
+    if thermostat is not None:
+        meta["thermostat"] = thermostat.as_dict()
+    if massless and meta["system"] is not None:
+        meta["system"]["massless"] = list(massless)
     if resolved.entry is None:
         meta["description"] = describe(method)
     if resolved.is_mts:
@@ -94,12 +106,21 @@ def methods_of(meta: dict):
 def options_of(meta: dict, step_size: float, inner_method) -> IntegratorOptions:
     """The :class:`~.options.IntegratorOptions` the metadata records (``step_size`` in ps: the program's)."""
     options = meta.get("options", {})
-    system = meta.get("system")
+    system = {k: v for k, v in (meta.get("system") or {}).items() if k != "massless"}
     groups = options.get("groups")
     return IntegratorOptions(
         step_size, SystemSignature(**system) if system else None, bool(options.get("exact_momentum", False)),
         bool(options.get("check_finite", True)), float(options.get("max_speed") or 0.0),
-        tuple((int(g), int(n)) for g, n in groups) if groups else None, inner_method,
-        ThermostatSettings(**meta["thermostat"]) if meta.get("thermostat") else None, options.get("constraints"),
+        tuple((int(g), int(n)) for g, n in groups) if groups else None, inner_method, options.get("constraints"),
         bool(options.get("allow_nonsymplectic", False)), float(options.get("tolerance", DEFAULT_TOLERANCE)),
         int(options.get("max_iterations", DEFAULT_MAX_ITERATIONS)))
+
+
+def massless_of(meta: dict) -> tuple:
+    """The massless particles the metadata records (none where it records none, as earlier versions wrote it)."""
+    return tuple(int(i) for i in (meta.get("system") or {}).get("massless", ()))
+
+
+def thermostat_of(meta: dict) -> ThermostatSettings | None:
+    """The thermostat's settings the metadata records (as the integrator was created), or None (NVE)."""
+    return ThermostatSettings(**meta["thermostat"]) if meta.get("thermostat") else None

@@ -9,8 +9,9 @@ Reference and CPU (one kernel), OpenCL and CUDA (the Common compute source); :mo
 loads them and says why the backend is unavailable when it is.
 
 With ``temperature=`` the plugin runs the stochastic velocity-rescaling thermostat (:mod:`.thermostat` checks
-the options), at the ends of the step or, with ``thermostat_position="middle"``, as the THERMOSTAT sub-step the
-resolved method holds at the step's centre.  On Reference/CPU the plugin's host code draws the noise and computes
+the options): its events are the THERMOSTAT sub-steps of the resolved method (half events at the ends of the step,
+or one at its centre with the step run from its closing kicks), which the plugin runs in order like the kicks and
+drifts.  On Reference/CPU the plugin's host code draws the noise and computes
 the factor; on OpenCL/CUDA the whole event runs on the device (OpenMM's random numbers, the chi-squared variate
 summed there): a step makes no host transfer (``getHostTransfers()`` counts the plugin's own).  The C++ object
 holds the settings, so a copy or an integrator read back from XML has them; a State taken with
@@ -30,7 +31,7 @@ from ..methods.resolved import substep_label
 from .backend import resolve_for_system
 from .base import IntegratorBase
 from .options import NATIVE_OPTIONS, IntegratorOptions, check_option_names
-from .thermostat import ThermostatSettings
+from .thermostat import ThermostatSettings, thermostat_settings
 from .program import ProgramInfo
 from .symplectic import SymplecticIntegrator
 from ..support.errors import InputError
@@ -68,15 +69,16 @@ class NativeSymplecticIntegrator(SymplecticIntegrator, _PluginIntegrator, backen
         check_option_names(unknown, NATIVE_OPTIONS | {"backend"}, type(self).__name__)
         opts = IntegratorOptions.build(
             type(self).__name__, stepSize, system, exact_momentum=exact_momentum, check_finite=check_finite,
-            max_speed=max_speed, groups=groups, inner_method=inner_method, temperature=temperature,
-            collision_time=collision_time, thermostat_interval=thermostat_interval, random_seed=random_seed,
-            thermostat_position=thermostat_position)
+            max_speed=max_speed, groups=groups, inner_method=inner_method)
+        settings = thermostat_settings(system, temperature=temperature, collision_time=collision_time,
+                                       thermostat_interval=thermostat_interval, random_seed=random_seed,
+                                       thermostat_position=thermostat_position)
         if _swig is None:
             raise plugin.NativeUnavailableError(f"the native backend is unavailable: {plugin.unavailable_reason()}. "
                                                 f"To fix it, {plugin.fix_hint()}.")
         # the native kernels place virtual sites after every drift: no CustomIntegrator caveat
         r = resolve_for_system(type(self).__name__, method, system, opts, skip_checks=("virtualsites",),
-                               splittings_only="the native backend runs kick/drift splittings and compositions only. "
+                               thermostat=settings, splittings_only="the native backend runs kick/drift splittings and compositions only. "
                                                "Use SymplecticIntegrator(..., backend='custom') for it.")
         subs = r.substeps
         _PluginIntegrator.__init__(self, opts.step_size, [int(s.kind) for s in subs],
@@ -87,8 +89,8 @@ class NativeSymplecticIntegrator(SymplecticIntegrator, _PluginIntegrator, backen
         self.setMaxSpeed(opts.max_speed)
         if opts.system is not None:
             self.setExpectedSystem(opts.system.n_particles, r.constraints)
-        if opts.thermostat is not None:
-            self._set_thermostat(opts.thermostat)
+        if settings is not None:
+            self._set_thermostat(settings)
         self._set_program(r, opts)
 
     def _set_program(self, r, options, notes=()):
@@ -111,17 +113,16 @@ class NativeSymplecticIntegrator(SymplecticIntegrator, _PluginIntegrator, backen
     def _reset_binding(self):
         """A copy of a 0.2.0 pickle carried no settings of its own (the plugin held them): read them from the plugin."""
         if self.__dict__.get("_thermostat") is None and self.hasThermostat() and self.resolved is not None:
-            asked = self.options.thermostat if self.options is not None else None
-            self._thermostat = self.plugin_thermostat_settings(
-                asked.position if asked is not None else (self.resolved.thermostat_position or "ends"))
+            self._thermostat = self.plugin_thermostat_settings(self.resolved.thermostat_position)
 
     def _adopt(self, other):
-        """Take over a deserialized SymPRKIntegrator (XmlSerializer gives it as a base openmm.Integrator)."""
+        """Wrap a deserialized SymPRKIntegrator (XmlSerializer gives it as a base openmm.Integrator), which stays valid:
+        the cast gives a second SWIG handle that does not own the C++ object, so ``other`` keeps owning it and this
+        wrapper keeps ``other`` alive (dropping either one leaves the other usable)."""
         typed = _swig.SymPRKIntegrator.cast(other)
-        own = bool(getattr(other, "thisown", False))
-        other.thisown = False
+        typed.thisown = False
         self.this = typed.this
-        self.thisown = own
+        self._wrapped = other
 
     # -- the thermostat: the plugin is given the settings the integrator holds ----------------------------------------
     def plugin_thermostat_settings(self, position: str):

@@ -3,16 +3,17 @@
 Every integrator class takes ``stepSize``, the method, ``system=`` and keyword options.  Its constructor builds one
 :class:`IntegratorOptions` with :meth:`IntegratorOptions.build`, which refuses an unknown option name (with close
 names, as method names get), checks every value (with an error naming it and what is accepted) and derives what the
-backends need (the step size in ps, ``max_speed`` in nm/ps, the thermostat's settings, the facts of ``system=``);
-both backends then read that one object.
+backends need (the step size in ps, ``max_speed`` in nm/ps, the facts of ``system=``); both backends then read
+that one object.  The thermostat's settings are not among them: they change while the
+integrator runs (``setTemperature``), so the integrator holds them once (``integrator.thermostat``, checked by
+:func:`.thermostat.thermostat_settings`).
 
 The options (defaults in brackets):
 
 * both backends: ``exact_momentum`` [False] (needs ``system=``), ``check_finite`` [True], ``max_speed`` [None: only
   NaN, infinity and absurd speeds (the custom program: a velocity component above 1e15 nm/ps) count as a blow-up;
-  at most :data:`MAX_SPEED_LIMIT`], ``groups`` and ``inner_method`` (multiple time stepping), and the
-  thermostat's ``temperature``, ``collision_time``, ``thermostat_interval``, ``random_seed``
-  (:func:`.thermostat.thermostat_settings`);
+  at most :data:`MAX_SPEED_LIMIT`], ``groups`` and ``inner_method`` (multiple time stepping) (and the
+  thermostat's options, :data:`.thermostat.THERMOSTAT_OPTIONS`, checked apart);
 * the CustomIntegrator backend only: ``constraints`` [None: from ``system=``], ``allow_nonsymplectic`` [False],
   ``tolerance`` [1e-12 nm] and ``max_iterations`` [60] (implicit methods' fixed-point iteration).
 """
@@ -28,7 +29,7 @@ from ..methods.respa import mts_groups
 from ..systems.checks import check_system_type
 from ..systems.properties import SystemSignature, signature
 from .base import step_size_in_ps
-from .thermostat import THERMOSTAT_OPTIONS, ThermostatSettings, thermostat_settings
+from .thermostat import THERMOSTAT_OPTIONS
 from ..support.errors import InputError
 
 __all__ = ["IntegratorOptions", "NATIVE_OPTIONS", "CUSTOM_OPTIONS", "OPTIONS", "DEFAULT_TOLERANCE",
@@ -107,7 +108,6 @@ class IntegratorOptions:
     max_speed: float = 0.0  # nm/ps; 0: only NaN and infinity count as a blow-up
     groups: tuple | None = None  # multiple time stepping: ((force group, substeps), ...)
     inner_method: object = None  # multiple time stepping: the inner levels' method (None: the outer one)
-    thermostat: ThermostatSettings | None = None  # None: no thermostat (NVE)
     constraints: bool | None = None  # RATTLE steps or not; None: from system= (kick/drift methods keep them without)
     allow_nonsymplectic: bool = False
     tolerance: float = DEFAULT_TOLERANCE  # nm
@@ -115,8 +115,7 @@ class IntegratorOptions:
 
     @classmethod
     def build(cls, where: str, step_size, system=None, *, exact_momentum=False, check_finite=True, max_speed=None,
-              groups=None, inner_method=None, temperature=None, collision_time=None, thermostat_interval=None,
-              random_seed=None, thermostat_position=None, constraints=None, allow_nonsymplectic=False,
+              groups=None, inner_method=None, constraints=None, allow_nonsymplectic=False,
               tolerance=DEFAULT_TOLERANCE, max_iterations=DEFAULT_MAX_ITERATIONS) -> IntegratorOptions:
         """The checked options of ``where`` (the class name, for messages), each by its name (the module docstring
         lists them).  A class refuses the names it does not take before it calls this (:func:`check_option_names`)."""
@@ -133,11 +132,8 @@ class IntegratorOptions:
                              "System's masses")
         if system is not None:
             check_system_type(system)
-        thermostat = thermostat_settings(system, temperature=temperature, collision_time=collision_time,
-                                         thermostat_interval=thermostat_interval, random_seed=random_seed,
-                                         thermostat_position=thermostat_position)
         return cls(step_size=dt, system=signature(system) if system is not None else None,
                    exact_momentum=exact_momentum, check_finite=bool(check_finite), max_speed=max_speed,
                    groups=mts_groups(groups) if groups is not None else None, inner_method=inner_method,
-                   thermostat=thermostat, constraints=constraints, allow_nonsymplectic=bool(allow_nonsymplectic),
+                   constraints=constraints, allow_nonsymplectic=bool(allow_nonsymplectic),
                    tolerance=tolerance, max_iterations=max_iterations)

@@ -234,11 +234,12 @@ class _Emitter:
         return signature
 
 
-def _compile_splitting(integrator, method: ResolvedMethod, constraints: bool, options: IntegratorOptions) -> ProgramInfo:
+def _compile_splitting(integrator, method: ResolvedMethod, constraints: bool, options: IntegratorOptions,
+                       thermostat=None) -> ProgramInfo:
     """Emit the program of a resolved kick/drift method: its sub-steps as they run, with a velocity projection
     before every drift flagged for one.  ``constraints``: emit the RATTLE steps (the System has constraints, or
     virtual sites that only ConstrainPositions places on the Common platforms)."""
-    em = _Emitter(integrator, constraints, options.exact_momentum, options.thermostat)
+    em = _Emitter(integrator, constraints, options.exact_momentum, thermostat)
     last = max(i for i, sub in enumerate(method.substeps) if sub.is_kick_or_drift)
     for i, sub in enumerate(method.substeps):
         c = float(sub.coefficient)
@@ -273,13 +274,13 @@ def _lincomb(base: str, coeffs, names) -> str:
 
 
 def _compile_tableau(integrator, method: ResolvedMethod, options: IntegratorOptions,
-                     place_virtual_sites=False) -> ProgramInfo:
+                     place_virtual_sites=False, thermostat=None) -> ProgramInfo:
     """Emit the program of a general PRK pair (unconstrained systems only).
 
     Per-DOF variables: symprk_x0/v0 (start of step), symprk_k<i> (stage accelerations F(Q_i)/m),
     symprk_p<i> (stage velocities P_i), symprk_q<i> (implicit stage positions).  ``place_virtual_sites``
     ends the step with a ConstrainPositions (which only places virtual sites in an unconstrained System)."""
-    em = _Emitter(integrator, False, options.exact_momentum, options.thermostat)
+    em = _Emitter(integrator, False, options.exact_momentum, thermostat)
     # the thermostat's events around the stages: those of the first step of its interval before them, the rest after
     before = [sub for sub in method.substeps if sub.phase is EventPhase.FIRST]
     for sub in before:
@@ -361,13 +362,13 @@ def _compile_tableau(integrator, method: ResolvedMethod, options: IntegratorOpti
 
 
 def compile_program(integrator, method: ResolvedMethod, options: IntegratorOptions,
-                    virtual_sites: bool = False) -> ProgramInfo:
-    """Compile a resolved method (:func:`openmm_symprk.methods.resolved.resolve`) with its ``options`` into
-    ``integrator``'s program.
+                    virtual_sites: bool = False, thermostat=None) -> ProgramInfo:
+    """Compile a resolved method (:func:`openmm_symprk.methods.resolved.resolve`) with its ``options`` and the
+    ``thermostat``'s settings (:class:`~.thermostat.ThermostatSettings`, None for NVE) into ``integrator``'s program.
 
     A kick/drift method gets RATTLE steps where it was resolved with constraints or the System has
     ``virtual_sites`` (whose ConstrainPositions places them); a general PRK pair (resolved without constraints)
     ends the step with a ConstrainPositions where there are virtual sites."""
     if method.is_splitting:
-        return _compile_splitting(integrator, method, method.constraints or virtual_sites, options)
-    return _compile_tableau(integrator, method, options, place_virtual_sites=virtual_sites)
+        return _compile_splitting(integrator, method, method.constraints or virtual_sites, options, thermostat)
+    return _compile_tableau(integrator, method, options, place_virtual_sites=virtual_sites, thermostat=thermostat)

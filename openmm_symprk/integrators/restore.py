@@ -20,14 +20,13 @@ import openmm.unit as unit
 
 from .. import plugin
 from ..methods.catalogue import methods as catalogue_methods
-from ..methods.placement import THERMOSTAT
-from ..methods.resolved import SubstepFlag, SubstepKind, resolve
+from ..methods.resolved import EventPhase, SubstepKind, method_steps, placement_of, resolve
 from ..methods.splitting import Splitting
 from . import program
 from .backend import resolve_for_system
 from .base import IntegratorBase
 from .custom_backend import CustomSymplecticIntegrator, PRKIntegrator
-from .metadata import methods_of, options_of, read_metadata
+from .metadata import massless_of, methods_of, options_of, read_metadata, thermostat_of
 from .native_backend import NativeSymplecticIntegrator, native_available
 from .options import IntegratorOptions
 from ..support.errors import InputError
@@ -41,8 +40,9 @@ def deserialize(xml: str):
 
 
 def restore(integrator):
-    """The package's integrator class around ``integrator`` (an OpenMM integrator from XML), which it takes
-    over; an integrator that already is one is returned as it is."""
+    """The package's integrator class around ``integrator`` (an OpenMM integrator from XML); an integrator that
+    already is one is returned as it is.  Both wrap the same C++ integrator and ``integrator`` stays valid whether
+    the result is kept or not (using it directly only skips the package's checks); keep the result to have them."""
     if isinstance(integrator, IntegratorBase):
         return integrator
     if isinstance(integrator, mm.CustomIntegrator):
@@ -65,9 +65,10 @@ def _restore_custom(integrator: mm.CustomIntegrator):
     cls = CustomSymplecticIntegrator if meta.get("class") == "CustomSymplecticIntegrator" else PRKIntegrator
     method, inner = methods_of(meta)
     options = options_of(meta, integrator.getStepSize().value_in_unit(unit.picosecond), inner)
-    resolved = resolve_for_system(cls.__name__, method, None, options, name=meta.get("method"))
+    settings = thermostat_of(meta)
+    resolved = resolve_for_system(cls.__name__, method, None, options, name=meta.get("method"), thermostat=settings)
     has_sites = options.system.virtual_sites if options.system is not None else True
-    info = program.compile_program(mm.CustomIntegrator(options.step_size), resolved, options, has_sites)
+    info = program.compile_program(mm.CustomIntegrator(options.step_size), resolved, options, has_sites, settings)
     stored = integrator.getGlobalVariable(0)
     if stored != info.signature:
         raise InputError(f"this {cls.__name__}({resolved.name}) program is not the one its metadata compiles to (its "
@@ -76,26 +77,13 @@ def _restore_custom(integrator: mm.CustomIntegrator):
     obj = object.__new__(cls)
     obj._adopt(integrator)
     obj._set_program(resolved, options, replace(info, notes=(*info.notes, "restored from XML")))
-    obj.__dict__.update(_masses=None)
+    obj.__dict__.update(_masses=None, _massless=massless_of(meta))
     # the program holds the temperature and collision time as they were last set (the metadata: as created)
-    if options.thermostat is not None:
-        obj._thermostat = obj.program_thermostat_settings(options.thermostat)
+    if settings is not None:
+        obj._thermostat = obj.program_thermostat_settings(settings)
     obj._reset_binding()
     obj._forget_run_state()
     return obj
-
-
-def _without_thermostat(steps: list) -> list:
-    """(label, coefficient) sub-steps without the thermostat's, the two halves it split joined again."""
-    out = []
-    for i, (label, c) in enumerate(steps):
-        if label == THERMOSTAT:
-            continue
-        if i > 0 and steps[i - 1][0] == THERMOSTAT and out and out[-1][0] == label:
-            out[-1] = (label, out[-1][1] + c)
-        else:
-            out.append((label, c))
-    return out
 
 
 def _restore_native(integrator):
@@ -106,11 +94,9 @@ def _restore_native(integrator):
     constraints = bool(obj.getExpectedConstraints()) if expected >= 0 else True
     plugin_steps = [(obj.getSubstepKind(i), obj.getSubstepCoefficient(i), obj.getSubstepForceGroups(i),
                      obj.getSubstepFlags(i)) for i in range(obj.getNumSubsteps())]
-    # the thermostat's placement: an event in the centre step of the interval is the middle one (resolve puts it back
-    # at the centre), events in the first and last steps are the ends'
-    edges = SubstepFlag.FIRST_OF_INTERVAL | SubstepFlag.LAST_OF_INTERVAL
-    middle = any(kind == SubstepKind.THERMOSTAT and not flags & edges for kind, _, _, flags in plugin_steps)
-    position = "middle" if middle else ("ends" if obj.hasThermostat() else None)
+    # the thermostat's placement, read back from the phases its events' flags name
+    position = placement_of(EventPhase.of_flags(flags) for kind, _, _, flags in plugin_steps
+                            if kind == SubstepKind.THERMOSTAT)
 
     def runs_as_plugin(r):
         return [(int(s.kind), float(s.coefficient), s.group_mask, int(s.flags)) for s in r.substeps] == plugin_steps
@@ -119,12 +105,13 @@ def _restore_native(integrator):
     # time stepping, a user splitting) the plugin's sub-steps as they run, with the catalogue's orders if named
     resolved = resolve(name, constraints=constraints, thermostat_position=position) if name in catalogue_methods else None
     if resolved is None or not runs_as_plugin(resolved):
-        resolved = resolve(Splitting(_without_thermostat(obj.substeps())), constraints=constraints, name=name,
+        resolved = resolve(Splitting(method_steps(obj.substeps(), position)), constraints=constraints, name=name,
                            thermostat_position=position)
         if not runs_as_plugin(resolved):
             raise InputError(f"the SymPRKIntegrator {name!r} read from XML runs sub-steps {plugin_steps} (kind, "
-                             f"coefficient, force groups, flags) whose flags its sequence would not get: it was not "
-                             f"built by openmm_symprk")
+                             f"coefficient, force groups, flags) that its sequence would not get: it was not built by "
+                             f"this version of openmm_symprk (0.3.0 runs the middle placement's step from its closing "
+                             f"kicks), or not by openmm_symprk. Create the integrator again with its method and options")
         if name in catalogue_methods:
             entry = catalogue_methods[name]
             resolved = replace(resolved, entry=entry, order=entry.order, constrained_order=entry.constrained_order,
@@ -132,8 +119,7 @@ def _restore_native(integrator):
     # the plugin holds these options; check_finite is Python's (True), system= is held as the expected particle count
     settings = obj.plugin_thermostat_settings(position)
     options = IntegratorOptions(float(obj.getStepSize().value_in_unit(unit.picosecond)),
-                                exact_momentum=bool(obj.getExactMomentum()), max_speed=float(obj.getMaxSpeed()),
-                                thermostat=settings)
+                                exact_momentum=bool(obj.getExactMomentum()), max_speed=float(obj.getMaxSpeed()))
     obj._thermostat = settings
     obj._set_program(resolved, options, notes=("restored from XML",))
     obj._reset_binding()

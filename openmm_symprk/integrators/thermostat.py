@@ -18,15 +18,15 @@ import openmm.unit as unit
 
 from ..methods.placement import PLACEMENT_TEXT, check_position
 from ..physics.temperature import R_KJ
-from ..physics.velocity_rescaling import peculiar_kinetic_energy, relaxation_factor
+from ..physics.velocity_rescaling import relaxation_factor
 from ..systems.checks import EXACT_MOMENTUM_FORBIDDEN, check_system_type, conservation_issues
-from ..systems.properties import masses, thermostat_degrees_of_freedom
+from ..systems.properties import thermostat_degrees_of_freedom
 from .quantities import positive_quantity
 from ..support.errors import InputError
 
 __all__ = ["ThermostatSettings", "thermostat_settings", "temperature_in_kelvin", "collision_time_in_ps",
            "check_interval", "check_seed", "system_is_isolated", "DEFAULT_COLLISION_TIME", "THERMOSTAT_OPTIONS",
-           "MAX_SEED", "MAX_INTERVAL", "DEFAULT_POSITION", "check_position", "on_step_temperature"]
+           "MAX_SEED", "MAX_INTERVAL", "DEFAULT_POSITION", "check_position"]
 
 #: Default collision time tau (ps) when ``temperature`` is given without ``collision_time``.
 DEFAULT_COLLISION_TIME = 0.1
@@ -88,21 +88,6 @@ def system_is_isolated(system: mm.System) -> bool:
     return not any(key in EXACT_MOMENTUM_FORBIDDEN for key, _ in conservation_issues(system))
 
 
-def on_step_temperature(context: mm.Context) -> float:
-    """The kinetic temperature (K) of a Context's current velocities with the thermostat's count of degrees of freedom:
-    2 K_pec / (N_f R), K_pec the kinetic energy without the centre-of-mass motion (and the rigid rotation, for an isolated
-    System), N_f = 3 per particle with mass - constraints - 3 (- 3)."""
-    system = context.getSystem()
-    isolated = system_is_isolated(system)
-    dof = thermostat_degrees_of_freedom(system, isolated)
-    if dof <= 0:
-        return 0.0
-    state = context.getState(getPositions=True, getVelocities=True)
-    x = state.getPositions(asNumpy=True).value_in_unit(unit.nanometer)
-    v = state.getVelocities(asNumpy=True).value_in_unit(unit.nanometer / unit.picosecond)
-    return 2.0 * peculiar_kinetic_energy(x, v, masses(system), isolated) / (dof * R_KJ)
-
-
 @dataclass(frozen=True)
 class ThermostatSettings:
     """What a backend needs to run the thermostat.
@@ -110,7 +95,8 @@ class ThermostatSettings:
     ``temperature`` (K), ``collision_time`` tau (ps), ``interval`` n (it acts every n steps), ``seed`` (0: a
     fresh one per Context), ``dof`` (the degrees of freedom it samples), ``keep_rotation`` (the System is
     isolated: the rigid rotation about the centre of mass is kept, as the centre-of-mass velocity always is),
-    ``position`` ("ends", "middle" or "auto" as asked; the method decides "auto": ``resolved.thermostat_position``).
+    ``position`` ("ends", "middle" or "auto" as asked; where the events sit is the resolved method's, read back by
+    :func:`~openmm_symprk.methods.resolved.placement_of`: ``integrator.thermostat_position``).
 
     What it needs: a peculiar kinetic energy to scale (velocities that are not all one rigid motion).  A System at
     rest, or moving only as a rigid whole, stays where it is (a warning says so): start a run with velocities drawn
@@ -149,10 +135,10 @@ class ThermostatSettings:
             out["position"] = self.position
         return out
 
-    def describe(self, position: str | None = None, outer: bool = False) -> str:
-        """One line; ``position``: the placement the method resolved "auto" to; ``outer``: the step is the outer one of
-        multiple time stepping."""
-        placed = PLACEMENT_TEXT[position or self.position] + (" (the outer step)" if outer else "")
+    def describe(self, position: str, outer: bool = False) -> str:
+        """One line; ``position``: where the events sit as the method was resolved ("ends" or "middle"); ``outer``:
+        the step is the outer one of multiple time stepping."""
+        placed = PLACEMENT_TEXT[position] + (" (the outer step)" if outer else "")
         kept = "centre-of-mass velocity and rigid rotation kept" if self.keep_rotation else \
             "centre-of-mass velocity kept"
         every = "every step" if self.interval == 1 else f"every {self.interval} steps"

@@ -5,7 +5,8 @@ and half after: O_{h/2} . step . O_{h/2}) or at its exact centre (one whole even
 harmonic oscillators q'' = -w^2 q the choice decides how far the sampled configurations are from the canonical
 ones: velocity Verlet with O at the ends samples <q^2> w^2/kT = 1/(1 - h^2 w^2/4) (configurations hot), with O in
 the middle (between its two half drifts: BAOAB) exactly 1, while its on-step velocities then read
-<v^2>/kT = 1 - h^2 w^2/4 (docs/theory.md, section 6).  Higher-order splittings behave otherwise (omelyan-2's ends
+<v^2>/kT = 1 - h^2 w^2/4 and those at O exactly 1 (docs/theory.md, section 6; the integrators' State holds the
+latter: :func:`openmm_symprk.methods.resolved.resolve` runs such a step from its closing kick).  Higher-order splittings behave otherwise (omelyan-2's ends
 placement is already within 0.4% of exact at h w <= 1, its middle one 6% off), so the package does not assume
 which placement helps a method: :func:`harmonic_sampling` computes the stationary moments of a step with its
 thermostat exactly, and :func:`best_position` picks the placement for ``thermostat_position="auto"``.
@@ -80,7 +81,8 @@ def harmonic_sampling(steps, h_omega: float, decay: float = 0.5, forced=None) ->
     moments to 3 digits (docs/theory.md, section 6).  ``forced``: the kick labels that carry the oscillator's force
     (default: every kick; for a multiple-time-step sequence the fast level's label).  The moments are the
     stationary covariance of the linear stochastic map of one step (the discrete Lyapunov equation S = A S A^T + Q), taken at the
-    step's end: <v^2> is what a State's on-step velocities read.  ValueError when the step is unstable at h_omega
+    step's end: given the sub-steps as they run (``[(s.label, s.coefficient) for s in resolve(...).substeps]``, whose
+    middle placement runs the step from its closing kick), <v^2> is what a State's velocities read.  ValueError when the step is unstable at h_omega
     (no stationary distribution)."""
     if not 0.0 < decay < 1.0:
         raise InputError(f"decay must lie strictly between 0 and 1, got {decay!r}")

@@ -18,7 +18,9 @@ the catalogue's order, constrained order and stability interval.  The result is 
 
 ``substeps`` is the whole step, in the order it runs: the kicks and drifts and the thermostat's events where they
 sit, each event with the fraction of the step it relaxes over and the step of the thermostat's interval it runs in
-(:class:`EventPhase`).  Under constraints the kicks and drifts are RATTLE's, whose last part is a velocity projection
+(:class:`EventPhase`).  With the thermostat in the middle the step runs from its closing kicks, so that between
+steps the Context holds the velocities of the thermostat point (velocity Verlet: kick 1, drift 1/2, event,
+drift 1/2; see :func:`resolve`).  Under constraints the kicks and drifts are RATTLE's, whose last part is a velocity projection
 right after the last kick or drift (before an ends placement's closing event).  (A general PRK pair's stages are its
 ``tableau``; its sub-steps are only the thermostat's events around them.)
 
@@ -38,12 +40,13 @@ import numpy as np
 from .catalogue import Method, get_method
 from .placement import THERMOSTAT, best_position, centre, check_position
 from .respa import MTSError, evaluations_per_step, label_groups, levels, mts_groups, respa
-from .splitting import DRIFT, KICK, Splitting
+from .splitting import DRIFT, KICK, Splitting, evaluating_kicks
 from .tableau import PRKTableau, TableauError
 from ..support.errors import InputError
 
-__all__ = ["resolve", "thermostat_position_for", "ResolvedMethod", "Substep", "substep_label", "SubstepKind", "SubstepFlag", "EventPhase",
-           "ConstraintSupportError", "projected_drifts", "FORMS"]
+__all__ = ["resolve", "thermostat_position_for", "placement_of", "method_steps", "ResolvedMethod", "Substep",
+           "substep_label",
+           "SubstepKind", "SubstepFlag", "EventPhase", "ConstraintSupportError", "projected_drifts", "FORMS"]
 
 #: The form of a step, which decides how it runs: a kick/drift sequence (any splitting or composition, multiple time
 #: stepping included), an explicit general PRK pair, or an implicit one (stages solved by fixed-point iteration).
@@ -83,6 +86,25 @@ class EventPhase(IntEnum):
         """The step, counted from 0 within an interval of ``interval`` steps, in which such an event runs."""
         n = int(interval)
         return 0 if self is EventPhase.FIRST else (n - 1 if self is EventPhase.LAST else (n - 1) // 2)
+
+    @classmethod
+    def of_flags(cls, flags) -> "EventPhase":
+        """The phase a thermostat sub-step's flags (:class:`SubstepFlag`, the plugin's) name."""
+        flags = SubstepFlag(int(flags))
+        if flags & SubstepFlag.FIRST_OF_INTERVAL:
+            return cls.FIRST
+        return cls.LAST if flags & SubstepFlag.LAST_OF_INTERVAL else cls.CENTRE
+
+
+def placement_of(phases) -> str | None:
+    """Where a step's thermostat sits, read back from the :class:`EventPhase` of its events: "middle" (one event in
+    the centre step of the interval), "ends" (half events in its first and last steps), or None (no event: no
+    thermostat).  The one reading of a placement: a resolved method's (:attr:`ResolvedMethod.thermostat_position`) and
+    a plugin's read from XML (its sub-steps' flags, :meth:`EventPhase.of_flags`)."""
+    phases = set(phases)
+    if not phases:
+        return None
+    return "middle" if EventPhase.CENTRE in phases else "ends"
 
 
 class ConstraintSupportError(InputError):
@@ -188,12 +210,15 @@ class ResolvedMethod:
     levels: tuple = ()  # multiple time stepping: Level, slowest first
     groups: tuple | None = None  # multiple time stepping: ((force group, substeps), ...) as given
     inner_name: str | None = None  # multiple time stepping: the inner levels' method
-    #: where the thermostat sits: None (no thermostat, or one a backend runs at the ends itself), "ends" or
-    #: "middle" (then ``substeps`` holds one THERMOSTAT sub-step at the step's centre)
-    thermostat_position: str | None = None
     entry: Method | None = field(default=None, repr=False)  # the catalogue entry, when there is one
 
     # -- views ----------------------------------------------------------------------------------------------
+    @property
+    def thermostat_position(self) -> str | None:
+        """Where the thermostat's events sit in ``substeps``: "ends", "middle" or None (resolved without a thermostat):
+        :func:`placement_of` their phases."""
+        return placement_of(s.phase for s in self.substeps if s.kind == SubstepKind.THERMOSTAT)
+
     @property
     def family(self) -> str | None:
         """The catalogue family (splitting, composition, implicit, reference), None for user methods."""
@@ -286,6 +311,55 @@ def _with_middle_thermostat(substeps: tuple, constrained: bool) -> tuple:
     return (*substeps[:i], first, event, second, *substeps[i + 1:])
 
 
+def _from_closing_kicks(substeps: tuple) -> tuple:
+    """The step of ``substeps`` (a symmetric sequence with the middle event) run from its closing kicks: the kicks it
+    ends with (the mirror of those it begins with, at the same positions) are taken off its end and added to the
+    kicks it begins with, those of the next step.  Both use the forces at the positions the step ends with, so a
+    long run is the same sequence of operations and force evaluations; between steps the Context then holds the
+    positions at the end of the step and the velocities before its closing kicks, half a kick behind them (as
+    OpenMM's LangevinMiddleIntegrator holds them), and a new run's velocities are taken as such.  Where only drifts
+    lie between the event and the closing kicks (velocity Verlet, multiple time stepping whose outer step is one
+    inner step) those are the velocities at the thermostat point; elsewhere they are the leapfrog velocities of the
+    inner Verlet steps (multiple time stepping: canonical for the fast modes too) or of the method.  A step that
+    begins with a drift (position Verlet) is left as it is: its on-step velocities are what it holds.  The kicks'
+    cached-force flags follow :func:`~.splitting.evaluating_kicks` on the new sequence."""
+    n = 0
+    while substeps[n].kind == SubstepKind.KICK:
+        n += 1
+    if n == 0:
+        return substeps
+    opening, closing = substeps[:n], substeps[len(substeps) - n:]
+    if [(s.groups, s.coefficient) for s in opening] != [(s.groups, s.coefficient) for s in reversed(closing)]:
+        raise ValueError("the step does not close with the mirror of its opening kicks")  # symmetric by construction
+    steps = (*(replace(s, coefficient=2 * s.coefficient) for s in opening), *substeps[n:len(substeps) - n])
+    evaluating = evaluating_kicks([s.label for s in steps], others=(THERMOSTAT,))
+    return tuple(replace(s, forces_cached=i not in evaluating) if s.kind == SubstepKind.KICK else s
+                 for i, s in enumerate(steps))
+
+
+def method_steps(steps, position: str | None) -> list:
+    """The method's own kick/drift sequence, as (label, coefficient), from ``steps`` (the (label, coefficient) of the
+    sub-steps as they run, e.g. a plugin's read from XML) with the thermostat at ``position``: the events left out and
+    the halves they split joined again, and for the middle placement the kicks the step begins with split back into
+    its opening and closing kicks (:func:`_from_closing_kicks`)."""
+    out = []
+    for i, (label, c) in enumerate(steps):
+        if label == THERMOSTAT:
+            continue
+        if i > 0 and steps[i - 1][0] == THERMOSTAT and out and out[-1][0] == label:
+            out[-1] = (label, out[-1][1] + c)
+        else:
+            out.append((label, c))
+    if position == "middle":
+        n = 0
+        while n < len(out) and out[n][0] != DRIFT:
+            n += 1
+        if n:
+            halves = [(label, c / 2) for label, c in out[:n]]
+            out = [*halves, *out[n:], *reversed(halves)]
+    return out
+
+
 def _with_end_events(substeps: tuple) -> tuple:
     """``substeps`` with the ends placement's two half events: one before them, in the first step of the thermostat's
     interval, and one after them (after RATTLE's closing velocity projection under constraints), in its last step."""
@@ -324,14 +398,16 @@ def resolve(method, constraints: bool | None = False, groups=None, inner_method=
     ``thermostat_position``: None (no thermostat), "ends", "middle" or "auto" (:func:`thermostat_position_for`).
     With "middle" the sub-steps get one :attr:`SubstepKind.THERMOSTAT` event at the exact centre of the step (of the
     outer step with multiple time stepping), splitting the central drift or kick in two halves, in the centre step of
-    the thermostat's interval; ValueError for a general PRK pair or a sequence that is not symmetric (no one centre).
-    With "ends" they get a half event before the first sub-step (in the first step of the interval) and one after the
-    last (in its last step): :class:`EventPhase`."""
+    the thermostat's interval, and the step runs from its closing kicks (:func:`_from_closing_kicks`: velocity
+    Verlet becomes kick 1, drift 1/2, event, drift 1/2, so that a State holds the velocities at the thermostat
+    point); ValueError for a general PRK pair or a sequence that is not symmetric (no one centre).  With "ends" they
+    get a half event before the first sub-step (in the first step of the interval) and one after the last (in its
+    last step): :class:`EventPhase`.  ``splitting`` and ``tableau`` stay the method's own."""
     if thermostat_position is not None:
         plain = resolve(method, constraints, groups, inner_method, name)
         where = thermostat_position_for(plain, thermostat_position)
         if where == "ends":
-            return replace(plain, substeps=_with_end_events(plain.substeps), thermostat_position="ends")
+            return replace(plain, substeps=_with_end_events(plain.substeps))
         if not plain.is_splitting:
             raise InputError(f"thermostat_position='middle' needs a kick/drift method, whose step has a centre "
                              f"sub-step; {plain.name!r} is a general ({plain.family or plain.form}) PRK tableau: use "
@@ -340,7 +416,7 @@ def resolve(method, constraints: bool | None = False, groups=None, inner_method=
             substeps = _with_middle_thermostat(plain.substeps, plain.constraints)
         except InputError as exc:
             raise InputError(f"{plain.name}: {exc}") from None
-        return replace(plain, substeps=substeps, thermostat_position="middle")
+        return replace(plain, substeps=_from_closing_kicks(substeps))
     entry, splitting, tableau = _normalise(method)
     form = _form(splitting, tableau)
     name = name or (entry.name if entry is not None else None) or (

@@ -93,23 +93,9 @@ class Splitting:
 
     @cached_property
     def evaluating_kicks(self) -> frozenset:
-        """Indices (into ``steps``) of the sub-flows that need a fresh evaluation of their forces in a long run.
-
-        The one rule of the package for cached forces: a sub-flow of a kick label needs an evaluation when the
-        positions changed (a drift) since the previous sub-flow of the same label, counted cyclically: the
-        closing evaluation of a step is reused by the next step's opening one when no drift separates them
-        (first same as last).  Kicks of other labels (force groups of a multiple-time-step sequence) do not
-        move the positions.  Every other kick runs on cached forces."""
-        out = set()
-        n = len(self.steps)
-        for label in dict.fromkeys(lab for lab in self.labels if lab != DRIFT):
-            kicks = [i for i, (lab, _) in enumerate(self.steps) if lab == label]
-            for k, i in enumerate(kicks):
-                previous = kicks[k - 1]  # cyclically: the last one of the previous step for the first
-                between = range(previous + 1, i) if previous < i else list(range(previous + 1, n)) + list(range(i))
-                if len(kicks) == 1 or any(self.steps[j][0] == DRIFT for j in between):
-                    out.add(i)
-        return frozenset(out)
+        """Indices (into ``steps``) of the sub-flows that need a fresh evaluation of their forces in a long run
+        (:func:`evaluating_kicks`)."""
+        return evaluating_kicks(self.labels)
 
     def force_evaluations(self, label: str = KICK) -> int:
         """Evaluations of the ``label`` part per step in a long run (see :attr:`evaluating_kicks`)."""
@@ -123,6 +109,29 @@ class Splitting:
 
     def __str__(self):
         return "\n".join(f"{label:6s} {float(c): .22f}" for label, c in self.steps)
+
+
+def evaluating_kicks(labels: Sequence, others: Sequence = ()) -> frozenset:
+    """Indices (into ``labels``, a step's sequence of sub-flow labels) of the kicks that need a fresh evaluation of
+    their forces in a long run; every label but a drift and ``others`` (entries that move nothing, such as a
+    thermostat event) is a kick.
+
+    The one rule of the package for cached forces: a sub-flow of a kick label needs an evaluation when the
+    positions changed (a drift) since the previous sub-flow of the same label, counted cyclically: the
+    closing evaluation of a step is reused by the next step's opening one when no drift separates them
+    (first same as last).  Kicks of other labels (force groups of a multiple-time-step sequence) do not
+    move the positions, and neither do ``others``.  Every other kick runs on cached forces."""
+    labels = list(labels)
+    out = set()
+    n = len(labels)
+    for label in dict.fromkeys(lab for lab in labels if lab != DRIFT and lab not in others):
+        kicks = [i for i, lab in enumerate(labels) if lab == label]
+        for k, i in enumerate(kicks):
+            previous = kicks[k - 1]  # cyclically: the last one of the previous step for the first
+            between = range(previous + 1, i) if previous < i else list(range(previous + 1, n)) + list(range(i))
+            if len(kicks) == 1 or any(labels[j] == DRIFT for j in between):
+                out.add(i)
+    return frozenset(out)
 
 
 def merge(steps: Iterable) -> list:

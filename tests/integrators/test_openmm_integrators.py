@@ -2,6 +2,8 @@
 
 Tests that are about the program the compiler emits ask for backend="custom"; the native plugin is
 checked against that program, bit for bit, in test_native.py."""
+import warnings
+
 import numpy as np
 import openmm as mm
 import openmm.app as app
@@ -233,26 +235,30 @@ def test_implicit_non_convergence_is_reported(morse):
         ig2.step(5)
 
 
-def test_virtual_sites_are_warned_about_and_do_break_conservation(water8):
-    """OpenMM 8.6's CustomIntegrator moves virtual sites only at the end of a step (a known limit of
-    the CustomIntegrator path): the warning is there because the effect is real and measurable."""
-    from openmm_symprk.systems.checks import ConservationWarning
+def test_virtual_sites_are_refused_by_the_custom_backend_wherever_it_is_chosen(water8, monkeypatch):
+    """OpenMM 8.6's CustomIntegrator places virtual sites only at the end of a step on Reference and CPU, so forces
+    inside the step see them one drift behind and the system heats (tests/integrators/test_reliability.py measures
+    it on a TIP4P-Ew box).  Before, the custom backend ran such a System with a warning; now it refuses it by name
+    wherever it is chosen: backend="custom", PRKIntegrator, a general tableau, and backend="auto"'s fallback."""
+    from openmm_symprk import PRKIntegrator, plugin
+    from openmm_symprk.integrators import VirtualSitesError
 
     mod = app.Modeller(water8.topology, water8.positions * unit.nanometer)
     ff = app.ForceField("tip4pew.xml")
     mod.addExtraParticles(ff)
-    system = ff.createSystem(mod.topology, nonbondedMethod=app.NoCutoff, rigidWater=True, removeCMMotion=False)
-    pos = np.array(mod.positions.value_in_unit(unit.nanometer))
-    masses = np.array([system.getParticleMass(i).value_in_unit(unit.dalton) for i in range(system.getNumParticles())])
-    real = masses > 0
-    vel = np.zeros_like(pos)
-    vel[real] = np.cross([0, 0, 2.0], pos[real] - pos[real].mean(0))
-    with pytest.warns(ConservationWarning, match="virtual sites"):
-        ig = SymplecticIntegrator(1 * unit.femtoseconds, "verlet", system=system, backend="custom")
-    ctx = mm.Context(system, ig, mm.Platform.getPlatformByName("Reference"))
-    ctx.setPositions(pos)
-    ctx.computeVirtualSites()
-    ctx.setVelocities(vel)
-    ctx.applyVelocityConstraints(1e-12)
-    dp, dl = drift_after(ctx, ig, masses, 400)
-    assert dl > 1e-4  # versus ~1e-13 for the same cluster with TIP3P
+    rigid = ff.createSystem(mod.topology, nonbondedMethod=app.NoCutoff, rigidWater=True, removeCMMotion=False)
+    flexible = ff.createSystem(mod.topology, nonbondedMethod=app.NoCutoff, rigidWater=False, removeCMMotion=False)
+    named = r"System has 8 virtual site\(s\) \(e.g. particle 3\).*one drift behind"
+    with pytest.raises(VirtualSitesError, match=named + r".*backend='native'"):
+        SymplecticIntegrator(1 * unit.femtoseconds, "verlet", system=rigid, backend="custom")
+    with pytest.raises(VirtualSitesError, match=r"PRKIntegrator: the " + named):
+        PRKIntegrator(0.001, "yoshida-4", system=rigid)
+    with pytest.raises(VirtualSitesError, match="general PRK tableaux.*cannot run such a System"):
+        SymplecticIntegrator(0.001, "gauss-2", system=flexible)  # only the custom backend runs it: refused
+    monkeypatch.setattr(plugin, "available", lambda: False)
+    monkeypatch.setattr(plugin, "unavailable_reason", lambda: "the plugin was not built (a test)")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        with pytest.raises(VirtualSitesError, match=r"native backend.*is unavailable here \(the plugin was not "
+                                                    r"built \(a test\)\); to fix it"):
+            SymplecticIntegrator(0.001, "verlet", system=rigid)  # "auto" falls back to the custom backend

@@ -1,5 +1,5 @@
 """Reliability of both backends: what an integrator was compiled for, checkpoints across variants, recovery
-after a blow-up, copies, time after setStepSize, virtual sites on OpenCL, and the blow-up threshold.
+after a blow-up, copies, time after setStepSize, virtual sites (a TIP4P-Ew box), and the blow-up threshold.
 
 Each test fails on the behaviour reported before these checks existed (wrong results without a word, or a
 false alarm)."""
@@ -13,7 +13,7 @@ import openmm.unit as unit
 import pytest
 
 from conftest import platform_available
-from helpers import COMMON, stiff_diatomic, tip4p_waters, virtual_site_error
+from helpers import COMMON, stiff_diatomic
 from openmm_symprk import (CheckpointMismatchError, SimulationBlowUpError, SymplecticIntegrator, SystemMismatchError,
                            deserialize, plugin, restore)
 from openmm_symprk.integrators import CustomSymplecticIntegrator, NativeSymplecticIntegrator
@@ -120,52 +120,98 @@ def test_checkpoints_across_backends_and_methods_are_refused(water8):
         ctx.loadCheckpoint(native)
 
 
-# -- 4. virtual sites on OpenCL without constraints ---------------------------------------------------------------------
-def _flexible_tip4p():
+# -- 4. virtual sites: conserved where they run, refused where they would heat --------------------------------------------
+def _tip4pew_box():
+    """215 rigid TIP4P-Ew waters with PME (1.9 nm box, 0.8 nm cutoff, no CMMotionRemover), minimised on CPU, with
+    Maxwell-Boltzmann velocities at 300 K."""
+    import openmm.app as app
+
     from openmm_symprk.systems.prepare import maxwell_boltzmann, minimise
 
-    system, positions = tip4p_waters(4, rigid=False)
-    pos = minimise(system, positions, tolerance=1.0)
-    return system, pos, maxwell_boltzmann(system, pos, 100.0, 1)
+    ff = app.ForceField("tip4pew.xml")
+    mod = app.Modeller(app.Topology(), [])
+    mod.addSolvent(ff, model="tip4pew", boxSize=mm.Vec3(1.9, 1.9, 1.9) * unit.nanometer)
+    system = ff.createSystem(mod.topology, nonbondedMethod=app.PME, nonbondedCutoff=0.8 * unit.nanometer,
+                             constraints=app.HBonds, rigidWater=True, removeCMMotion=False)
+    pos = minimise(system, mod.positions, platform="CPU", tolerance=10.0)
+    return system, pos, maxwell_boltzmann(system, pos, 300.0, 1)
 
 
-@needs_opencl
-def test_custom_places_virtual_sites_on_opencl_without_constraints():
-    system, pos, vel = _flexible_tip4p()
-    assert system.getNumConstraints() == 0
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        ig = SymplecticIntegrator(0.5 * unit.femtoseconds, "verlet", system=system, backend="custom")
-    ctx = mm.Context(system, ig, mm.Platform.getPlatformByName(COMMON), {"Precision": "double"})
+def _energy_excursion(system, pos, vel, ig, steps=400, every=40) -> float:
+    """Largest |E(t) - E(0)| (kJ/mol) over ``steps`` NVE steps on CPU."""
+    ctx = mm.Context(system, ig, mm.Platform.getPlatformByName("CPU"))
     ctx.setPositions(pos)
     ctx.setVelocities(vel)
-    ig.step(200)
-    assert virtual_site_error(system, _positions(ctx)) < 1e-9
+    energies = []
+    for _ in range(steps // every + 1):
+        st = ctx.getState(getEnergy=True)
+        energies.append((st.getPotentialEnergy() + st.getKineticEnergy()).value_in_unit(unit.kilojoule_per_mole))
+        ig.step(every)
+    return float(np.max(np.abs(np.array(energies) - energies[0])))
+
+
+@pytest.mark.filterwarnings("ignore::openmm_symprk.systems.checks.ConservationWarning")
+def test_tip4pew_box_conserves_energy_or_is_refused():
+    """A TIP4P-Ew box in NVE at 2 fs (0.8 ps): every backend that accepts it conserves the energy as OpenMM's
+    VerletIntegrator does.  The CustomIntegrator backend used to run it with a warning and heated: +238 kJ/mol in
+    1 ps (T 300 -> 322 K) where Verlet and the native backend stay within 8, because OpenMM's CustomIntegrator places
+    the M sites only at the end of a step on CPU; it now refuses the System by name."""
+    system, pos, vel = _tip4pew_box()
+    verlet = _energy_excursion(system, pos, vel, mm.VerletIntegrator(0.002))
+    refused = []
+    for backend in ("custom", "native"):
+        if backend == "native" and not plugin.available():
+            continue
+        try:
+            ig = SymplecticIntegrator(0.002, "verlet", system=system, backend=backend)
+        except ValueError as exc:  # VirtualSitesError
+            assert "virtual site" in str(exc)
+            refused.append(backend)
+            continue
+        excursion = _energy_excursion(system, pos, vel, ig)
+        assert excursion < 2 * verlet + 5.0, (backend, excursion, verlet)
+    assert refused == ["custom"]
 
 
 # -- 5. time after setStepSize --------------------------------------------------------------------------------------------
 @pytest.mark.parametrize("platform", ["Reference", "CPU", COMMON])
 @pytest.mark.parametrize("backend", BACKENDS)
 def test_time_follows_setstepsize_mid_run(backend, platform, water8):
-    """OpenMM's CustomIntegrator on Reference/CPU advances the Context's time by the step size the Context was
-    created with; both backends report the time the steps took, on every platform."""
+    """The native backend reports the time the steps took, on every platform, without a word.  OpenMM's
+    CustomIntegrator on Reference/CPU advances the Context's time by the step size the Context was created with, and
+    the CustomIntegrator backend cannot reach its Context to set it (it used to find it by scanning the Python heap):
+    setStepSize on a bound one warns once (TimeWarning), naming context.reinitialize(preserveState=True), after which
+    the time follows the step size on every platform."""
+    from openmm_symprk.integrators import TimeWarning
+
     if not platform_available(platform) or (backend == "native" and platform not in plugin.platforms()):
         pytest.skip(f"no {platform} platform (or no native kernel for it)")
     ig = SymplecticIntegrator(0.002, "verlet", system=water8.system, backend=backend)
     ctx = water8.context(ig, platform, {"Precision": "double"} if platform == COMMON else None)
     ig.step(1)
+    if backend == "custom":
+        with pytest.warns(TimeWarning, match=r"from 0.002 to 0.001 ps.*reinitialize\(preserveState=True\)"):
+            ig.setStepSize(0.001)
+        ctx.reinitialize(preserveState=True)
+
+    def change(step):
+        ig.setStepSize(step)
+        if backend == "custom":
+            ctx.reinitialize(preserveState=True)
+
     with warnings.catch_warnings():
-        warnings.simplefilter("error")  # no warning: the time is kept right, not explained
-        ig.setStepSize(0.001)
+        warnings.simplefilter("error")  # once: no more warnings
+        if backend == "native":
+            change(0.001)
         ig.step(10)
         assert ctx.getState().getTime().value_in_unit(unit.picosecond) == pytest.approx(0.012, rel=1e-12)
-        ig.setStepSize(0.0005 * unit.picoseconds)
+        change(0.0005 * unit.picoseconds)
         ig.step(4)
         assert ctx.getState().getTime().value_in_unit(unit.picosecond) == pytest.approx(0.014, rel=1e-12)
         ctx.setTime(1.0)  # the user's own time is kept too
         ig.step(2)
         assert ctx.getState().getTime().value_in_unit(unit.picosecond) == pytest.approx(1.001, rel=1e-12)
-        ig.setStepSize(0.002)  # back to the step the Context was created with
+        change(0.002)  # back to the step the Context was created with
         ig.step(3)
         assert ctx.getState().getTime().value_in_unit(unit.picosecond) == pytest.approx(1.007, rel=1e-12)
 

@@ -109,9 +109,53 @@ def test_options_are_built_once_and_frozen(water8):
     opts = ig.options
     assert isinstance(opts, IntegratorOptions) and ig.program_info.method is ig.resolved
     assert (opts.step_size, opts.max_speed, opts.groups, opts.system.n_particles) == (0.002, 40.0, ((0, 1),), 24)
-    assert opts.thermostat == ig.thermostat and opts.thermostat.temperature == 300.0
     assert (opts.check_finite, opts.exact_momentum, opts.constraints, opts.tolerance) == (True, False, None, 1e-12)
     with pytest.raises(AttributeError):
         opts.max_speed = 1.0
-    assert IntegratorOptions.build("X", 0.002, water8.system, max_speed=40.0, groups=[(0, 1)],
-                                   temperature=300) == opts
+    assert IntegratorOptions.build("X", 0.002, water8.system, max_speed=40.0, groups=[(0, 1)]) == opts
+    # the thermostat's settings live in one holder, which setTemperature replaces: no construction-time copy
+    assert not hasattr(opts, "thermostat") and ig.thermostat.temperature == 300.0
+    ig.setTemperature(310)
+    assert ig.thermostat.temperature == 310.0 and deserialize(mm.XmlSerializer.serialize(ig)).thermostat == ig.thermostat
+
+
+_RESTORE_AND_DROP = """
+import gc, sys
+import openmm as mm, openmm.app as app
+from openmm_symprk import SymplecticIntegrator, restore
+from openmm_symprk.systems.scenes import water_cluster
+scene = water_cluster(8)
+ig = SymplecticIntegrator(0.002, "verlet", system=scene.system, backend=sys.argv[1])
+original = mm.XmlSerializer.deserialize(mm.XmlSerializer.serialize(ig))
+kept = restore(mm.XmlSerializer.deserialize(mm.XmlSerializer.serialize(ig)))
+restore(original)  # the result dropped: `original` must stay a valid integrator
+del ig
+gc.collect()
+sim = app.Simulation(scene.topology, scene.system, original, mm.Platform.getPlatformByName("Reference"))
+sim.context.setPositions(scene.positions)
+sim.step(5)
+other = mm.XmlSerializer.deserialize(mm.XmlSerializer.serialize(kept))
+wrapper = restore(other)
+del other  # and the other way round: the wrapper keeps the integrator it wraps alive
+gc.collect()
+ctx = mm.Context(scene.system, wrapper, mm.Platform.getPlatformByName("Reference"))
+ctx.setPositions(scene.positions)
+wrapper.step(5)
+print("stepped", sim.currentStep, wrapper.steps_taken)
+"""
+
+
+@pytest.mark.parametrize("backend", ["custom", pytest.param("native", marks=pytest.mark.skipif(
+    not __import__("openmm_symprk").plugin.available(), reason="native plugin unavailable"))])
+def test_restore_leaves_the_integrator_it_wraps_valid(backend):
+    """restore(x) whose result is dropped, then x used in a Simulation (README's restore(XmlSerializer.deserialize(
+    xml)) idiom, or restore(x) taken to change x in place): before the fix the result took over x's C++ object and
+    deleted it, and the native backend's next use of x killed the interpreter (exit 139).  Run in a subprocess, so
+    that a crash fails the test instead of ending the session."""
+    import subprocess
+    import sys
+
+    done = subprocess.run([sys.executable, "-W", "ignore", "-c", _RESTORE_AND_DROP, backend], capture_output=True,
+                          text=True, timeout=300)
+    assert done.returncode == 0, (done.returncode, done.stderr[-2000:])
+    assert done.stdout.split() == ["stepped", "5", "5"]

@@ -188,7 +188,7 @@ def test_custom_event_computes_rescaling_factor_exactly(cluster):
     mask = np.array(ig.getPerDofVariableByName(tp.MASK_VAR))
     assert mask.sum() == settings.dof - 1 and set(np.unique(mask)) == {0.0, 1.0}
     # a Context reinitialized without its state loses per-DOF values set while bound: the integrator notices (the
-    # Context's step count went back) and fills the mask again before stepping
+    # mask is missing: a new run) and fills the mask again before stepping
     ctx.reinitialize(preserveState=False)
     ctx.setPositions(cluster.positions)
     ctx.setVelocities(cluster.velocities)
@@ -197,17 +197,13 @@ def test_custom_event_computes_rescaling_factor_exactly(cluster):
     ig.step(1)
     assert ig.computeHeatBathEnergy() != heat
     assert np.sum(ig.getPerDofVariableByName(tp.MASK_VAR)) == settings.dof - 1
-    # where it cannot notice (its Context not found), the events find the mask incomplete, do nothing, and the
-    # integrator fills it again after the call, with a warning
-    ctx.reinitialize(preserveState=False)
-    ctx.setPositions(cluster.positions)
-    ctx.setVelocities(cluster.velocities)
-    ig._step_count = None  # as if the Context could not be found
+    # and the program guards itself: steps run on a mask without its dof - 1 ones (OpenMM's own step, past the
+    # integrator's checks) change nothing through the events and raise the flag
     heat = ig.computeHeatBathEnergy()
-    with pytest.warns(RuntimeWarning, match="mask was lost"):
-        ig.step(2)
-    assert ig.computeHeatBathEnergy() == heat
-    assert np.sum(ig.getPerDofVariableByName(tp.MASK_VAR)) == settings.dof - 1
+    ig.setPerDofVariableByName(tp.MASK_VAR, [mm.Vec3(0, 0, 0)] * cluster.system.getNumParticles())
+    mm.CustomIntegrator.step(ig, 2)
+    assert ig.getGlobalVariableByName(tp.LOST_MASK_VAR) == 1.0 and ig.getGlobalVariableByName(tp.HEAT_BATH_VAR) == \
+        heat.value_in_unit(unit.kilojoule_per_mole)
 
 
 # -- thermostat off: the NVE program, bit for bit ------------------------------------------------------------------
@@ -436,22 +432,26 @@ def test_water_box_temperature_and_kinetic_energy_are_canonical(backend, equilib
 @pytest.mark.parametrize("backend", BACKENDS)
 def test_state_data_reporter_prints_the_thermostats_temperature(backend, equilibrated_box):
     """OpenMM's StateDataReporter prints computeSystemTemperature() where the integrator has it.  The PME box at 4 fs
-    with the thermostat in the middle: the on-step velocities read several kelvin low (a stiff mode of frequency w
-    reads T (1 - h^2 w^2/4) on-step), the printed column is the thermostat's temperature, 300 K within 3 standard
-    errors (blocks of 1 ps).  Before issue 33 it was the on-step one, with StateDataReporter's own count of degrees of
-    freedom."""
+    with the thermostat in the middle: the printed column is the thermostat's temperature, 300 K within 3 standard
+    errors (blocks of 1 ps), and the reporter's kinetic-energy column and the recorded velocities read the same
+    temperature (paired, within 0.5 K): the State holds the thermostat point's velocities, changed only by the RATTLE
+    correction of the half drift after the event (measured: 0.16 K low, 0.05 %).  Before, it held the on-step ones,
+    half a kick later, which read more than 2 K low (a stiff mode of frequency w reads T (1 - h^2 w^2/4) there)."""
     system, x = equilibrated_box
     ig, rec, sdr, _, _ = _water_box_run(backend, system, x, 2000, platform=REF, equilibration=250, collision_time=0.05,
                                         step_ps=0.004, position="middle")
     assert ig.thermostat_position == "middle"
     m, dof = masses(system), ig.thermostat_dof
-    on_step = np.array([2 * peculiar_kinetic(xs, vs, m, False) / (dof * R_KJ) for xs, vs in zip(rec.x, rec.v)])
-    printed = np.array([float(line.split(",")[1]) for line in sdr.splitlines()[1:]])
-    assert len(printed) == len(on_step) == 200
+    recorded = np.array([2 * peculiar_kinetic(xs, vs, m, False) / (dof * R_KJ) for xs, vs in zip(rec.x, rec.v)])
+    rows = [line.split(",") for line in sdr.splitlines()[1:]]
+    printed = np.array([float(r[1]) for r in rows])
+    kinetic = np.array([2 * float(r[0]) / (dof * R_KJ) for r in rows])  # the State's kinetic energy (P = 0)
+    assert len(printed) == len(recorded) == 200
     t = block_stats(printed, 8)
     assert abs(t.mean - 300.0) < 3 * t.se and t.se < 4.0, t
-    low = block_stats(on_step - printed, 8)  # paired: the thermostat's noise cancels
-    assert low.mean < -3 * low.se and low.mean < -2.0, low
+    for other in (recorded, kinetic):
+        d = block_stats(other - printed, 8)  # paired: the thermostat's noise cancels
+        assert abs(d.mean) < 0.5 and d.se < 0.1, d
 
 
 @pytest.mark.parametrize("backend", BACKENDS)

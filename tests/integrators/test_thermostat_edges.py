@@ -2,6 +2,7 @@
 Context, copies of a used integrator, clusters far from the origin, systems without peculiar kinetic energy, linear
 molecules, checkpoints with another temperature.  Each test failed before its fix."""
 import copy
+from dataclasses import replace
 import pickle
 import warnings
 
@@ -275,6 +276,46 @@ def test_reinitialized_context_reports_a_new_run_at_once(backend, cluster):
 
 
 @pytest.mark.parametrize("backend", BACKENDS)
+def test_state_and_checkpoint_right_after_reinitialize_hold_a_new_run(backend, cluster):
+    """A checkpoint or a State (with integrator parameters) taken right after Context.reinitialize(), before any step,
+    is a new run wherever it is loaded: heat-bath energy 0 and (a checkpoint) step count 0, on both backends.  Before,
+    the custom backend's carried the old run's (its global variables outlive the reinitialize: heat bath -40 kJ/mol,
+    100 steps), since it noticed the new run only through its Context, at its next step."""
+    def make():
+        return SymplecticIntegrator(0.002, "verlet", system=cluster.system, backend=backend, temperature=300,
+                                    random_seed=3)
+
+    kj = unit.kilojoule_per_mole
+    ig = make()
+    ctx = context(cluster.system, ig, cluster.positions, cluster.velocities)
+    ig.step(100)
+    assert ig.computeHeatBathEnergy() != 0 * kj
+    ctx.reinitialize()
+    ctx.setPositions(cluster.positions)
+    ctx.setVelocities(cluster.velocities)
+    chk = ctx.createCheckpoint()
+    state = ctx.getState(getPositions=True, getVelocities=True, integratorParameters=True)
+    other = make()
+    octx = context(cluster.system, other, cluster.positions, cluster.velocities)
+    octx.loadCheckpoint(chk)  # into a new Context, before its first step
+    assert (other.computeHeatBathEnergy(), other.steps_taken) == (0 * kj, 0)
+    other.step(30)
+    octx.loadCheckpoint(chk)  # into a running one
+    assert (other.computeHeatBathEnergy(), other.steps_taken) == (0 * kj, 0)
+    other.step(30)
+    assert other.computeHeatBathEnergy() != 0 * kj
+    octx.setState(state)
+    assert other.computeHeatBathEnergy() == 0 * kj
+    third = make()
+    tctx = context(cluster.system, third, cluster.positions, cluster.velocities)
+    tctx.setState(state)
+    assert (third.computeHeatBathEnergy(), third.steps_taken) == (0 * kj, 0)
+    # and the run loaded goes on as a new run: the thermostat acts from its first step
+    other.step(1)
+    assert other.computeHeatBathEnergy() != 0 * kj
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
 def test_loaded_checkpoint_reports_its_run_and_the_integrators_temperature(backend, cluster):
     """After loadCheckpoint, before any step: the checkpoint's heat-bath energy, kinetic energy at the thermostat and
     step count, and the temperature the next step will use (the integrator's).  Before issue 36 the custom backend
@@ -320,4 +361,102 @@ def test_a_pickle_of_0_2_keeps_its_thermostat(backend, cluster):
     if backend == "custom":
         old["thermostat"] = settings
     back = func(cls, xml, old)
-    assert back.thermostat == settings and back.getTemperature() == 320 * unit.kelvin
+    # (the native plugin holds the placement as its events run: "auto" was resolved to verlet's middle)
+    asked = settings if backend == "custom" else replace(settings, position="middle")
+    assert back.thermostat == asked and back.getTemperature() == 320 * unit.kelvin
+    assert back.thermostat_position == ig.thermostat_position == "middle"
+
+
+# -- what computeSystemTemperature reads ----------------------------------------------------------------------------------
+def _state_temperature(ctx, ig) -> float:
+    """2 K_pec / (N_f R) of the Context's velocities (the kept rigid motion taken out), in K."""
+    from openmm_symprk.physics.temperature import R_KJ
+    from openmm_symprk.physics.velocity_rescaling import kept_velocities
+    from openmm_symprk.systems.properties import masses
+
+    st = ctx.getState(getPositions=True, getVelocities=True)
+    x = st.getPositions(asNumpy=True).value_in_unit(unit.nanometer)
+    v = st.getVelocities(asNumpy=True).value_in_unit(unit.nanometer / unit.picosecond)
+    m = masses(ctx.getSystem())
+    u = kept_velocities(x, v, m, ig.thermostat.keep_rotation)
+    return float(np.sum(m[:, None] * (v - u) ** 2)) / (ig.thermostat_dof * R_KJ)
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_system_temperature_is_the_thermostats_and_nve_has_none(backend, cluster):
+    """computeSystemTemperature() is the thermostat's: 2 K'/(N_f R) of its last event, which with the default placement
+    (verlet: the middle, the State holding the thermostat point's velocities) is the State's peculiar temperature up
+    to the constraint correction of the half drift after the event (rigid waters: 0.3 %).  It is NaN before the first
+    event; after setVelocitiesToTemperature it reads the last event's until the next step (the integrator cannot
+    reach its Context: that took a scan of the Python heap before), then the new velocities'.  An NVE integrator has
+    none (hasattr False), so OpenMM's StateDataReporter computes the temperature from the State, as for
+    VerletIntegrator; before, it had one that needed the heap scan to find its Context."""
+    import io
+    import math
+
+    import openmm.app as app
+
+    nve = SymplecticIntegrator(0.002, "verlet", system=cluster.system, backend=backend)
+    assert not hasattr(nve, "computeSystemTemperature")
+    with pytest.raises(AttributeError, match="runs NVE.*StateDataReporter does so itself"):
+        nve.computeSystemTemperature()
+    sim = app.Simulation(cluster.topology, cluster.system, nve, mm.Platform.getPlatformByName(REF))
+    sim.context.setPositions(cluster.positions)
+    sim.context.setVelocities(cluster.velocities)
+    out = io.StringIO()
+    sim.reporters.append(app.StateDataReporter(out, 5, temperature=True))
+    sim.step(10)
+    assert all(float(line.split(",")[0]) > 0 for line in out.getvalue().splitlines()[1:])
+
+    ig = SymplecticIntegrator(0.002, "verlet", system=cluster.system, backend=backend, temperature=300, random_seed=4)
+    assert ig.thermostat_position == "middle"
+    ctx = context(cluster.system, ig, cluster.positions, cluster.velocities)
+    assert math.isnan(ig.computeSystemTemperature().value_in_unit(unit.kelvin))
+    ig.step(20)
+    before = ig.computeSystemTemperature().value_in_unit(unit.kelvin)
+    assert before == pytest.approx(_state_temperature(ctx, ig), rel=3e-3)
+    ctx.setVelocitiesToTemperature(600 * unit.kelvin, 5)
+    assert ig.computeSystemTemperature().value_in_unit(unit.kelvin) == before  # the last event's, as documented
+    ig.step(1)
+    after = ig.computeSystemTemperature().value_in_unit(unit.kelvin)
+    assert after > before + 50 and after == pytest.approx(_state_temperature(ctx, ig), rel=3e-3)
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_no_heap_scan_with_simulation_checkpoints_and_copies(backend, cluster, monkeypatch):
+    """The integrators never look for their Context in the Python heap (the custom backend did, with gc.get_objects, to
+    notice a reinitialized Context and to compute temperatures): with the heap scan made to fail, an NVT run in an
+    app.Simulation, its reinitialize, checkpoint and State, and its pickle, deepcopy and XML copies all run and report
+    as before."""
+    import gc
+
+    import openmm.app as app
+
+    def no_scan(*args, **kwargs):
+        raise AssertionError("the Python heap was scanned")
+
+    monkeypatch.setattr(gc, "get_objects", no_scan)
+    kj = unit.kilojoule_per_mole
+    ig = SymplecticIntegrator(0.002, "verlet", system=cluster.system, backend=backend, temperature=300, random_seed=5,
+                              exact_momentum=True)
+    sim = app.Simulation(cluster.topology, cluster.system, ig, mm.Platform.getPlatformByName(REF))
+    sim.context.setPositions(cluster.positions)
+    sim.context.setVelocities(cluster.velocities)
+    sim.step(10)
+    assert ig.steps_taken == 10 and ig.computeHeatBathEnergy() != 0 * kj
+    assert ig.computeSystemTemperature().value_in_unit(unit.kelvin) > 0
+    chk = sim.context.createCheckpoint()
+    sim.step(5)
+    sim.context.loadCheckpoint(chk)
+    assert ig.steps_taken == 10
+    sim.context.reinitialize()
+    assert (ig.computeHeatBathEnergy(), ig.steps_taken) == (0 * kj, 0)
+    sim.context.setPositions(cluster.positions)
+    sim.context.setVelocities(cluster.velocities)
+    sim.step(3)
+    assert ig.steps_taken == 3 and ig.computeHeatBathEnergy() != 0 * kj
+    for copied in (pickle.loads(pickle.dumps(ig)), copy.deepcopy(ig), deserialize(mm.XmlSerializer.serialize(ig))):
+        ctx = context(cluster.system, copied, cluster.positions, cluster.velocities)
+        copied.step(4)
+        assert copied.steps_taken == 4 and copied.computeHeatBathEnergy() != 0 * kj
+        del ctx

@@ -2,7 +2,8 @@
 Reference, CPU (the Reference kernel on the CPU platform's data) and OpenCL (the Common kernel, PoCL here).
 
 * N independent harmonic oscillators: w^2<q^2>/kT = 1/(1 - h^2 w^2/4) with the thermostat at the
-  ends and 1 in the middle, on-step <v^2>/kT = 1 (ends) and 1 - h^2 w^2/4 (middle), the kinetic energy at the
+  ends and 1 in the middle, the State's <v^2>/kT = 1 with both (the middle placement's State holds the thermostat
+  point's velocities; its on-step ones would read 1 - h^2 w^2/4), the kinetic energy at the
   thermostat point (thermostat_kinetic_energy) at the target, within 3 standard errors, at h w = 0.5 and 1, on CPU and
   OpenCL (Reference: test_thermostat_placement.py);
 * on OpenCL a step makes no host transfer, with either placement (getHostTransfers counts the plugin's own);
@@ -87,7 +88,7 @@ def test_oscillators_sample_the_known_answer(platform, h_omega, position):
         event.append(2 * ig.thermostat_kinetic_energy().value_in_unit(unit.kilojoule_per_mole) / dof_kT)
     (q, q_se), (vv, v_se), (ev, ev_se) = _blocks(q2), _blocks(v2), _blocks(event)
     shrink = 1 - h_omega ** 2 / 4
-    q_exact, v_exact = (1 / shrink, 1.0) if position == "ends" else (1.0, shrink)
+    q_exact, v_exact = (1 / shrink, 1.0) if position == "ends" else (1.0, 1.0)
     assert abs(q - q_exact) < 3 * q_se, (q, q_se, q_exact)
     assert abs(vv - v_exact) < 3 * v_se, (vv, v_se, v_exact)
     assert abs(ev - 1.0) < 3 * ev_se, (ev, ev_se)  # the temperature at the thermostat point is the target
@@ -185,8 +186,10 @@ def test_angular_momentum_is_kept_far_from_the_origin(offset, position, water8):
     nve = _angular_drift(water8, offset)
     nvt = _angular_drift(water8, offset, temperature=300, collision_time=0.02, random_seed=5,
                          thermostat_position=position)
-    # both are round-off random walks (positions 1e5 nm out keep ~11 digits of the 0.3 nm cluster): within 20x
-    assert nvt <= 20 * max(nve, 1e-12), (nve, nvt)
+    # both are round-off random walks (positions 1e5 nm out keep ~11 digits of the 0.3 nm cluster), the thermostat's
+    # the longer one: at 1e5 nm, seeds 5-7, NVE 8.7e-9, ends 2-7e-8, middle 0.9-2.5e-7 (before the middle placement ran
+    # from its closing kick as after), against 1.7e-4 for the bug: within 100x
+    assert nvt <= 100 * max(nve, 1e-12), (nve, nvt)
 
 
 # -- nothing to scale (issue 27 #6) ---------------------------------------------------------------------------------------

@@ -192,8 +192,17 @@ class Row:
 
     @property
     def leapfrog(self) -> bool:
-        """Whether the State velocities lag half a step behind the positions (OpenMM's leapfrog integrators)."""
-        return self.who in LEAPFROG
+        """Whether the State velocities lag half a step behind the positions, by half a kick of all forces: OpenMM's
+        leapfrog integrators, and this package's velocity Verlet with the thermostat in the middle, whose step runs from
+        its closing kick (kick 1, drift 1/2, event, drift 1/2), as LangevinMiddleIntegrator's does."""
+        if self.who in LEAPFROG:
+            return True
+        if self.thermostat != "svr" or self.is_rigid or self.mts:
+            return False
+        from ...methods.resolved import SubstepKind, resolve
+
+        first = resolve(self.method, thermostat_position=self.position).substeps[0]
+        return first.kind == SubstepKind.KICK and first.groups is None and first.coefficient == 1
 
     @property
     def has_heat_bath(self) -> bool:
