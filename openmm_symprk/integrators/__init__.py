@@ -12,7 +12,7 @@ Both backends take the options checked once (:class:`.options.IntegratorOptions`
 and the method resolved once for the System (:func:`.backend.resolve_for_system`, kept as ``integrator.resolved``);
 ``integrator.program_info`` holds the facts of the compiled program.
 """
-from .backend import BackendWarning, NativeMethodError, NativeUnavailableError, choose_backend
+from .backend import BackendWarning, NativeMethodError, NativeUnavailableError, PlacementWarning, choose_backend
 from .base import (CheckpointMismatchError, ConvergenceWarning, IntegratorBase, SimulationBlowUpError,
                    SystemMismatchError, step_size_in_ps)
 from .custom_backend import CustomSymplecticIntegrator, PRKIntegrator, TimeWarning, VirtualSitesError
@@ -25,5 +25,6 @@ from .symplectic import SymplecticIntegrator
 __all__ = ["SymplecticIntegrator", "PRKIntegrator", "CustomSymplecticIntegrator", "NativeSymplecticIntegrator",
            "IntegratorBase", "choose_backend", "native_available", "restore", "deserialize", "SimulationBlowUpError",
            "ConvergenceWarning", "SystemMismatchError", "CheckpointMismatchError", "ConstraintSupportError",
-           "BackendWarning", "NativeMethodError", "NativeUnavailableError", "TimeWarning", "step_size_in_ps",
+           "BackendWarning", "NativeMethodError", "NativeUnavailableError", "PlacementWarning", "TimeWarning",
+           "step_size_in_ps",
            "IntegratorOptions", "VirtualSitesError"]

@@ -10,11 +10,14 @@ The options are checked once, into one :class:`~.options.IntegratorOptions`; eac
 :func:`resolve_for_system`, which resolves the method (:func:`openmm_symprk.methods.resolved.resolve`) with the
 System's constraint facts and checks the System against it (warning about what breaks the conservation the run asked
 for: an NVT run's periodic box and CMMotionRemover are not warned about), and warns once where the step is beyond what
-the method was measured to run on a System of its kind (:mod:`openmm_symprk.systems.step_limits`).
+the method was measured to run on a System of its kind (:mod:`openmm_symprk.systems.step_limits`), and where
+``thermostat_position="middle"`` was asked for a method whose middle samples worse than its ends
+(:func:`openmm_symprk.methods.placement.middle_placement_advice`).
 """
 from __future__ import annotations
 
 from .. import plugin
+from ..methods.placement import middle_placement_advice
 from ..methods.resolved import ConstraintSupportError, ResolvedMethod, resolve
 from ..systems.checks import validate_system, warn_once
 from ..systems.forcegroups import check_groups
@@ -22,7 +25,7 @@ from ..systems.step_limits import warn_step_limit
 from .options import NATIVE_OPTIONS, OPTIONS, IntegratorOptions, check_option_names
 from ..support.errors import InputError
 
-__all__ = ["BACKENDS", "choose_backend", "resolve_for_system", "BackendWarning", "NativeMethodError",
+__all__ = ["BACKENDS", "choose_backend", "resolve_for_system", "BackendWarning", "PlacementWarning", "NativeMethodError",
            "NativeUnavailableError"]
 
 BACKENDS = ("auto", "native", "custom")
@@ -31,6 +34,11 @@ NativeUnavailableError = plugin.NativeUnavailableError
 
 class BackendWarning(UserWarning):
     """backend="auto" could not use the native plugin (the message says why and how to fix it)."""
+
+
+class PlacementWarning(UserWarning):
+    """``thermostat_position="middle"`` asked for a method whose configurations it samples further from canonical
+    than the ends (every method but Verlet; the message says where the middle falls and what it costs)."""
 
 
 class NativeMethodError(InputError):
@@ -64,9 +72,13 @@ def resolve_for_system(where: str, method, system, options: IntegratorOptions, n
         raise NativeMethodError(
             f"method {resolved.name!r} is a general ({resolved.family or resolved.form}) PRK tableau; "
             f"{splittings_only}")
+    if thermostat is not None and thermostat.position == "middle" and resolved.is_splitting and not resolved.is_mts:
+        advice = middle_placement_advice(resolved.name, resolved.splitting.steps, resolved.stability)
+        if advice is not None:
+            warn_once(f"placement-middle-{resolved.name}", f"{where}({resolved.name}): {advice}", PlacementWarning)
     if system is not None:
         validate_system(system, f"{where}({resolved.name})", options.exact_momentum, skip=skip_checks,
-                        thermostat=options.thermostat is not None)
+                        thermostat=thermostat is not None)
         if resolved.entry is not None and not resolved.is_mts:
             warn_step_limit(system, resolved.entry.name, options.step_size * 1000.0, f"{where}({resolved.name})")
         if resolved.groups is not None:

@@ -37,6 +37,7 @@ from __future__ import annotations
 import math
 import operator
 import warnings
+import weakref
 
 import openmm as mm
 import openmm.unit as unit
@@ -94,7 +95,7 @@ class IntegratorBase:
     program_info = None  # the ProgramInfo of its compiled program (.program)
     _thermostat = None  # the one holder of the thermostat's settings (ThermostatSettings; None: NVE)
     #: attributes a copy does not carry (the C++ object, per-Context handles)
-    _transient: tuple = ("this", "thisown", "_wrapped")
+    _transient: tuple = ("this", "thisown", "_wrapped", "_system_ref")
 
     # -- what it runs -----------------------------------------------------------------------------------
     @property
@@ -162,10 +163,21 @@ class IntegratorBase:
             return f"velocities became NaN, infinite or faster than {self.options.max_speed:g} nm/ps"
         return "velocities became NaN or infinite"
 
+    def _remember_system(self, system):
+        """Keep a weak reference to the System given as ``system=``: what a message names of it (the hydrogens a
+        blow-up leaves unconstrained) is read only when needed, and no copy of the System is kept (nor carried into
+        copies of the integrator)."""
+        self._system_ref = weakref.ref(system) if system is not None else None
+
+    def _given_system(self):
+        """The System given as ``system=``, while the caller keeps it (None otherwise, and in a copy)."""
+        ref = self.__dict__.get("_system_ref")
+        return ref() if ref is not None else None
+
     def _blow_up(self, step: int, what: str) -> SimulationBlowUpError:
-        context = self._bound_context()
+        system = self._given_system()
         step_fs = self.getStepSize().value_in_unit(unit.femtoseconds)
-        hint = unconstrained_hydrogen_hint(context.getSystem(), step_fs) if context is not None else ""
+        hint = unconstrained_hydrogen_hint(system, step_fs) if system is not None else ""
         return SimulationBlowUpError(
             f"the simulation blew up at integrator step {step} with method {self.method_name!r} at step size "
             f"{self.getStepSize()} ({self.backend} backend): {what}.{hint} Reduce the step size (largest stable "

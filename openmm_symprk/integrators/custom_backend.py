@@ -122,6 +122,7 @@ class PRKIntegrator(IntegratorBase, mm.CustomIntegrator):
             type(self).__name__, stepSize, system, exact_momentum=exact_momentum, check_finite=check_finite,
             max_speed=max_speed, groups=groups, inner_method=inner_method, constraints=constraints,
             allow_nonsymplectic=allow_nonsymplectic, tolerance=tolerance, max_iterations=max_iterations)
+        self._remember_system(system)
         settings = thermostat_settings(system, temperature=temperature, collision_time=collision_time,
                                        thermostat_interval=thermostat_interval, random_seed=random_seed,
                                        thermostat_position=thermostat_position)
@@ -188,10 +189,9 @@ class PRKIntegrator(IntegratorBase, mm.CustomIntegrator):
         self._start_new_run_where_lost()
         stored = self.getGlobalVariable(0)
         if stored != self.program_info.signature:
-            context = self._bound_context()
             raise CheckpointMismatchError(mismatch_message(
-                f"{type(self).__name__}({self.method_name})", self.resolved, self.options, stored,
-                self.program_info.signature, context.getSystem() if context is not None else None))
+                f"{type(self).__name__}({self.method_name})", self.resolved, self.options, self.thermostat, stored,
+                self.program_info.signature, self._given_system()))
         if self.thermostat is not None:
             self._keep_thermostat_settings()
 

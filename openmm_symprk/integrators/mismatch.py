@@ -29,19 +29,21 @@ STATE_ADVICE = ("save a State of that run (Simulation.saveState, or Context.getS
 _INTERVALS = range(1, 11)
 
 
-def _signature(method, options, has_sites: bool) -> int | None:
-    """The signature of the program ``method`` compiles to with ``options`` (None if it does not compile)."""
+def _signature(method, options, thermostat, has_sites: bool) -> int | None:
+    """The signature of the program ``method`` compiles to with ``options`` and the ``thermostat``'s settings (None
+    for NVE; None returned if it does not compile)."""
     try:
-        resolved = resolve_for_system("checkpoint", method, None, options)
-        return program.compile_program(mm.CustomIntegrator(options.step_size), resolved, options, has_sites).signature
+        resolved = resolve_for_system("checkpoint", method, None, options, thermostat=thermostat)
+        return program.compile_program(mm.CustomIntegrator(options.step_size), resolved, options, has_sites,
+                                       thermostat).signature
     except (ValueError, TypeError):
         return None
 
 
-def _thermostats(options, system):
-    """Thermostat settings the checkpoint's run may have had: this integrator's with another interval or placement,
-    or (an NVE integrator) the defaults at every interval and placement."""
-    base = options.thermostat
+def _thermostats(thermostat, system):
+    """Thermostat settings the checkpoint's run may have had: this integrator's (``thermostat``) with another interval
+    or placement, or (an NVE integrator) the defaults at every interval and placement."""
+    base = thermostat
     if base is None:
         try:
             base = thermostat_settings(system, temperature=300.0)
@@ -52,46 +54,49 @@ def _thermostats(options, system):
             yield replace(base, interval=interval, position=position)
 
 
-def _candidates(resolved, options, system):
-    """(what differs, whether it is the ensemble, method, options) for the programs the checkpoint's run may have had."""
+def _candidates(resolved, options, thermostat, system):
+    """(what differs, whether it is the ensemble, method, options, thermostat settings) for the programs the
+    checkpoint's run may have had."""
     method = resolved.entry.name if resolved.entry is not None and not resolved.is_mts else None
     if method is None:
         return
-    nvt = options.thermostat is not None
+    nvt = thermostat is not None
     if nvt:
         yield "the ensemble (the checkpoint's run was NVE, without temperature=; this integrator runs NVT)", True, \
-            method, replace(options, thermostat=None)
-    for settings in _thermostats(options, system):
+            method, options, None
+    for settings in _thermostats(thermostat, system):
         if not nvt:
             yield ("the ensemble (the checkpoint's run was NVT, with temperature=; this integrator runs NVE)", True,
-                   method, replace(options, thermostat=settings))
-        elif settings.interval != options.thermostat.interval:
+                   method, options, settings)
+        elif settings.interval != thermostat.interval:
             yield (f"thermostat_interval (the checkpoint's run had {settings.interval}; this integrator has "
-                   f"{options.thermostat.interval})", False, method, replace(options, thermostat=settings))
-        elif settings.position != options.thermostat.position:
+                   f"{thermostat.interval})", False, method, options, settings)
+        elif settings.position != thermostat.position:
             yield (f"thermostat_position (the checkpoint's run had {settings.position!r}; this integrator has "
-                   f"{options.thermostat.position!r})", False, method, replace(options, thermostat=settings))
+                   f"{thermostat.position!r})", False, method, options, settings)
     on_off = {True: "on", False: "off"}
     yield (f"exact_momentum (the checkpoint's run had it {on_off[not options.exact_momentum]}; this integrator has it "
-           f"{on_off[options.exact_momentum]})", False, method, replace(options, exact_momentum=not options.exact_momentum))
+           f"{on_off[options.exact_momentum]})", False, method, replace(options, exact_momentum=not options.exact_momentum),
+           thermostat)
     yield (f"check_finite (the checkpoint's run had it {on_off[not options.check_finite]}; this integrator has it "
-           f"{on_off[options.check_finite]})", False, method, replace(options, check_finite=not options.check_finite))
+           f"{on_off[options.check_finite]})", False, method, replace(options, check_finite=not options.check_finite),
+           thermostat)
     if options.max_speed:
         yield (f"max_speed (the checkpoint's run had none; this integrator has {options.max_speed:g} nm/ps)", False,
-               method, replace(options, max_speed=0.0))
+               method, replace(options, max_speed=0.0), thermostat)
     yield (f"the constraints (the checkpoint's program was compiled {'without' if resolved.constraints else 'with'} "
            f"RATTLE steps; this one {'with' if resolved.constraints else 'without'}: constraints= or the System's "
-           f"constraints)", False, method, replace(options, constraints=not resolved.constraints))
+           f"constraints)", False, method, replace(options, constraints=not resolved.constraints), thermostat)
     for other in methods.splittings():
         if other.name != method:
             yield (f"the method (the checkpoint's run used {other.name!r}; this integrator runs {method!r})", False,
-                   other.name, options)
+                   other.name, options, thermostat)
 
 
-def mismatch_message(where: str, resolved, options, stored: float, expected: int, system=None) -> str:
+def mismatch_message(where: str, resolved, options, thermostat, stored: float, expected: int, system=None) -> str:
     """The message of the CheckpointMismatchError of ``where`` (the class and method), whose program (``resolved``,
-    ``options``, signature ``expected``) finds ``stored`` in global 0; ``system``: the bound Context's System (for the
-    thermostat an NVE integrator's run may have had)."""
+    ``options``, the ``thermostat``'s settings or None, signature ``expected``) finds ``stored`` in global 0;
+    ``system``: the System given as ``system=`` (for the thermostat an NVE integrator's run may have had)."""
     head = f"{where}: the Context holds the state of another integrator program (a checkpoint was loaded)"
     if struct.pack(">d", stored)[:6] == b"SymPRK":
         return (f"{head}: it was written by the native backend; load it into SymplecticIntegrator(..., "
@@ -102,8 +107,8 @@ def mismatch_message(where: str, resolved, options, stored: float, expected: int
                 f"VerletIntegrator, LangevinMiddleIntegrator and the like). A checkpoint continues the run of the "
                 f"integrator that wrote it; to go on from that run with this one, {STATE_ADVICE}.")
     has_sites = options.system.virtual_sites if options.system is not None else True
-    for what, ensemble, method, candidate in _candidates(resolved, options, system):
-        if _signature(method, candidate, has_sites) == int(stored):
+    for what, ensemble, method, candidate, settings in _candidates(resolved, options, thermostat, system):
+        if _signature(method, candidate, settings, has_sites) == int(stored):
             if ensemble:
                 return (f"{head}; what differs: {what}. A checkpoint continues one run in its ensemble; to change the "
                         f"ensemble, {STATE_ADVICE}.")

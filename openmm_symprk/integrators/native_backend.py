@@ -70,6 +70,7 @@ class NativeSymplecticIntegrator(SymplecticIntegrator, _PluginIntegrator, backen
         opts = IntegratorOptions.build(
             type(self).__name__, stepSize, system, exact_momentum=exact_momentum, check_finite=check_finite,
             max_speed=max_speed, groups=groups, inner_method=inner_method)
+        self._remember_system(system)
         settings = thermostat_settings(system, temperature=temperature, collision_time=collision_time,
                                        thermostat_interval=thermostat_interval, random_seed=random_seed,
                                        thermostat_position=thermostat_position)

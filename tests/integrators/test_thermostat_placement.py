@@ -404,3 +404,26 @@ def test_conservation_reporter_shows_the_temperature_at_the_thermostat(backend):
         u = kept_velocities(x, v, m, True)
         on_step = float(np.sum(m[:, None] * (v - u) ** 2)) / (ig.thermostat_dof * R_KJ)
         assert reporter.records[-1]["T_thermostat"] == pytest.approx(on_step, rel=1e-9 if position == "ends" else 3e-3)
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_a_middle_placement_that_samples_worse_than_the_ends_warns_once(backend):
+    """thermostat_position="middle" on omelyan-2 (its middle falls inside the central kick and samples configurations
+    further from canonical than the ends) warns once, on both backends, naming where the middle falls, the harmonic
+    numbers and "auto"; verlet's middle (its best placement) and "auto" give no such warning."""
+    from openmm_symprk.integrators import PlacementWarning
+    from openmm_symprk.systems.checks import warn_once
+
+    scene = water_cluster(8)
+    warn_once.reset()
+    with pytest.warns(PlacementWarning, match=r"inside its central kick.*1\.0150.*'auto'") as got:
+        SymplecticIntegrator(0.002, "omelyan-2", system=scene.system, backend=backend, temperature=300,
+                             thermostat_position="middle")
+        SymplecticIntegrator(0.002, "omelyan-2", system=scene.system, backend=backend, temperature=300,
+                             thermostat_position="middle")
+    assert sum(issubclass(w.category, PlacementWarning) for w in got) == 1
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", PlacementWarning)
+        for method, position in (("verlet", "middle"), ("omelyan-2", "auto"), ("omelyan-2", "ends")):
+            SymplecticIntegrator(0.002, method, system=scene.system, backend=backend, temperature=300,
+                                 thermostat_position=position)
