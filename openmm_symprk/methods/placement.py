@@ -160,10 +160,10 @@ def placement_table(names=("verlet", "omelyan-2", "pefrl", "yoshida-4", "blanes-
 #: thermostat at collision time 0.1 ps, 12 replicas paired with a Verlet 0.5-fs reference (the frontier study's side
 #: rows: ``symprk fidelity --preset frontier --out docs/data/fidelity/frontier-spce --report-only``).
 MEASURED_MIDDLE = {
-    "omelyan-2": "in 216 rigid SPC/E waters at 6 fs the middle ran the translational temperature 4.6 K and the "
-                 "potential energy 0.34 kJ/mol per molecule above the reference",
-    "predescu-3": "in 216 rigid SPC/E waters at 12 fs the middle ran the translational temperature 7.4 K and the "
-                  "potential energy 0.36 kJ/mol per molecule below the reference",
+    "omelyan-2": "in 216 rigid SPC/E waters at 6 fs the middle ran the translational temperature 4.4 +- 0.7 K and "
+                 "the potential energy 0.29 +- 0.03 kJ/mol per molecule above the reference",
+    "predescu-3": "in 216 rigid SPC/E waters at 12 fs the middle ran the translational temperature 6.7 +- 0.9 K and "
+                  "the potential energy 0.32 +- 0.04 kJ/mol per molecule below the reference",
 }
 
 
