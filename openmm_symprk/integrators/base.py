@@ -228,7 +228,7 @@ class IntegratorBase:
         return self._thermostat is not None
 
     def _require_thermostat(self, what: str):
-        self._sync_run_state()
+        """The thermostat's settings (they need no look at the Context); InputError for an NVE integrator."""
         if self._thermostat is None:
             raise InputError(f"{type(self).__name__}({self.method_name}).{what}: this integrator was created without "
                              f"temperature=, so it runs NVE and has no thermostat; create it with e.g. "
@@ -289,6 +289,7 @@ class IntegratorBase:
         of the thermostat point: docs/thermostat.md, "What a user reads as the temperature"), up to the constraint
         corrections of the drift after a middle event.  0 before the first event."""
         self._require_thermostat("thermostat_kinetic_energy()")
+        self._sync_run_state()
         return float(self._thermostat_kinetic_energy()) * unit.kilojoule_per_mole
 
     @property

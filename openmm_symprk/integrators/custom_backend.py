@@ -21,6 +21,7 @@ from dataclasses import replace
 import openmm as mm
 import openmm.unit as unit
 
+from ..support.errors import InputError
 from ..physics.velocity_rescaling import no_peculiar_motion
 from ..systems.checks import warn_once
 from ..systems.properties import masses, virtual_sites
@@ -41,7 +42,7 @@ class TimeWarning(UserWarning):
     """OpenMM's CustomIntegrator keeps the Context's time on the old step size after setStepSize."""
 
 
-class VirtualSitesError(ValueError):
+class VirtualSitesError(InputError):
     """The CustomIntegrator backend was asked to run a System with virtual sites, which it cannot keep right."""
 
 

@@ -16,8 +16,8 @@ from dataclasses import replace
 import openmm as mm
 
 from ..methods.catalogue import methods
+from ..methods.resolved import resolve
 from . import program
-from .backend import resolve_for_system
 from .thermostat import thermostat_settings
 
 __all__ = ["mismatch_message", "STATE_ADVICE"]
@@ -32,8 +32,13 @@ _INTERVALS = range(1, 11)
 def _signature(method, options, thermostat, has_sites: bool) -> int | None:
     """The signature of the program ``method`` compiles to with ``options`` and the ``thermostat``'s settings (None
     for NVE; None returned if it does not compile)."""
-    try:
-        resolved = resolve_for_system("checkpoint", method, None, options, thermostat=thermostat)
+    try:  # the method alone (resolve_for_system would check a System and warn, once per kind, for a candidate)
+        constraints = options.constraints
+        if constraints is None and options.system is not None:
+            constraints = options.system.constraints
+        resolved = resolve(method, constraints=constraints, groups=options.groups,
+                           inner_method=options.inner_method,
+                           thermostat_position=thermostat.position if thermostat is not None else None)
         return program.compile_program(mm.CustomIntegrator(options.step_size), resolved, options, has_sites,
                                        thermostat).signature
     except (ValueError, TypeError):

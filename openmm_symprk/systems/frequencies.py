@@ -12,13 +12,12 @@ import numpy as np
 import openmm as mm
 import openmm.unit as unit
 
+from ..physics.temperature import R_KJ
 from ..support.errors import InputError
 from .properties import degrees_of_freedom, masses
 
 __all__ = ["mean_square_frequency"]
 
-#: Boltzmann's constant in kJ/mol/K.
-_KB = unit.MOLAR_GAS_CONSTANT_R.value_in_unit(unit.kilojoule_per_mole / unit.kelvin)
 
 
 def mean_square_frequency(system: mm.System, configurations, temperature: float, molecules=None,
@@ -29,7 +28,7 @@ def mean_square_frequency(system: mm.System, configurations, temperature: float,
     OpenMM's own (``Context.applyVelocityConstraints`` on M^-1 F)."""
     m = masses(system)
     inv = np.where(m > 0, 1.0 / np.where(m > 0, m, 1.0), 0.0)
-    kt = _KB * float(temperature)
+    kt = R_KJ * float(temperature)
     n_f = degrees_of_freedom(system)
     context = mm.Context(system, mm.VerletIntegrator(0.001), mm.Platform.getPlatformByName(platform))
     total, trans, n = 0.0, 0.0, 0

@@ -91,3 +91,28 @@ def test_checkpoints_across_backends_still_name_the_backend(water8):
         return  # OpenMM may refuse the stream itself
     with pytest.raises(CheckpointMismatchError, match="written by the native backend.*backend='native'"):
         custom.step(1)
+
+
+def test_naming_what_differs_warns_about_nothing():
+    """Working out what a refused checkpoint's run had compiles candidate programs; that gives no warning of its own
+    (a PlacementWarning per candidate method would both flood the user and use up the warning a real integrator of
+    that method is owed)."""
+    import warnings
+
+    import openmm as mm
+
+    from openmm_symprk import SymplecticIntegrator
+    from openmm_symprk.integrators.mismatch import mismatch_message
+    from openmm_symprk.systems.scenes import water_cluster
+
+    from openmm_symprk.systems.checks import warn_once
+
+    scene = water_cluster(8)
+    ig = SymplecticIntegrator(0.002, "verlet", system=scene.system, backend="custom", temperature=300,
+                              thermostat_position="middle")
+    warn_once.reset()
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        text = mismatch_message("X", ig.resolved, ig.options, ig.thermostat, 12345.0, ig.program_info.signature,
+                                scene.system)
+    assert "another integrator program" in text

@@ -78,11 +78,14 @@ def test_what_a_row_knows():
         ("langevin", False, False, True)
     assert nh.has_heat_bath and not nh.leapfrog and nh.conserves_effective_energy
     assert verlet.ensemble == "NVE" and verlet.leapfrog and not verlet.has_heat_bath and verlet.conserves_effective_energy
-    # the package's velocity Verlet with the thermostat in the middle holds half-step velocities too (its step runs
-    # from its closing kick); other placements and methods, and multiple time stepping, hold those of their own step
-    assert [Row.parse(t).leapfrog for t in ("verlet 2 fs SVR 0.1 ps middle", "verlet 2 fs SVR 0.1 ps auto",
-                                            "verlet 4/2 fs SVR 0.1 ps middle", "omelyan-2 2 fs SVR 0.1 ps middle",
-                                            "verlet 2 fs")] == [True, True, False, False, False]
+    # the package's middle placement holds the velocities before the step's closing kicks too (its step runs from
+    # them): half a kick for velocity Verlet, omelyan-2's closing b h, both levels' for multiple time stepping; the
+    # ends placement and NVE hold on-step velocities
+    lags = [Row.parse(t).velocity_lag for t in ("verlet 2 fs SVR 0.1 ps middle", "verlet 2 fs SVR 0.1 ps auto",
+                                                "verlet 4/2 fs SVR 0.1 ps middle", "omelyan-2 2 fs SVR 0.1 ps middle",
+                                                "omelyan-2 2 fs SVR 0.1 ps", "verlet 2 fs")]
+    assert lags[0] == lags[1] == ((0.5, None),) and lags[4] == lags[5] == ()
+    assert len(lags[2]) == 2 and {g for _, g in lags[2]} == {(1,), (0,)} and lags[3][0][0] == pytest.approx(0.1932, abs=1e-4)
 
 
 def _system(n=4):
@@ -205,3 +208,37 @@ def test_on_step_velocities_of_a_leapfrog_row_are_velocity_verlets(scene):
     leap.step(5)
     ours.step(5)
     np.testing.assert_allclose(leap.sample().x, ours.sample().x, atol=tol)
+
+
+@pytest.mark.parametrize("label", ["omelyan-2 2 fs", "verlet 4/2 fs", "verlet 1 fs"])
+def test_a_middle_placement_rows_on_step_velocities_are_its_methods(label):
+    """Known answer: with a collision time so long that its events change nothing (1e9 ps), a row with the thermostat
+    in the middle (its step run from its closing kicks, the State behind by them) started from a state and sampled
+    on-step has the positions and on-step velocities of the same method without a thermostat: omelyan-2 (closing
+    kick b h), multiple time stepping (both levels' closing kicks) and Verlet; the State's own velocities lag."""
+    from openmm_symprk.studies.core.engine import RowEngine
+    from openmm_symprk.systems.scenes.builders import harmonic_oscillators
+
+    system, x, v = harmonic_oscillators(30, 2.0e4, 300.0)
+    if "/" in label:  # multiple time stepping: a slow group 1 and a fast group 0
+        for k, f in enumerate(system.getForces()):
+            f.setForceGroup(k % 2)
+        slow = mm.CustomExternalForce("0.5*k2*(x^2+y^2+z^2)")
+        slow.addGlobalParameter("k2", 3.0e3)
+        slow.setForceGroup(1)
+        for i in range(system.getNumParticles()):
+            slow.addParticle(i, [])
+        system.addForce(slow)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        middle = RowEngine(Row.parse(f"{label} SVR 1e9 ps middle"), system, x, v, platform="Reference")
+        plain = RowEngine(Row.parse(label), system, x, v, platform="Reference")
+    assert middle.lag
+    for _ in range(3):
+        middle.step(5)
+        plain.step(5)
+        a, b, lagging = middle.sample(on_step=True), plain.sample(), middle.sample()
+        scale = np.abs(b.v).max()
+        np.testing.assert_allclose(a.x, b.x, atol=1e-7)
+        assert np.abs(a.v - b.v).max() < 1e-5 * scale, np.abs(a.v - b.v).max() / scale
+        assert np.abs(lagging.v - b.v).max() > 1e-3 * scale  # the closing kicks away

@@ -52,6 +52,7 @@ class RowEngine:
         v = scene.velocities if v is None else v
         name, precision = platforms.split(platform)
         self.row, self.platform = row, name
+        self.lag = ()  # the kicks the State's velocities lack (Row.velocity_lag; none for the rigid-body engine)
         props = platforms.properties(name, threads, precision)
         self.integrator = self.context = self.rigid = None
         if row.is_rigid:
@@ -70,12 +71,11 @@ class RowEngine:
         self.context = mm.Context(self.system, self.integrator, mm.Platform.getPlatformByName(name), props)
         self.context.setPositions(x)
         v = np.array(v, dtype=np.float64)
-        if start and row.leapfrog:
-            f = self.context.getState(getForces=True).getForces(asNumpy=True).value_in_unit(KJ / unit.nanometer)
-            inv = np.where(self.masses > 0, 1.0 / np.where(self.masses > 0, self.masses, 1.0), 0.0)
-            v = v - 0.5 * row.h_ps * np.asarray(f) * inv[:, None]
+        self.lag = row.velocity_lag
+        if start and self.lag:
+            v = v - self.lag_kick()
         self.context.setVelocities(v)
-        if start and row.leapfrog and self.system.getNumConstraints():
+        if start and self.lag and self.system.getNumConstraints():
             self.context.applyVelocityConstraints(tolerance)
 
     def step(self, n: int):
@@ -105,23 +105,33 @@ class RowEngine:
             return Sample(self.rigid.positions() if positions else None, v if velocities else None,
                           self.rigid.potential_energy() if energy else None,
                           kinetic_energy(v, self.masses) if energy else None)
-        shift = on_step and velocities and self.row.leapfrog
-        st = self.context.getState(getPositions=positions, getVelocities=velocities, getEnergy=energy,
-                                   getForces=shift)
+        shift = on_step and velocities and bool(self.lag)
+        st = self.context.getState(getPositions=positions, getVelocities=velocities, getEnergy=energy)
         v = np.array(st.getVelocities(asNumpy=True).value_in_unit(unit.nanometer / unit.picosecond)) \
             if velocities else None
         if shift:
-            v = self.on_step_velocities(v, st.getForces(asNumpy=True).value_in_unit(KJ / unit.nanometer))
+            v = self.on_step_velocities(v)
         return Sample(np.array(st.getPositions(asNumpy=True).value_in_unit(unit.nanometer)) if positions else None, v,
                       st.getPotentialEnergy().value_in_unit(KJ) if energy else None,
                       st.getKineticEnergy().value_in_unit(KJ) if energy else None)
 
-    def on_step_velocities(self, v, forces, tolerance: float = 1e-10) -> np.ndarray:
-        """A leapfrog row's State velocities ``v`` (half a step behind the positions) brought to the positions' time:
-        v + (h/2) F(x)/m, the velocity velocity Verlet has there (the mean of the half-step velocities on either side),
-        projected onto the constraints (through the Context, whose velocities are set back as they were)."""
+    def lag_kick(self) -> np.ndarray:
+        """The velocity change of the kicks a State's velocities lack (:attr:`~.rows.Row.velocity_lag`) at the Context's
+        positions: sum over them of (fraction of h) h F_groups / m."""
         inv = np.where(self.masses > 0, 1.0 / np.where(self.masses > 0, self.masses, 1.0), 0.0)
-        shifted = v + 0.5 * self.row.h_ps * np.asarray(forces) * inv[:, None]
+        dv = np.zeros((len(self.masses), 3))
+        for fraction, groups in self.lag:
+            kw = {"groups": set(groups)} if groups is not None else {}
+            f = self.context.getState(getForces=True, **kw).getForces(asNumpy=True).value_in_unit(KJ / unit.nanometer)
+            dv += float(fraction) * self.row.h_ps * np.asarray(f) * inv[:, None]
+        return dv
+
+    def on_step_velocities(self, v, tolerance: float = 1e-10) -> np.ndarray:
+        """A lagging row's State velocities ``v`` brought to the positions' time: v plus the kicks they lack
+        (:meth:`lag_kick`; for a leapfrog integrator v + (h/2) F(x)/m, the velocity velocity Verlet has there, the mean
+        of the half-step velocities on either side), projected onto the constraints (through the Context, whose
+        velocities are set back as they were)."""
+        shifted = v + self.lag_kick()
         if not self.system.getNumConstraints():
             return shifted
         self.context.setVelocities(shifted)

@@ -38,6 +38,7 @@ OpenMM names ``openmm-nosehoover``, ``openmm-dpd``, ``openmm-mtslangevin``, ``no
 from __future__ import annotations
 
 import dataclasses
+from fractions import Fraction
 import math
 import re
 import warnings
@@ -191,18 +192,34 @@ class Row:
         return self.step_fs * 1e-3
 
     @property
-    def leapfrog(self) -> bool:
-        """Whether the State velocities lag half a step behind the positions, by half a kick of all forces: OpenMM's
-        leapfrog integrators, and this package's velocity Verlet with the thermostat in the middle, whose step runs from
-        its closing kick (kick 1, drift 1/2, event, drift 1/2), as LangevinMiddleIntegrator's does."""
+    def velocity_lag(self) -> tuple:
+        """The kicks a State's velocities lack to be at the positions' time, as ((fraction of the step, force groups or
+        None for all), ...): half a kick of all forces for OpenMM's leapfrog integrators; for this package's thermostat
+        in the middle of the step, the step's closing kicks (its step runs from them, so that the State holds the
+        thermostat point's velocities: half of each opening kick, which carries both); () where the State's velocities
+        are on-step (NVE, the ends placement, a step that begins with a drift)."""
         if self.who in LEAPFROG:
-            return True
-        if self.thermostat != "svr" or self.is_rigid or self.mts:
-            return False
-        from ...methods.resolved import SubstepKind, resolve
+            return ((Fraction(1, 2), None),)
+        if self.thermostat != "svr" or self.is_rigid:
+            return ()
+        from ...methods.resolved import SubstepKind
 
-        first = resolve(self.method, thermostat_position=self.position).substeps[0]
-        return first.kind == SubstepKind.KICK and first.groups is None and first.coefficient == 1
+        r = self.resolved(thermostat_position=self.position)
+        if r.thermostat_position != "middle":
+            return ()
+        lag = []
+        for sub in r.substeps:
+            if sub.kind != SubstepKind.KICK:
+                break
+            lag.append((Fraction(sub.coefficient) / 2, sub.groups))
+        return tuple(lag)
+
+    @property
+    def leapfrog(self) -> bool:
+        """Whether the State velocities lag behind the positions (:attr:`velocity_lag`): OpenMM's leapfrog integrators,
+        and this package's middle placement, whose step runs from its closing kicks, as LangevinMiddleIntegrator's
+        does."""
+        return bool(self.velocity_lag)
 
     @property
     def has_heat_bath(self) -> bool:
@@ -220,15 +237,17 @@ class Row:
         """Whether the total momentum is kept (OpenMM's Langevin integrators apply per-particle friction)."""
         return self.who not in NO_MOMENTUM
 
-    def resolved(self, constraints: bool | None = None):
-        """The method as it runs (:func:`openmm_symprk.methods.resolve`); ValueError for OpenMM's integrators."""
+    def resolved(self, constraints: bool | None = None, thermostat_position: str | None = None):
+        """The method as it runs (:func:`openmm_symprk.methods.resolve`; with ``thermostat_position``, its thermostat
+        placed there); ValueError for OpenMM's integrators."""
         from ...methods.resolved import resolve
 
         if not self.is_ours:
             raise InputError(f"row {self.label!r}: OpenMM's integrators have no resolved method")
         if self.mts:
-            return resolve(self.method, constraints, groups=split_groups(self.mts), inner_method=self.inner or None)
-        return resolve(self.method, constraints)
+            return resolve(self.method, constraints, groups=split_groups(self.mts), inner_method=self.inner or None,
+                           thermostat_position=thermostat_position)
+        return resolve(self.method, constraints, thermostat_position=thermostat_position)
 
     def require_kick_drift(self, where: str):
         """ValueError unless this package's method of the row is a kick/drift splitting or composition, which is what

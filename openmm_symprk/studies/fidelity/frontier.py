@@ -130,14 +130,15 @@ def frontier_summary(rows, per: dict, references: dict, tolerances: dict, timing
         entry = {"reference": reference, "families": [], "levels": {},
                  "left_out": sorted(f.name for f, _ in found if all(f.name != g.name for g, _ in fams))}
         for f, labs in fams:
+            fits = {k: fit(f.steps, f.bias[k], f.order, intercept=k in f.free) for k in keys}
             entry["families"].append({
                 "family": f.name, "rows": labs, "steps_fs": list(f.steps), "evals_per_step": f.cost_per_step,
                 "s_per_step": wall[f.name], "openmm": to_row(labs[0]).who in OPENMM_KINDS,
-                "c": {k: fit(f.steps, f.bias[k], f.order, intercept=k in f.free)[1] for k in keys},
+                "c": {k: fits[k][1] for k in keys},
                 "c_interval": {k: [float(np.nanquantile(boot[f.name][k][:, 1], q)) for q in (0.025, 0.975)]
                                for k in keys}})
             if f.free:  # the h-independent part of the bias, where the family has one
-                entry["families"][-1]["a"] = {k: fit(f.steps, f.bias[k], f.order, intercept=True)[0] for k in f.free}
+                entry["families"][-1]["a"] = {k: fits[k][0] for k in f.free}
                 entry["families"][-1]["a_interval"] = {
                     k: [float(np.nanquantile(boot[f.name][k][:, 0], q)) for q in (0.025, 0.975)] for k in f.free}
         for level, tol in tolerances.items():

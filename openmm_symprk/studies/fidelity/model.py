@@ -20,12 +20,10 @@ from __future__ import annotations
 import numpy as np
 
 from ...methods.shadow import event_coefficients
+from ...physics.temperature import R_KJ as KB
 from .rowspec import to_row
 
-__all__ = ["predict", "bias_predictions", "KB"]
-
-#: Boltzmann's constant in kJ/mol/K.
-KB = 0.00831446261815324
+__all__ = ["predict", "bias_predictions", "box_properties"]
 
 
 def predict(label: str, props: dict, temperature: float) -> dict | None:

@@ -130,7 +130,7 @@ def row_set(methods, backends, thermostat: bool, dt_fs: float) -> dict:
         for b in backends:
             rows[f"{b}:{m}"] = Row(m, dt_fs, backend=b)
             if thermostat:
-                rows[f"{b}:{m}:nvt"] = Row(m, dt_fs, backend=b, tau_ps=THERMOSTAT_TAU_PS, position="middle")
+                rows[f"{b}:{m}:nvt"] = Row(m, dt_fs, backend=b, tau_ps=THERMOSTAT_TAU_PS, position="auto")
     return rows
 
 
