@@ -42,8 +42,10 @@ NVT = {"temperature": 300, "random_seed": 3}
 SHAPES = {
     # [K][D][A][K] / [K+K+D][A]
     "verlet": ("verlet", {}, {0: (4, 0), 1: (2, 1), 2: (2, 1)}),
-    # [K][D][A] [E][EA] [D][A][K] / [K+K+D][A] [E] [EA+D][A] / [K+K+D] [A+E+EA+D in one block] [A]
-    "verlet-nvt-middle": ("verlet", dict(NVT, thermostat_position="middle"), {0: (8, 0), 1: (5, 1), 2: (3, 1)}),
+    # the middle placement's step runs from its closing kick (kick 1, drift 1/2, event, drift 1/2: the State holds the
+    # thermostat point's velocities), so a call ends on a drift and adds nothing:
+    # [K][D][A] [E][EA] [D][A] / [K+D][A] [E] [EA+D][A] / [K+D] [A+E+EA+D in one block] [A]
+    "verlet-nvt-middle": ("verlet", dict(NVT, thermostat_position="middle"), {0: (7, 0), 1: (5, 0), 2: (3, 0)}),
     # [E][EA][K][D][A][K] [E][EA] / [E] [EA+K+D][A][K] [E] [EA] / [E+EA+K+D][A][K][E+EA]: the events run every step, so
     # the kicks are not joined across steps
     "verlet-nvt-ends": ("verlet", dict(NVT, thermostat_position="ends"), {0: (8, 0), 1: (6, 0), 2: (4, 0)}),
