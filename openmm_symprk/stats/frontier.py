@@ -18,7 +18,10 @@ the reference replica by replica (the same initial state), this module
 A family whose dynamics differ from the reference's at any step (OpenMM's Langevin integrators against a velocity-
 rescaling reference: friction slows diffusion whatever h) names those observables in ``free``: their bias is fitted
 as a + c h^p, and the equal-accuracy step is where |a + c h^p| leaves the tolerance, none (0) where |a| is already
-beyond it: such a family costs infinitely much at that tolerance, as it should.
+beyond it: such a family costs infinitely much at that tolerance, as it should.  Families whose h-independent part
+comes from one cause of different strengths (OpenMM's LangevinMiddleIntegrator at two frictions) share it: ``shared =
+(group, s)`` makes a = kappa s, with one kappa fitted jointly over the group's rows (:func:`fits`): linear response in
+the friction, which lets the strong friction's well-measured effect fix the weak one's.
 
 Two families of the same order compare by one number per observable whatever eps:
 cost_B / cost_A = (s_B / s_A) (c_B / c_A)^(1/p); with several observables the step is the smallest h_eps over them,
@@ -33,7 +36,7 @@ import numpy as np
 
 from ..support.errors import InputError
 
-__all__ = ["Family", "fit", "fit_c", "bootstrap", "equal_accuracy_step", "FrontierPoint", "frontier", "compare"]
+__all__ = ["Family", "fit", "fit_c", "fits", "bootstrap", "equal_accuracy_step", "FrontierPoint", "frontier", "compare"]
 
 
 @dataclass(frozen=True)
@@ -50,6 +53,7 @@ class Family:
     cost_per_step: float = 1.0
     cap: float | None = None  # the largest usable step (default: the largest measured)
     free: tuple = ()  # observables whose bias has an h-independent part a (fitted as a + c h^p)
+    shared: tuple | None = None  # (group, s): the free observables' a is kappa * s, kappa shared by the group
 
     def __post_init__(self):
         steps = np.asarray(self.steps, dtype=float)
@@ -112,6 +116,48 @@ def fit_c(steps, bias, order: int, weights=None) -> float:
     return fit(steps, bias, order, weights)[1]
 
 
+def _joint(group, obs: str, means: dict) -> dict:
+    """{family name: (a, c)} of ``obs`` for the families of one shared group, fitted jointly by weighted least squares:
+    mean bias = kappa s_f + c_f h^p over every row of every family (``means``: {name: row means}); NaNs where the
+    rows cannot fix them."""
+    rows_y, rows_w, design = [], [], []
+    k = len(group)
+    for j, f in enumerate(group):
+        x = np.asarray(f.steps, dtype=float) ** f.order
+        w = _weights(f, obs)
+        for xi, yi, wi in zip(x, means[f.name], w):
+            if np.isfinite(yi) and np.isfinite(wi) and wi > 0:
+                row = np.zeros(1 + k)
+                row[0], row[1 + j] = f.shared[1], xi
+                design.append(row)
+                rows_y.append(yi)
+                rows_w.append(wi)
+    if len(rows_y) < 1 + k:
+        return {f.name: (float("nan"), float("nan")) for f in group}
+    sw = np.sqrt(np.asarray(rows_w))
+    sol, *_ = np.linalg.lstsq(np.asarray(design) * sw[:, None], np.asarray(rows_y) * sw, rcond=None)
+    return {f.name: (float(sol[0] * f.shared[1]), float(sol[1 + j])) for j, f in enumerate(group)}
+
+
+def fits(families, obs: str, means: dict | None = None) -> dict:
+    """{family name: (a, c)} of ``obs`` for every family: each on its own (:func:`fit`: a = 0 unless ``obs`` is
+    free), or jointly within a shared group (:func:`_joint`).  ``means``: {name: row means} (default: the families'
+    own; the bootstrap passes a resample's)."""
+    families = list(families)
+    if means is None:
+        means = {f.name: _row_stats(np.asarray(f.bias[obs], dtype=float))[0] for f in families}
+    out, groups = {}, {}
+    for f in families:
+        if obs in f.free and f.shared is not None:
+            groups.setdefault(f.shared[0], []).append(f)
+        else:
+            x = np.asarray(f.steps, dtype=float) ** f.order
+            out[f.name] = _solve(x, means[f.name], _weights(f, obs), obs in f.free)
+    for group in groups.values():
+        out.update(_joint(group, obs, means))
+    return out
+
+
 def _weights(family: Family, obs: str) -> np.ndarray:
     _, se, _ = _row_stats(np.asarray(family.bias[obs], dtype=float))
     return 1.0 / se ** 2
@@ -126,19 +172,15 @@ def bootstrap(families, observables, n_boot: int = 2000, seed: int = 1) -> dict:
     n = max(np.shape(f.bias[o])[1] for f in families for o in observables)
     rng = np.random.default_rng(seed)
     picks = rng.integers(0, n, size=(n_boot, n))
-    out = {}
-    for f in families:
-        out[f.name] = {}
-        for obs in observables:
-            b = np.asarray(f.bias[obs], dtype=float)
-            b = np.pad(b, ((0, 0), (0, n - b.shape[1])), constant_values=np.nan)
-            w = _weights(f, obs)
-            x = np.asarray(f.steps, dtype=float) ** f.order
-            fits = np.empty((n_boot, 2))
-            for i, pick in enumerate(picks):
-                mean, _, _ = _row_stats(b[:, pick])
-                fits[i] = _solve(x, mean, w, obs in f.free)
-            out[f.name][obs] = fits
+    out = {f.name: {obs: np.empty((n_boot, 2)) for obs in observables} for f in families}
+    for obs in observables:
+        padded = {f.name: np.pad(np.asarray(f.bias[obs], dtype=float),
+                                 ((0, 0), (0, n - np.shape(f.bias[obs])[1])), constant_values=np.nan)
+                  for f in families}
+        for i, pick in enumerate(picks):
+            means = {name: _row_stats(b[:, pick])[0] for name, b in padded.items()}
+            for name, pair in fits(families, obs, means).items():
+                out[name][obs][i] = pair
     return out
 
 
@@ -182,10 +224,13 @@ class FrontierPoint:
     samples: np.ndarray = field(repr=False)  # bootstrap h_eps, in the bootstrap's order (NaN: a resample without data)
 
 
-def frontier(family: Family, tolerances: dict, boot: dict, level: float = 0.95) -> FrontierPoint:
-    """``family`` at ``tolerances`` ({observable: eps}); ``boot`` its {observable: bootstrap c's}."""
-    cs = {obs: fit(family.steps, family.bias[obs], family.order, _weights(family, obs), obs in family.free)
-          for obs in tolerances}
+def frontier(family: Family, tolerances: dict, boot: dict, level: float = 0.95, point: dict | None = None) -> FrontierPoint:
+    """``family`` at ``tolerances`` ({observable: eps}); ``boot`` its {observable: bootstrap (a, c)'s}; ``point`` its
+    {observable: (a, c)} fitted on all the replicas (default: fitted here, on its own; a shared group's families pass
+    their joint fit, :func:`fits`)."""
+    cs = point if point is not None else {
+        obs: fit(family.steps, family.bias[obs], family.order, _weights(family, obs), obs in family.free)
+        for obs in tolerances}
     step = float(equal_accuracy_step(cs, tolerances, family.order, family.largest_step))
     limits = {obs: float(equal_accuracy_step({obs: cs[obs]}, {obs: eps}, family.order, np.inf))
               for obs, eps in tolerances.items()}

@@ -3,7 +3,7 @@ b(h) = c h^p plus replica noise, paired with a reference replica by replica."""
 import numpy as np
 import pytest
 
-from openmm_symprk.stats.frontier import Family, bootstrap, compare, equal_accuracy_step, fit, fit_c, frontier
+from openmm_symprk.stats.frontier import Family, bootstrap, compare, equal_accuracy_step, fit, fit_c, fits, frontier
 
 
 def _family(name, c, steps, n=12, noise=0.01, order=2, seed=0, cost=1.0, shared=None, cap=None):
@@ -115,3 +115,25 @@ def test_a_family_whose_bias_does_not_vanish_with_h_is_fitted_with_its_intercept
     ratio, low, high = compare(frontier(ours, {"D": 0.05}, boot["ours"]), frontier(friction, {"D": 0.05},
                                                                                    boot["langevin"]), 2.0, 1.0)
     assert ratio == np.inf and high == np.inf and low == np.inf
+
+
+def test_families_of_one_cause_share_their_h_independent_part():
+    """Two frictions of one Langevin integrator: a = kappa * friction (linear response), kappa shared.  The strong
+    friction's clear effect fixes the weak one's, whose own rows are too noisy to: fitted alone its intercept is far
+    off, jointly it is kappa / 10 within a few per cent of kappa."""
+    rng = np.random.default_rng(7)
+    steps = np.array([0.5, 1.0, 2.0, 3.0])
+    kappa = -0.15
+    strong = kappa * 1.0 + 0.004 * steps[:, None] ** 2 + rng.normal(0, 0.003, (4, 12))
+    weak = kappa * 0.1 + 0.002 * steps[:, None] ** 2 + rng.normal(0, 0.05, (4, 12))
+    a1 = Family("langevin 1/ps", tuple(steps), {"D": strong}, free=("D",), shared=("langevin", 1.0))
+    a01 = Family("langevin 0.1/ps", tuple(steps), {"D": weak}, free=("D",), shared=("langevin", 0.1))
+    got = fits([a1, a01], "D")
+    assert got["langevin 1/ps"][0] == pytest.approx(kappa, abs=0.005)
+    assert got["langevin 0.1/ps"][0] == pytest.approx(kappa * 0.1, abs=0.0005)
+    assert got["langevin 0.1/ps"][1] == pytest.approx(0.002, abs=0.003)
+    boot = bootstrap([a1, a01], ["D"], n_boot=200)
+    assert np.allclose(boot["langevin 0.1/ps"]["D"][:, 0], 0.1 * boot["langevin 1/ps"]["D"][:, 0])
+    point = frontier(a01, {"D": 0.05}, boot["langevin 0.1/ps"], point={"D": got["langevin 0.1/ps"]})
+    assert point.step > 0  # |a| = 0.015 < 0.05: the weak friction meets the tolerance at small steps
+    assert frontier(a1, {"D": 0.05}, boot["langevin 1/ps"], point={"D": got["langevin 1/ps"]}).step == 0.0

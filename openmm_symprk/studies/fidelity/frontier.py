@@ -16,7 +16,7 @@ import dataclasses
 
 import numpy as np
 
-from ...stats.frontier import Family, bootstrap, compare, fit, frontier
+from ...stats.frontier import Family, bootstrap, compare, fits, frontier
 from ..core.charts import pyplot, save
 from ..core.rows import OPENMM_KINDS
 from .rowspec import to_row
@@ -49,6 +49,16 @@ def bias_order(label: str) -> int:
 #: acts on each particle (OpenMM's Langevin integrators) changes them at any step, which the paired bias against a
 #: velocity-rescaling reference keeps as an h-independent part.
 DYNAMICAL = ("D", "tau2_dip", "w_zero", "w_min")
+
+
+def shared_part(label: str) -> tuple | None:
+    """(group, strength) of a family's h-independent part shared with others of one cause: OpenMM's Langevin
+    integrators at their friction (per ps; linear response: the friction's effect on the dynamics is proportional to
+    it, so the 1/ps family's well-resolved effect fixes the 0.1/ps family's); None otherwise."""
+    row = to_row(label)
+    if row.thermostat == "langevin" and row.friction_per_ps:
+        return row.who, float(row.friction_per_ps)
+    return None
 
 
 def free_observables(label: str, reference: str) -> tuple:
@@ -104,7 +114,8 @@ def families(rows, per: dict, reference: str, ensemble: str, observables) -> lis
         rows_ = [to_row(lab) for lab in labels]
         out.append((Family(name, tuple(r.step_fs for r in rows_), bias, order=bias_order(labels[0]),
                            cost_per_step=float(np.mean([r.evals_per_step() for r in rows_])),
-                           free=tuple(k for k in free_observables(labels[0], reference) if k in observables)),
+                           free=tuple(k for k in free_observables(labels[0], reference) if k in observables),
+                           shared=shared_part(labels[0])),
                     labels))
     return out
 
@@ -129,21 +140,25 @@ def frontier_summary(rows, per: dict, references: dict, tolerances: dict, timing
         wall = {f.name: _wall_per_step(labs, timings) for f, labs in fams}
         entry = {"reference": reference, "families": [], "levels": {},
                  "left_out": sorted(f.name for f, _ in found if all(f.name != g.name for g, _ in fams))}
+        point = {k: fits([f for f, _ in fams], k) for k in keys}  # {observable: {family: (a, c)}}
         for f, labs in fams:
-            fits = {k: fit(f.steps, f.bias[k], f.order, intercept=k in f.free) for k in keys}
+            fitted = {k: point[k][f.name] for k in keys}
             entry["families"].append({
                 "family": f.name, "rows": labs, "steps_fs": list(f.steps), "evals_per_step": f.cost_per_step,
                 "s_per_step": wall[f.name], "openmm": to_row(labs[0]).who in OPENMM_KINDS,
-                "c": {k: fits[k][1] for k in keys},
+                "c": {k: fitted[k][1] for k in keys},
                 "c_interval": {k: [float(np.nanquantile(boot[f.name][k][:, 1], q)) for q in (0.025, 0.975)]
                                for k in keys}})
             if f.free:  # the h-independent part of the bias, where the family has one
-                entry["families"][-1]["a"] = {k: fits[k][0] for k in f.free}
+                entry["families"][-1]["a"] = {k: fitted[k][0] for k in f.free}
+                if f.shared is not None:
+                    entry["families"][-1]["shared"] = list(f.shared)
                 entry["families"][-1]["a_interval"] = {
                     k: [float(np.nanquantile(boot[f.name][k][:, 0], q)) for q in (0.025, 0.975)] for k in f.free}
         for level, tol in tolerances.items():
             eps = _absolute(tol, ref_means)
-            points = {f.name: frontier(f, eps, boot[f.name]) for f, _ in fams}
+            points = {f.name: frontier(f, eps, boot[f.name], point={k: point[k][f.name] for k in eps})
+                      for f, _ in fams}
             level_entry = {"tolerances": eps, "families": {}}
             for f, _ in fams:
                 p = points[f.name]
@@ -198,7 +213,9 @@ def format_frontier(summary: dict) -> str:
             lines.append("  " + fam["family"][:33].ljust(34) + ",".join(f"{h:g}" for h in fam["steps_fs"]).ljust(16)
                          + cs)
             if fam.get("a"):
-                lines.append("    and an h-independent part a (its thermostat is not the reference's): " + ", ".join(
+                why = (f"a = kappa x {fam['shared'][1]:g}, kappa fitted over the {fam['shared'][0]} families"
+                       if fam.get("shared") else "fitted")
+                lines.append(f"    and an h-independent part a (its thermostat is not the reference's; {why}): " + ", ".join(
                     f"a[{k}] {fam['a'][k]:+.3g} [{fam['a_interval'][k][0]:+.2g},{fam['a_interval'][k][1]:+.2g}]"
                     for k in fam["a"]))
         if entry.get("left_out"):
