@@ -36,7 +36,8 @@ import numpy as np
 
 from ..support.errors import InputError
 
-__all__ = ["Family", "fit", "fit_c", "fits", "bootstrap", "equal_accuracy_step", "FrontierPoint", "frontier", "compare"]
+__all__ = ["Family", "fit", "fit_c", "fits", "bootstrap", "equal_accuracy_step", "FrontierPoint", "frontier", "compare",
+           "replicas_for_interval"]
 
 
 @dataclass(frozen=True)
@@ -261,3 +262,17 @@ def compare(ours: FrontierPoint, theirs: FrontierPoint, cost_ours: float, cost_t
     method = "linear" if np.isfinite(boot).all() else "inverted_cdf"  # no interpolation between infinite samples
     return (float(ratio), float(np.quantile(boot, tail, method=method)),
             float(np.quantile(boot, 1.0 - tail, method=method)))
+
+
+def replicas_for_interval(n: int, ratio: float, low: float, high: float, within: float = 0.25) -> float:
+    """Replicas that would bring a ratio's interval (``low``-``high`` around ``ratio``, measured over ``n``
+    replicas) inside ``ratio`` (1 +- ``within``): on a log scale the interval's half-widths shrink as 1/sqrt(n),
+    the measured scatter kept.  ``n`` where it is already inside; inf where an end is infinite or not a number (no
+    replica count mends a family that meets the tolerance at no step)."""
+    if n < 1 or not 0 < within < 1:
+        raise InputError(f"replicas_for_interval: n must be >= 1 and within in (0, 1), got n={n!r}, within={within!r}")
+    values = np.array([ratio, low, high], dtype=float)
+    if not (np.isfinite(values).all() and (values > 0).all()):
+        return float("inf")
+    grow = max(np.log(ratio / low) / -np.log1p(-within), np.log(high / ratio) / np.log1p(within))
+    return float(max(n, int(np.ceil(n * grow ** 2))))

@@ -3,7 +3,8 @@ b(h) = c h^p plus replica noise, paired with a reference replica by replica."""
 import numpy as np
 import pytest
 
-from openmm_symprk.stats.frontier import Family, bootstrap, compare, equal_accuracy_step, fit, fit_c, fits, frontier
+from openmm_symprk.stats.frontier import (Family, bootstrap, compare, equal_accuracy_step, fit, fit_c, fits, frontier,
+                                          replicas_for_interval)
 
 
 def _family(name, c, steps, n=12, noise=0.01, order=2, seed=0, cost=1.0, shared=None, cap=None):
@@ -137,3 +138,16 @@ def test_families_of_one_cause_share_their_h_independent_part():
     point = frontier(a01, {"D": 0.05}, boot["langevin 0.1/ps"], point={"D": got["langevin 0.1/ps"]})
     assert point.step > 0  # |a| = 0.015 < 0.05: the weak friction meets the tolerance at small steps
     assert frontier(a1, {"D": 0.05}, boot["langevin 1/ps"], point={"D": got["langevin 1/ps"]}).step == 0.0
+
+
+def test_the_replicas_an_interval_needs_follow_one_over_root_n():
+    """Half-widths on a log scale shrink as 1/sqrt(n): an interval 1.0-2.0 around 1.2 (upper half-width ln(5/3))
+    needs (ln(5/3) / ln 1.25)^2 = 11.7 times the replicas to fit within +-25 %; one already inside needs none more;
+    an infinite end cannot be mended; bad input is named."""
+    need = replicas_for_interval(12, 1.2, 1.0, 2.0)
+    assert need == np.ceil(12 * (np.log(2.0 / 1.2) / np.log(1.25)) ** 2)
+    assert replicas_for_interval(12, 1.2, 1.0, 1.4) == 12
+    assert replicas_for_interval(12, 1.2, 0.8, 1.3) == np.ceil(12 * (np.log(1.2 / 0.8) / -np.log(0.75)) ** 2)
+    assert replicas_for_interval(12, 1.2, 1.0, np.inf) == np.inf
+    with pytest.raises(ValueError, match="within"):
+        replicas_for_interval(12, 1.2, 1.0, 2.0, within=1.5)

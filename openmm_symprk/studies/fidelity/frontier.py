@@ -16,13 +16,16 @@ import dataclasses
 
 import numpy as np
 
-from ...stats.frontier import Family, bootstrap, compare, fits, frontier
+from ...stats.frontier import Family, bootstrap, compare, fits, frontier, replicas_for_interval
 from ..core.charts import pyplot, save
 from ..core.rows import OPENMM_KINDS
 from .rowspec import to_row
 
 __all__ = ["family_of", "bias_order", "free_observables", "families", "frontier_summary", "format_frontier",
            "frontier_chart", "N_BOOT", "DYNAMICAL"]
+
+#: A ratio's interval is decisive within this fraction of its value (the NVT answer's target).
+WITHIN = 0.25
 
 #: Bootstrap resamples of the replicas.
 N_BOOT = 2000
@@ -121,9 +124,10 @@ def families(rows, per: dict, reference: str, ensemble: str, observables) -> lis
 
 
 def frontier_summary(rows, per: dict, references: dict, tolerances: dict, timings: dict | None = None,
-                     n_boot: int = N_BOOT) -> dict:
-    """{ensemble: {"families": [...], "levels": {level: {...}}}} (see the module docstring)."""
-    timings = timings or {}
+                     n_boot: int = N_BOOT, run_seconds: dict | None = None) -> dict:
+    """{ensemble: {"families": [...], "levels": {level: {...}}}} (see the module docstring).  ``run_seconds``:
+    {label: mean wall seconds of one of its runs}, for what a ratio's interval of :data:`WITHIN` would cost."""
+    timings, run_seconds = timings or {}, run_seconds or {}
     out = {}
     for ensemble, reference in references.items():
         keys = sorted({k[:-len("_rel")] if k.endswith("_rel") else k for t in tolerances.values() for k in t})
@@ -178,11 +182,25 @@ def frontier_summary(rows, per: dict, references: dict, tolerances: dict, timing
                 b = dataclasses.replace(points[best_theirs],
                                         cost=_per_step(cost_of(best_theirs), points[best_theirs].step))
                 ratio, low, high = compare(a, b, cost_of(best_ours), cost_of(best_theirs))
+                n = min(_replicas(f) for f, _ in fams if f.name in (best_ours, best_theirs))
+                need = replicas_for_interval(n, ratio, low, high, WITHIN)
+                # the reference, the two families and those sharing a fitted part with them (a shared group's rows
+                # all fix its kappa)
+                groups = {f.shared[0] for f, _ in fams if f.name in (best_ours, best_theirs) and f.shared}
+                labels = [reference] + [lab for f, labs in fams if f.name in (best_ours, best_theirs)
+                                        or (f.shared and f.shared[0] in groups) for lab in labs]
+                more = (need - n) * sum(run_seconds.get(lab, np.nan) for lab in labels) / 3600.0
                 level_entry[f"ratio_{unit}"] = {"ours": best_ours, "theirs": best_theirs, "ratio": ratio,
-                                                "low": low, "high": high}
+                                                "low": low, "high": high, "replicas": n, "replicas_needed": need,
+                                                "core_hours_more": more if np.isfinite(more) else None}
             entry["levels"][level] = level_entry
         out[ensemble] = entry
     return out
+
+
+def _replicas(family: Family) -> int:
+    """The fewest replicas any row of ``family`` has of any observable."""
+    return int(min(np.isfinite(np.asarray(b, dtype=float)).sum(axis=1).min() for b in family.bias.values()))
 
 
 def _per_step(cost: float, step: float) -> float:
@@ -236,8 +254,24 @@ def format_frontier(summary: dict) -> str:
                     what = "force evaluations" if unit == "evals" else "wall time"
                     lines.append(f"    {r['ours']} against {r['theirs']}: {r['ratio']:.2f}x less {what} per "
                                  f"simulated ps (95 % interval {r['low']:.2f}-{r['high']:.2f})")
+                    if unit == "evals" and r.get("replicas_needed") is not None:
+                        lines.append("      " + _interval_need(r))
         lines.append("")
     return "\n".join(lines).rstrip()
+
+
+def _interval_need(r: dict) -> str:
+    """What an interval within :data:`WITHIN` of the ratio would take, in words."""
+    goal = f"an interval within +-{100 * WITHIN:g} % of the ratio"
+    if r["replicas_needed"] <= r["replicas"]:
+        return f"{goal}: reached at {r['replicas']} replicas"
+    if not np.isfinite(r["replicas_needed"]):
+        return f"{goal}: no replica count gives it (an end of the interval is infinite)"
+    cost = (f", about {r['core_hours_more']:.0f} more core-hours at the measured wall time per run"
+            if r.get("core_hours_more") is not None else "")
+    return (f"{goal}: about {r['replicas_needed']:.0f} replicas of the two families' rows, the reference and the "
+            f"families that share a fitted part with them "
+            f"(now {r['replicas']}; half-widths shrink as 1/sqrt(n)){cost}")
 
 
 def frontier_chart(summary: dict, path: str):

@@ -210,8 +210,10 @@ def summarise(cfg: dict, rows: list, grouped: dict, timings: dict | None = None,
         from .frontier import frontier_summary
 
         side = {describe(r)["label"] for r in cfg.get("side", ())}
+        run_seconds = {label: float(np.mean(w)) for label, runs in grouped.items()
+                       if (w := [i["wall_s"] for _, i in runs if i.get("wall_s")])}
         out["frontier"] = frontier_summary([e["label"] for e in table if e["label"] not in side], per, refs,
-                                           cfg["tolerances"], timings)
+                                           cfg["tolerances"], timings, run_seconds=run_seconds)
     if model and model.get("c_conf") is not None:
         from .model import bias_predictions
 
