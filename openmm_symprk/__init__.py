@@ -42,6 +42,7 @@ _LAZY = {
     "ConservationReporter": ".conservation.reporters",
     "VelocityTRRReporter": ".conservation.reporters",
     "split_forces": ".systems.forcegroups",
+    "lowered_target": ".integrators.shadow",
 }
 
 

@@ -31,10 +31,14 @@ WITHIN = 0.25
 N_BOOT = 2000
 
 
-def family_of(label: str) -> str:
-    """The family of a row: its label with the step (and the thermostat interval that follows it) left out."""
+def family_of(label: str, temperature: float = 300.0) -> str:
+    """The family of a row: its label with the step (and the thermostat interval that follows it) left out; a row
+    whose thermostat's target is not the study's ``temperature`` (lowered by the modified energy, a different
+    target at each step) is of the family "... T lowered"."""
     row = to_row(label)
-    return dataclasses.replace(row, step_fs=1.0, every=1).label.replace(" 1 fs", "", 1)
+    lowered = row.ensemble == "NVT" and row.temperature != temperature
+    name = dataclasses.replace(row, step_fs=1.0, every=1, temperature=temperature if lowered else row.temperature)
+    return name.label.replace(" 1 fs", "", 1) + (" T lowered" if lowered else "")
 
 
 def bias_order(label: str) -> int:

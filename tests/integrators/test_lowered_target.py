@@ -1,0 +1,55 @@
+"""The thermostat's target lowered by the modified energy (integrators.shadow.lowered_target)."""
+import numpy as np
+import openmm.unit as unit
+import pytest
+
+from openmm_symprk import lowered_target
+from openmm_symprk.methods.catalogue import get_method
+from openmm_symprk.methods.shadow import shadow_target
+from openmm_symprk.systems.frequencies import mean_square_frequency
+from openmm_symprk.systems.scenes import water_cluster
+
+
+@pytest.fixture(scope="module")
+def cluster():
+    return water_cluster(8)
+
+
+def test_the_target_is_lowered_by_c_t_h2_omega2(cluster):
+    """T (1 - c_T h^2 <w^2>) with <w^2> of the configurations given, c_T of omelyan-2 at the ends ("auto"), and a
+    Quantity in, a Quantity out; a larger step lowers it more, and the middle of Verlet (its "auto") differs from
+    the ends."""
+    x = np.asarray(cluster.positions)  # nm
+    omega2 = mean_square_frequency(cluster.system, [x], 300.0)["all"]
+    got = lowered_target("omelyan-2", 4 * unit.femtoseconds, cluster.system, x * unit.nanometer, 300 * unit.kelvin)
+    want = 300.0 * shadow_target(get_method("omelyan-2").splitting.steps, "ends", 0.004 ** 2 * omega2)
+    assert got.value_in_unit(unit.kelvin) == pytest.approx(want, rel=1e-12) and want < 300.0
+    assert lowered_target("omelyan-2", 0.006, cluster.system, [x, x], 300.0) < want
+    verlet = get_method("verlet").splitting.steps
+    assert lowered_target("verlet", 0.002, cluster.system, x, 300.0) == pytest.approx(
+        300.0 * shadow_target(verlet, "middle", 0.002 ** 2 * omega2), rel=1e-12)
+
+
+def test_the_studys_lowered_rows_follow_it():
+    """The fidelity study's rows with a lowered target carry T (1 - c_T h^2 <w^2>) at the water box's measured
+    <w^2> = 6.81e-3 fs^-2, to the label's 0.01 K."""
+    from openmm_symprk.studies.core.rows import Row
+    from openmm_symprk.studies.fidelity import presets
+
+    lowered = [Row.parse(lab) for lab in presets.FRONTIER_ROWS if " T " in lab]
+    assert len(lowered) >= 6
+    for row in lowered:
+        steps = get_method(row.method).splitting.steps
+        assert row.temperature == pytest.approx(300.0 * shadow_target(steps, "ends", row.step_fs ** 2 * 6.81e-3),
+                                                abs=0.011), row.label
+
+
+@pytest.mark.parametrize("kwargs, message", [
+    ({"step_size": -1.0}, "step size"),
+    ({"temperature": 0.0}, "temperature 0.0"),
+    ({"method": "gauss-2"}, "kick/drift method"),
+])
+def test_bad_input_is_named(cluster, kwargs, message):
+    args = {"method": "omelyan-2", "step_size": 0.004, "temperature": 300.0, **kwargs}
+    with pytest.raises(ValueError, match=message):
+        lowered_target(args["method"], args["step_size"], cluster.system, cluster.positions, args["temperature"])
