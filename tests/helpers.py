@@ -3,6 +3,7 @@ import os
 import re
 
 import numpy as np
+import openmm as mm
 import openmm.app as app
 import pytest
 import openmm.unit as unit
@@ -122,6 +123,20 @@ def tip4p_waters(n: int, rigid: bool):
     system = ff.createSystem(mod.topology, nonbondedMethod=app.NoCutoff, constraints=None, rigidWater=rigid,
                              removeCMMotion=False)
     return system, mod.positions
+
+
+def tip4p_cluster(n: int = 8, iterations: int = 100, as_numpy: bool = False):
+    """(system, positions, velocities) of ``n`` rigid TIP4P-Ew waters in vacuum (a massless virtual site each),
+    minimised on Reference (``iterations`` at most), velocities at 100 K with the constraints applied."""
+    system, positions = tip4p_waters(n, rigid=True)
+    ctx = mm.Context(system, mm.VerletIntegrator(0.001), mm.Platform.getPlatformByName("Reference"))
+    ctx.setPositions(positions)
+    ctx.applyConstraints(1e-10)
+    mm.LocalEnergyMinimizer.minimize(ctx, 1.0, iterations)
+    ctx.setVelocitiesToTemperature(100, 1)
+    ctx.applyVelocityConstraints(1e-10)
+    st = ctx.getState(getPositions=True, getVelocities=True)
+    return system, st.getPositions(asNumpy=as_numpy), st.getVelocities(asNumpy=as_numpy)
 
 
 def virtual_site_error(system, x) -> float:

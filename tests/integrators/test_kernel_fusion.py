@@ -24,7 +24,7 @@ import openmm as mm
 import openmm.unit as unit
 import pytest
 
-from helpers import COMMON, positions_velocities, stiff_diatomic, tip4p_waters, virtual_site_error
+from helpers import COMMON, positions_velocities, stiff_diatomic, tip4p_cluster, virtual_site_error
 from openmm_symprk import SimulationBlowUpError, SymplecticIntegrator, plugin
 from openmm_symprk.systems.forcegroups import split_forces
 
@@ -36,22 +36,13 @@ FUSE_NONE, FUSE_SEGMENTS, FUSE_ALL = 0, 1, 2
 CALLS = (7, 13)  # two step() calls, the State read after each
 
 
-def _tip4p():
-    system, positions = tip4p_waters(8, rigid=True)
-    ctx = mm.Context(system, mm.VerletIntegrator(0.001), mm.Platform.getPlatformByName("Reference"))
-    ctx.setPositions(positions)
-    ctx.applyConstraints(1e-10)
-    mm.LocalEnergyMinimizer.minimize(ctx, 1.0, 50)
-    ctx.setVelocitiesToTemperature(100, 1)
-    ctx.applyVelocityConstraints(1e-10)
-    st = ctx.getState(getPositions=True, getVelocities=True)
-    return system, st.getPositions(asNumpy=True), st.getVelocities(asNumpy=True)
+
 
 
 def _scene(name, request):
     """(System, positions, velocities)."""
     if name == "tip4p":
-        return _tip4p()
+        return tip4p_cluster(8, iterations=50, as_numpy=True)
     scene = request.getfixturevalue(name)
     return scene.system, scene.positions, scene.velocities
 

@@ -10,7 +10,7 @@ import openmm as mm
 import openmm.unit as unit
 import pytest
 
-from helpers import (counted, drift_after, evaluations, reference_context, stiff_diatomic, tip4p_waters,
+from helpers import (counted, drift_after, evaluations, reference_context, stiff_diatomic, tip4p_cluster,
                      virtual_site_error)
 from openmm_symprk import SymplecticIntegrator, catalogue
 from openmm_symprk import plugin
@@ -238,23 +238,13 @@ def test_checkpoint_continues_bitwise_on_reference(scene_name, request):
 
 
 # -- virtual sites, errors ------------------------------------------------------------------------------------------
-def _tip4p_cluster():
-    """8 rigid TIP4P-Ew waters in vacuum (a massless virtual site each), minimized on Reference."""
-    system, positions = tip4p_waters(8, rigid=True)
-    ctx = mm.Context(system, mm.VerletIntegrator(0.001), mm.Platform.getPlatformByName("Reference"))
-    ctx.setPositions(positions)
-    ctx.applyConstraints(1e-10)
-    mm.LocalEnergyMinimizer.minimize(ctx, 1.0, 100)
-    ctx.setVelocitiesToTemperature(100, 1)
-    ctx.applyVelocityConstraints(1e-10)
-    st = ctx.getState(getPositions=True, getVelocities=True)
-    return system, st.getPositions(), st.getVelocities()
+
 
 
 def _run_tip4p(method, platform, properties, blocks):
     """The TIP4P cluster run natively by ``method`` in ``blocks`` blocks of 40 steps of 1 fs, the virtual sites
     checked after each (placed to 1e-12 nm): (integrator, context, total energy after each block)."""
-    system, pos, vel = _tip4p_cluster()
+    system, pos, vel = tip4p_cluster()
     ig = N(1 * unit.femtoseconds, method, system=system)
     ctx = mm.Context(system, ig, mm.Platform.getPlatformByName(platform), properties)
     ctx.setPositions(pos)
