@@ -36,7 +36,7 @@ MODULES = _modules()
 
 def _imports(name, path):
     """(target module, imported names, lazy?) for every import of the package inside ``name``."""
-    tree = ast.parse(open(path).read())
+    tree = ast.parse(open(path, encoding="utf-8").read())
     is_pkg = path.endswith("__init__.py")
     top_level = {id(n) for n in tree.body}
     found = []
@@ -126,7 +126,7 @@ def test_no_private_names_imported_across_modules():
 def test_pure_numerics_do_not_import_openmm(package):
     for name, path in MODULES.items():
         if name.split(".")[1:2] == [package]:
-            tree = ast.parse(open(path).read())
+            tree = ast.parse(open(path, encoding="utf-8").read())
             for node in ast.walk(tree):
                 mods = [a.name for a in node.names] if isinstance(node, ast.Import) else (
                     [node.module or ""] if isinstance(node, ast.ImportFrom) and not node.level else [])
@@ -211,7 +211,7 @@ def test_the_library_tests_do_not_import_the_studies():
                 path = os.path.join(folder, f)
                 read += 1
                 wrong += [f"{os.path.relpath(path, TESTS)}:{line} imports {m}"
-                          for line, m in _study_imports(ast.parse(open(path).read()))]
+                          for line, m in _study_imports(ast.parse(open(path, encoding="utf-8").read()))]
     assert not wrong, "\n".join(wrong)
     assert read > 50  # the walk saw the library's tests
     # and the rule sees an import where there is one
@@ -305,7 +305,7 @@ def test_nothing_in_the_package_scans_the_python_heap():
     """No module finds an object by walking the Python heap (the integrators once found their Context so, at a cost
     that grows with everything the process holds): what an object needs, it is given or keeps."""
     wrong = [f"{path}:{line}: {call}" for name, path in MODULES.items()
-             for line, call in _heap_scans(ast.parse(open(path).read()))]
+             for line, call in _heap_scans(ast.parse(open(path, encoding="utf-8").read()))]
     assert not wrong, "\n".join(wrong)
     # and the rule sees a scan where there is one
     assert _heap_scans(ast.parse("import gc\nfound = [o for o in gc.get_objects() if o]"))

@@ -232,7 +232,7 @@ def _write_json(target: str, stream: bool, data: dict) -> None:
     tmp = os.path.join(os.path.dirname(target), f".{os.path.basename(target)}.{os.getpid()}.tmp")
     try:
         if stream:
-            with open(target, "w") as fh:
+            with open(target, "w", encoding="utf-8") as fh:
                 fh.write(text)
             return
         with open(tmp, "x") as fh:

@@ -285,5 +285,5 @@ def write_topology(path: str, topology: app.Topology, positions) -> None:
     """Write the PDB file that MDAnalysis pairs with a trajectory (``positions`` in nm or a Quantity)."""
     if not unit.is_quantity(positions):
         positions = np.asarray(positions) * unit.nanometer
-    with open(path, "w") as fh:
+    with open(path, "w", encoding="utf-8") as fh:
         app.PDBFile.writeFile(topology, positions, fh, keepIds=True)

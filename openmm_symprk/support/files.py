@@ -33,7 +33,7 @@ def jsonable(obj):
 def write_text(path: str, text: str):
     """Write ``text`` to a temporary name, then rename."""
     tmp = f"{path}.tmp{os.getpid()}"
-    with open(tmp, "w") as fh:
+    with open(tmp, "w", encoding="utf-8") as fh:
         fh.write(text)
     os.replace(tmp, path)
 

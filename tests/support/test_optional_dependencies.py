@@ -101,7 +101,7 @@ def _sources():
         for f in files:
             if f.endswith(".py") and f != "symprk_swig.py":
                 path = os.path.join(folder, f)
-                yield os.path.relpath(path, REPO), ast.parse(open(path).read())
+                yield os.path.relpath(path, REPO), ast.parse(open(path, encoding="utf-8").read())
 
 
 def test_optional_packages_are_imported_only_through_require():

@@ -310,6 +310,26 @@ bool CommonIntegrateSymPRKStepKernel::canFuseAcross(const SymPRKStepPlan& plan, 
     return ops[next].kind == SymPRKStepPlan::Drift && lastDrift >= 0 && fabs(ops[next].coefficient) <= fabs(ops[lastDrift].coefficient);
 }
 
+bool CommonIntegrateSymPRKStepKernel::canSkipClosingProjection(const SymPRKStepPlan& plan) const {
+    // A step that ends on a velocity projection after its last drift (the middle placement, position Verlet), where
+    // the next step begins with kicks and then a constrained drift: the kicks add to the velocities at the same
+    // positions, and the drift's position projection acts along the directions the velocity projection would remove,
+    // so it absorbs what was left (the same positions and velocities after it; canFuseAcross states the rule).  The
+    // projection then runs once, at the call's end, where the State is read.  The drift must be no larger than the
+    // step's last one (the constraint solver's residual) and nothing may read the velocities in between.
+    if (fusion == SymPRKIntegrator::FuseNone || !stepsAreSeparable)
+        return false;
+    const vector<SymPRKStepPlan::Operation>& ops = plan.getOperations();
+    const int n = ops.size();
+    if (n < 2 || ops[n-1].kind != SymPRKStepPlan::ProjectVelocities || ops[n-2].kind != SymPRKStepPlan::Drift)
+        return false;
+    int next = 0;
+    while (next < n && ops[next].kind == SymPRKStepPlan::Kick)
+        next++;
+    return next < n-1 && ops[next].kind == SymPRKStepPlan::Drift
+        && fabs(ops[next].coefficient) <= fabs(ops[n-2].coefficient);
+}
+
 void CommonIntegrateSymPRKStepKernel::execute(ContextImpl& context, const SymPRKIntegrator& integrator, const SymPRKStepPlan& plan,
         bool& forcesAreValid, long long stepIndex, bool nextStepFollows) {
     ContextSelector selector(cc);
@@ -344,7 +364,12 @@ void CommonIntegrateSymPRKStepKernel::execute(ContextImpl& context, const SymPRK
             head++;
     }
     reorderedThisStep = false;
+    const bool skipClosing = (nextStepFollows && !across && canSkipClosingProjection(plan));
     for (int k = first; k < n; k++) {
+        if (skipClosing && k == n-1) {
+            trace.record(stepIndex, k, 0);  // absorbed by the next step's first drift (canSkipClosingProjection)
+            continue;
+        }
         if (k > tail) {
             // left out by the fusion across steps: a projection (the trace keeps it, as the plan's), or an event that
             // does not run in this step

@@ -98,6 +98,7 @@ private:
     void setForceSlotArgs(OpenMM::ComputeKernel& kernel, int base, const std::vector<OpenMM::ArrayInterface*>& slots);
     /** Whether this step's last kick and the next step's first may be one launch (see the class comment). */
     bool canFuseAcross(const SymPRKStepPlan& plan, long long stepIndex) const;
+    bool canSkipClosingProjection(const SymPRKStepPlan& plan) const;
     /** Run operation k of the plan as part of step stepIndex (recorded in the trace as such). */
     void runOperation(OpenMM::ContextImpl& context, const SymPRKIntegrator& integrator, const SymPRKStepPlan& plan, int k,
                       long long stepIndex, bool& forcesAreValid);

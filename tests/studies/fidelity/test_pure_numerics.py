@@ -15,7 +15,7 @@ def test_no_openmm_import_in_the_observables(folder):
     found = []
     for name in sorted(os.listdir(folder)):
         if name.endswith(".py"):
-            tree = ast.parse(open(os.path.join(folder, name)).read())
+            tree = ast.parse(open(os.path.join(folder, name), encoding="utf-8").read())
             for node in ast.walk(tree):
                 mods = [a.name for a in node.names] if isinstance(node, ast.Import) else (
                     [node.module or ""] if isinstance(node, ast.ImportFrom) and not node.level else [])
