@@ -271,7 +271,7 @@ def _interval_need(r: dict) -> str:
         return f"{goal}: reached at {r['replicas']} replicas"
     if not np.isfinite(r["replicas_needed"]):
         return f"{goal}: no replica count gives it (an end of the interval is infinite)"
-    cost = (f", about {r['core_hours_more']:.0f} more core-hours at the measured wall time per run"
+    cost = (f", about {r['core_hours_more']:.1f} more core-hours at the measured wall time per run"
             if r.get("core_hours_more") is not None else "")
     return (f"{goal}: about {r['replicas_needed']:.0f} replicas of the two families' rows, the reference and the "
             f"families that share a fitted part with them "
