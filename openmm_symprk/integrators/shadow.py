@@ -18,13 +18,24 @@ from ..support.errors import InputError
 from ..systems.frequencies import mean_square_frequency
 from .base import step_size_in_ps
 
-__all__ = ["lowered_target"]
+__all__ = ["lowered_target", "LoweredTargetWarning", "WARN_ABOVE", "REFUSE_ABOVE"]
+
+#: Relative lowerings above which the first-order correction is doubtful (a warning) or meaningless (an error): in
+#: water the method's steps lower 300 K by 0.1-1 % (Verlet at 3 fs: 1.0 %); unequilibrated configurations (large
+#: forces) or a step near the stability limit give far more.
+WARN_ABOVE, REFUSE_ABOVE = 0.02, 0.05
+
+
+class LoweredTargetWarning(UserWarning):
+    """The lowered target is more than :data:`WARN_ABOVE` below the temperature asked for."""
 
 
 def lowered_target(method: str, step_size, system, configurations, temperature, thermostat_position: str = "auto"):
     """The target temperature that makes ``method`` at ``step_size`` with the thermostat at ``thermostat_position``
     sample ``system``'s configurations at ``temperature`` (module docstring).  ``configurations``: positions (nm,
-    or a list of them) from an equilibrated run, over which <w^2> is averaged.  Returns a Quantity in kelvin where
+    or a list of them) from an equilibrated run, over which <w^2> is averaged (not a builder's positions, whose forces
+    are large, nor minimised ones, whose forces are nearly zero: a lowering beyond :data:`REFUSE_ABOVE` is refused,
+    one beyond :data:`WARN_ABOVE` warns).  Returns a Quantity in kelvin where
     ``temperature`` is one, else kelvin as a float."""
     h = step_size_in_ps(step_size)
     kelvin = temperature.value_in_unit(unit.kelvin) if unit.is_quantity(temperature) else float(temperature)
@@ -38,7 +49,21 @@ def lowered_target(method: str, step_size, system, configurations, temperature, 
     position = thermostat_position_for(resolved, thermostat_position)
     configurations = _in_nm(configurations)
     omega2 = mean_square_frequency(system, configurations, kelvin)["all"]  # 1/ps^2
-    lowered = kelvin * shadow_target(resolved.splitting.steps, position, h * h * omega2)
+    factor = shadow_target(resolved.splitting.steps, position, h * h * omega2)
+    what = (f"lowered_target({method!r}, {h * 1000:g} fs): the configurations' <w^2> = {omega2:.4g} ps^-2 lowers "
+            f"{kelvin:g} K by {100 * (1 - factor):.2f} %")
+    if abs(1 - factor) > REFUSE_ABOVE:
+        raise InputError(f"{what}, beyond the {100 * REFUSE_ABOVE:g} % where a first-order correction means anything: "
+                         f"give configurations from an equilibrated run (a builder's positions carry large forces, "
+                         f"minimised ones almost none: both misstate <w^2>), "
+                         f"or a smaller step (in water the method's usable steps lower it by 0.1-1 %)")
+    if abs(1 - factor) > WARN_ABOVE:
+        import warnings
+
+        warnings.warn(f"{what}: more than {100 * WARN_ABOVE:g} %, where the first-order correction is doubtful; check "
+                      f"that the configurations are equilibrated and the step well inside the method's stability",
+                      LoweredTargetWarning, stacklevel=2)
+    lowered = kelvin * factor
     return lowered * unit.kelvin if unit.is_quantity(temperature) else lowered
 
 
@@ -51,6 +76,9 @@ def _in_nm(configurations) -> list:
         return np.asarray(x.value_in_unit(unit.nanometer) if unit.is_quantity(x) else
                           [v.value_in_unit(unit.nanometer) if unit.is_quantity(v) else v for v in x], dtype=float)
 
+    if not unit.is_quantity(configurations) and not len(configurations):
+        raise InputError("lowered_target: no configuration given; pass the positions of an equilibrated run (one set "
+                         "of positions, or a list of them)")
     one = nm(configurations) if unit.is_quantity(configurations) else None
     if one is None:
         first = nm(configurations[0])

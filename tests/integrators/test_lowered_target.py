@@ -53,3 +53,24 @@ def test_bad_input_is_named(cluster, kwargs, message):
     args = {"method": "omelyan-2", "step_size": 0.004, "temperature": 300.0, **kwargs}
     with pytest.raises(ValueError, match=message):
         lowered_target(args["method"], args["step_size"], cluster.system, cluster.positions, args["temperature"])
+
+
+def test_unequilibrated_configurations_are_refused_and_a_large_lowering_warns(cluster):
+    """Positions straight from a builder carry large forces: <w^2> then lowers the target by far more than the
+    first-order correction can mean (refused, naming the per cent and what to pass); between 2 and 5 % it warns."""
+    from openmm_symprk.integrators.shadow import LoweredTargetWarning, REFUSE_ABOVE, WARN_ABOVE
+    from openmm_symprk.systems.scenes import water_box
+
+    system, _, raw = water_box("spce", n_waters=64, cutoff_nm=0.6)  # Modeller's positions: not minimised
+    with pytest.raises(ValueError, match=r"lowers 300 K by 1\d\.\d\d %.*equilibrated run"):
+        lowered_target("omelyan-2", 0.005, system, raw, 300.0)
+    x = np.asarray(cluster.positions)
+    omega2 = mean_square_frequency(cluster.system, [x], 300.0)["all"]
+    steps = get_method("verlet").splitting.steps
+    # a step whose lowering (Verlet's middle: c_T = -1/12 raises it; the ends: 1/6) lies between the two bounds
+    h = (0.5 * (WARN_ABOVE + REFUSE_ABOVE) / (omega2 / 6.0)) ** 0.5
+    assert WARN_ABOVE < 1 - shadow_target(steps, "ends", h * h * omega2) < REFUSE_ABOVE
+    with pytest.warns(LoweredTargetWarning, match="doubtful"):
+        lowered_target("verlet", h, cluster.system, x, 300.0, thermostat_position="ends")
+    with pytest.raises(ValueError, match="no configuration given"):
+        lowered_target("omelyan-2", 0.004, cluster.system, [], 300.0)
