@@ -12,13 +12,12 @@ System's constraint facts and checks the System against it (warning about what b
 for: an NVT run's periodic box and CMMotionRemover are not warned about), and warns once where the step is beyond what
 the method was measured to run on a System of its kind (:mod:`openmm_symprk.systems.step_limits`), and where
 ``thermostat_position="middle"`` was asked for a method whose middle samples worse than its ends
-(:func:`openmm_symprk.methods.placement.middle_placement_advice`).
+(:func:`openmm_symprk.methods.resolved.placement_advice`).
 """
 from __future__ import annotations
 
 from .. import plugin
-from ..methods.placement import middle_placement_advice
-from ..methods.resolved import ConstraintSupportError, ResolvedMethod, resolve
+from ..methods.resolved import ConstraintSupportError, ResolvedMethod, placement_advice, resolve
 from ..systems.checks import validate_system, warn_once
 from ..systems.forcegroups import check_groups
 from ..systems.step_limits import warn_step_limit
@@ -72,10 +71,9 @@ def resolve_for_system(where: str, method, system, options: IntegratorOptions, n
         raise NativeMethodError(
             f"method {resolved.name!r} is a general ({resolved.family or resolved.form}) PRK tableau; "
             f"{splittings_only}")
-    if thermostat is not None and thermostat.position == "middle" and resolved.is_splitting and not resolved.is_mts:
-        advice = middle_placement_advice(resolved.name, resolved.splitting.steps, resolved.stability)
-        if advice is not None:
-            warn_once(f"placement-middle-{resolved.name}", f"{where}({resolved.name}): {advice}", PlacementWarning)
+    advice = placement_advice(resolved, position)
+    if advice is not None:
+        warn_once(f"placement-middle-{resolved.name}", f"{where}({resolved.name}): {advice}", PlacementWarning)
     if system is not None:
         validate_system(system, f"{where}({resolved.name})", options.exact_momentum, skip=skip_checks,
                         thermostat=thermostat is not None)

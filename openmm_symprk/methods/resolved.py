@@ -38,13 +38,14 @@ from fractions import Fraction
 import numpy as np
 
 from .catalogue import Method, get_method
-from .placement import THERMOSTAT, best_position, centre, check_position
+from .placement import THERMOSTAT, best_position, centre, check_position, middle_placement_advice
 from .respa import MTSError, evaluations_per_step, label_groups, levels, mts_groups, respa
 from .splitting import DRIFT, KICK, Splitting, evaluating_kicks
 from .tableau import PRKTableau, TableauError
 from ..support.errors import InputError
 
-__all__ = ["resolve", "thermostat_position_for", "placement_of", "method_steps", "ResolvedMethod", "Substep",
+__all__ = ["resolve", "thermostat_position_for", "placement_of", "placement_advice", "method_steps", "ResolvedMethod",
+           "Substep",
            "substep_label",
            "SubstepKind", "SubstepFlag", "EventPhase", "ConstraintSupportError", "projected_drifts", "FORMS"]
 
@@ -366,6 +367,15 @@ def _with_end_events(substeps: tuple) -> tuple:
     half = Fraction(1, 2)
     return (Substep(SubstepKind.THERMOSTAT, half, phase=EventPhase.FIRST), *substeps,
             Substep(SubstepKind.THERMOSTAT, half, phase=EventPhase.LAST))
+
+
+def placement_advice(resolved: ResolvedMethod, position: str | None) -> str | None:
+    """Why the thermostat placement asked for (``position``) is the worse one for ``resolved``, or None: only
+    ``"middle"`` on a splitting on one time scale whose middle samples worse than its ends can be
+    (:func:`.placement.middle_placement_advice`); the backends warn with it."""
+    if position != "middle" or not resolved.is_splitting or resolved.is_mts:
+        return None
+    return middle_placement_advice(resolved.name, resolved.splitting.steps, resolved.stability)
 
 
 def thermostat_position_for(resolved: ResolvedMethod, position: str) -> str:

@@ -30,20 +30,6 @@ def test_the_target_is_lowered_by_c_t_h2_omega2(cluster):
         300.0 * shadow_target(verlet, "middle", 0.002 ** 2 * omega2), rel=1e-12)
 
 
-def test_the_studys_lowered_rows_follow_it():
-    """The fidelity study's rows with a lowered target carry T (1 - c_T h^2 <w^2>) at the water box's measured
-    <w^2> = 6.81e-3 fs^-2, to the label's 0.01 K."""
-    from openmm_symprk.studies.core.rows import Row
-    from openmm_symprk.studies.fidelity import presets
-
-    lowered = [Row.parse(lab) for lab in presets.FRONTIER_ROWS if " T " in lab]
-    assert len(lowered) >= 6
-    for row in lowered:
-        steps = get_method(row.method).splitting.steps
-        assert row.temperature == pytest.approx(300.0 * shadow_target(steps, "ends", row.step_fs ** 2 * 6.81e-3),
-                                                abs=0.011), row.label
-
-
 @pytest.mark.parametrize("kwargs, message", [
     ({"step_size": -1.0}, "step size"),
     ({"temperature": 0.0}, "temperature 0.0"),

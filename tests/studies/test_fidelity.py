@@ -583,3 +583,19 @@ def test_the_match_3se_preset_is_named_for_what_it_measures_and_reads_its_former
     assert main(["--preset", "issue26", "--out", str(tmp_path / "new"), "--no-progress"]) == 2
     err = capsys.readouterr().err.splitlines()
     assert len(err) == 2 and "the match-3se study is kept as it ran" in err[1] and not (tmp_path / "new").exists()
+
+
+def test_the_studys_lowered_rows_follow_it():
+    """The fidelity study's rows with a lowered target carry T (1 - c_T h^2 <w^2>) at the water box's measured
+    <w^2> = 6.81e-3 fs^-2, to the label's 0.01 K."""
+    from openmm_symprk.methods.catalogue import get_method
+    from openmm_symprk.methods.shadow import shadow_target
+    from openmm_symprk.studies.core.rows import Row
+    from openmm_symprk.studies.fidelity import presets
+
+    lowered = [Row.parse(lab) for lab in presets.FRONTIER_ROWS if " T " in lab]
+    assert len(lowered) >= 6
+    for row in lowered:
+        steps = get_method(row.method).splitting.steps
+        assert row.temperature == pytest.approx(300.0 * shadow_target(steps, "ends", row.step_fs ** 2 * 6.81e-3),
+                                                abs=0.011), row.label

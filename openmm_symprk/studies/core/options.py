@@ -44,15 +44,15 @@ def add_study_arguments(ap, *, quick: str, out: str | None, workers: str, length
     --scheduler, --replicas, --length-ps, --no-timing (with ``timing``), --no-progress and --report-only."""
     ap.add_argument("--quick", action="store_true", help=quick)
     ap.add_argument("--out", default=out, help=f"output folder (default {out_help or out}; finished runs are reused)")
-    ap.add_argument("--workers", type=int, default=default_workers, help=workers)
+    ap.add_argument("--workers", type=int, default=default_workers, help=f"{workers} (default %(default)s)")
     ap.add_argument("--scheduler", metavar="ADDRESS",
                     help="Dask distributed scheduler address (e.g. tcp://host:8786) instead of local workers; "
                          "needs the 'cluster' extra")
-    ap.add_argument("--replicas", type=int, default=None, help="independent replicas per row")
-    ap.add_argument("--length-ps", type=float, default=None, help=length)
+    ap.add_argument("--replicas", type=int, default=None, help="independent replicas per row (default: the study's)")
+    ap.add_argument("--length-ps", type=float, default=None, help=f"{length} (default: the study's)")
     if timing:
         ap.add_argument("--no-timing", action="store_true", help="skip the wall-time measurement in turns")
-    ap.add_argument("--no-progress", action="store_true")
+    ap.add_argument("--no-progress", action="store_true", help="no progress bar (for logs and scripts)")
     ap.add_argument("--report-only", action="store_true",
                     help="run nothing: summarise the finished runs in --out (a study still running, or rows run "
                          "with fewer replicas); the planned runs not finished are left out and counted")

@@ -35,9 +35,10 @@ def build_parser(prog: str = "symprk fidelity"):
     ap.add_argument("--model", choices=("spce", "tip3p"), default=None,
                     help="water model (default spce); its replica states and runs are kept apart")
     ap.add_argument("--preset", type=preset_name, choices=sorted(presets.PRESETS), default="match-3se",
-                    help="the study: match-3se (each row against Verlet at 0.5 fs, every observable within 3 standard "
-                         "errors; kept as it ran: --report-only remakes its report) or frontier (equal-accuracy costs "
-                         "with intervals, NVT rows paired by common random numbers)")
+                    help="the study (default match-3se): match-3se (each row against Verlet at 0.5 fs, every "
+                         "observable within 3 standard errors; kept as it ran: --report-only remakes its report) or "
+                         "frontier (the cost of each family at equal accuracy, with intervals: docs/fidelity.md's "
+                         "answer)")
     return ap
 
 
