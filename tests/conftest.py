@@ -1,5 +1,10 @@
+import locale
+
 import openmm as mm
 import pytest
+
+#: The character type the interpreter took from the environment (C.UTF-8 here).
+CTYPE = locale.setlocale(locale.LC_CTYPE)
 
 
 def platform_available(name: str) -> bool:
@@ -8,6 +13,14 @@ def platform_available(name: str) -> bool:
         return True
     except Exception:
         return False
+
+
+def pytest_runtest_setup(item):
+    """A C library a test loads may set the C locale's character type to "C" (seen on this machine in long runs of
+    the suite, not in a shorter one): Python's text files and pipes then read as ASCII. Every test starts with the
+    character type the interpreter started with."""
+    if locale.setlocale(locale.LC_CTYPE) != CTYPE:
+        locale.setlocale(locale.LC_CTYPE, CTYPE)
 
 
 @pytest.fixture(autouse=True)
