@@ -161,6 +161,9 @@ def native_skip_reason():
 #: regression fails instead of hiding behind a probe.
 BACKENDS = ["custom", pytest.param("native", marks=pytest.mark.skipif(
     native_skip_reason() is not None, reason=str(native_skip_reason())))]
+#: The same, for the long runs of a water box (10-25 s each): the custom backend's is marked slow (.ci/run runs it
+#: after the suite), the native one stays in the suite.
+BACKENDS_LONG = [pytest.param("custom", marks=pytest.mark.slow), BACKENDS[1]]
 
 
 def context(system, integrator, x, v, platform="Reference", properties=None):

@@ -13,7 +13,7 @@ import openmm.app as app
 import openmm.unit as unit
 import pytest
 
-from helpers import BACKENDS, context
+from helpers import BACKENDS, BACKENDS_LONG, context
 from openmm_symprk import SymplecticIntegrator, plugin
 from openmm_symprk.integrators import deserialize
 from openmm_symprk.integrators import thermostat_program as tp
@@ -391,7 +391,7 @@ def _water_box_run(backend, system, x, steps, seed=5, platform="CPU", equilibrat
     return ig, rec, sdr_out.getvalue(), sim.reporters[2], system
 
 
-@pytest.mark.parametrize("backend", BACKENDS)
+@pytest.mark.parametrize("backend", BACKENDS_LONG)
 def test_water_box_temperature_and_kinetic_energy_are_canonical(backend, equilibrated_box):
     """64 rigid waters (PME), equilibrated, collision time 0.05 ps, 8 ps sampled every 20 fs: <T> of the peculiar
     kinetic energy within 3 standard errors of 300 K, the mean and variance of K within 3 standard errors of
@@ -454,7 +454,7 @@ def test_state_data_reporter_prints_the_thermostats_temperature(backend, equilib
         assert abs(d.mean) < 0.5 and d.se < 0.1, d
 
 
-@pytest.mark.parametrize("backend", BACKENDS)
+@pytest.mark.parametrize("backend", BACKENDS_LONG)
 def test_npt_with_monte_carlo_barostat(backend, npt_box):
     """MonteCarloBarostat (1 bar, every 5 steps) with the thermostat (collision time 0.02 ps) on the PME box, from
     a state equilibrated at 300 K and 1 bar: the volume moves and <T> over 4 ps is within 3 standard errors (from
@@ -522,7 +522,7 @@ def test_isolated_cluster_keeps_momentum_and_angular_momentum(backend, cluster, 
     assert np.max(np.abs(np.sum(r * dv, axis=1)) / (np.linalg.norm(r, axis=1) * np.linalg.norm(dv, axis=1))) < 1e-6
 
 
-@pytest.mark.parametrize("backend", BACKENDS)
+@pytest.mark.parametrize("backend", BACKENDS_LONG)
 def test_effective_energy_drift_equals_the_nve_drift(backend):
     """27 rigid waters in vacuum, equilibrated at 300 K (2 ps of Langevin dynamics), omelyan-2 at 2 fs: eight
     independent 2-ps replicas (Maxwell-Boltzmann velocities of their own seed) of NVE and of NVT at 300 K.  (In

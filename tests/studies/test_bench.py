@@ -103,7 +103,7 @@ def test_interrupted_sweep_continues_and_loses_nothing(tmp_path):
 def test_harmonic_stability_reproduces_catalogue_intervals():
     """Bisection on the harmonic toy (the compiled OpenMM programs) against the catalogue's intervals, within 1 %."""
     scene = scenes.build("harmonic", n=8)
-    settings = stability.linear_settings(scene.linear["omega_max"], rel_tol=1e-3)
+    settings = stability.linear_settings(scene.linear["omega_max"], rel_tol=3e-3)  # the bracket within 0.3 %
     checked = []
     for name in ["openmm-verlet"] + [m.name for m in methods.values()]:
         cat = stability.catalogue_stability(name)
