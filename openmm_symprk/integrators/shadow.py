@@ -16,6 +16,7 @@ from ..methods.resolved import resolve, thermostat_position_for
 from ..methods.shadow import shadow_target
 from ..support.errors import InputError
 from ..systems.frequencies import mean_square_frequency
+from ..systems.prepare import positions_nm
 from .base import step_size_in_ps
 
 __all__ = ["lowered_target", "LoweredTargetWarning", "WARN_ABOVE", "REFUSE_ABOVE"]
@@ -68,22 +69,16 @@ def lowered_target(method: str, step_size, system, configurations, temperature, 
 
 
 def _in_nm(configurations) -> list:
-    """``configurations`` (one set of positions, or several; Quantities or numbers in nm) as a list of (N, 3)
-    arrays in nm."""
+    """``configurations`` (one set of positions, or a list of them; Quantities or numbers in nm) as a list of (N, 3)
+    arrays in nm (:func:`openmm_symprk.systems.prepare.positions_nm` each)."""
     import numpy as np
 
-    def nm(x):
-        return np.asarray(x.value_in_unit(unit.nanometer) if unit.is_quantity(x) else
-                          [v.value_in_unit(unit.nanometer) if unit.is_quantity(v) else v for v in x], dtype=float)
-
-    if not unit.is_quantity(configurations) and not len(configurations):
+    if unit.is_quantity(configurations):
+        return [positions_nm(configurations)]
+    if not len(configurations):
         raise InputError("lowered_target: no configuration given; pass the positions of an equilibrated run (one set "
                          "of positions, or a list of them)")
-    one = nm(configurations) if unit.is_quantity(configurations) else None
-    if one is None:
-        first = nm(configurations[0])
-        if first.ndim == 1:  # a list of positions: one configuration
-            one = nm(configurations)
-    if one is not None:
-        return [one.reshape(-1, 3)]
-    return [nm(x).reshape(-1, 3) for x in configurations]
+    first = configurations[0]
+    if np.ndim(first.value_in_unit(unit.nanometer) if unit.is_quantity(first) else first) <= 1:
+        return [positions_nm(configurations)]  # one configuration: a list of positions
+    return [positions_nm(x) for x in configurations]

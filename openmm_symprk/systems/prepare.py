@@ -11,7 +11,8 @@ from ..physics.temperature import R_KJ
 from .properties import has_constraints, masses
 from ..support.errors import InputError
 
-__all__ = ["minimise", "constrain_velocities", "maxwell_boltzmann", "equilibrate", "without_net_momentum", "R_KJ"]
+__all__ = ["positions_nm", "minimise", "constrain_velocities", "maxwell_boltzmann", "equilibrate", "without_net_momentum",
+           "R_KJ"]
 
 
 def _context(system, platform="Reference", properties=None):
@@ -19,7 +20,8 @@ def _context(system, platform="Reference", properties=None):
     return mm.Context(system, mm.VerletIntegrator(0.001), plat, properties or {})
 
 
-def _nm(positions) -> np.ndarray:
+def positions_nm(positions) -> np.ndarray:
+    """One set of positions (a Quantity, a list of Vec3 or of triples in nm, an array) as an (N, 3) array in nm."""
     if unit.is_quantity(positions):
         positions = positions.value_in_unit(unit.nanometer)
     return np.array([[float(c) for c in p] for p in positions]) if not isinstance(positions, np.ndarray) \
@@ -33,7 +35,7 @@ def minimise(system: mm.System, positions, platform="Reference", tolerance: floa
     to the Context's constraint tolerance, OpenMM's default 1e-5 relative)."""
     ctx = _context(system, platform, properties)
     try:
-        ctx.setPositions(_nm(positions))
+        ctx.setPositions(positions_nm(positions))
         if has_constraints(system):
             ctx.applyConstraints(1e-10)
         mm.LocalEnergyMinimizer.minimize(ctx, tolerance, max_iterations)
@@ -48,7 +50,7 @@ def constrain_velocities(system: mm.System, positions, velocities, tolerance: fl
         return np.asarray(velocities, dtype=np.float64)
     ctx = _context(system)
     try:
-        ctx.setPositions(_nm(positions))
+        ctx.setPositions(positions_nm(positions))
         ctx.setVelocities(np.asarray(velocities, dtype=np.float64))
         ctx.applyVelocityConstraints(tolerance)
         return np.array(ctx.getState(getVelocities=True).getVelocities(asNumpy=True).value_in_unit(
@@ -64,7 +66,7 @@ def maxwell_boltzmann(system: mm.System, positions, temperature: float, seed: in
     Massless particles get zero velocity.  ``seed``: an int, or a numpy Generator to draw from."""
     rng = np.random.default_rng(seed)
     m = masses(system)
-    x = _nm(positions)
+    x = positions_nm(positions)
     kT = R_KJ * temperature
     v = without_net_momentum(rng.normal(size=(len(m), 3)) * np.sqrt(kT / np.where(m > 0, m, 1.0))[:, None], m)
     if angular_velocity is not None:
@@ -101,7 +103,7 @@ def equilibrate(system: mm.System, positions, temperature: float, picoseconds: f
     plat = mm.Platform.getPlatformByName(platform) if isinstance(platform, str) else platform
     ctx = mm.Context(system, integrator, plat, properties or {})
     try:
-        x = _nm(positions)
+        x = positions_nm(positions)
         ctx.setPositions(x)
         ctx.setVelocities(maxwell_boltzmann(system, x, temperature, seed))
         integrator.step(max(0, int(round(picoseconds * 1000.0 / step_fs))))
