@@ -167,6 +167,64 @@ def test_an_interrupted_study_runs_only_what_is_missing(quick, tmp_path):
     assert os.path.exists(lost) and len(glob.glob(os.path.join(copy_, "runs", "*.json"))) == stored
 
 
+def test_rows_given_more_replicas_run_replica_by_replica_and_report_their_own_count(quick, tmp_path):
+    """``row_replicas`` gives some rows more replicas than the others: the plan holds them, ordered replica by replica
+    (a study stopped part way leaves every row within one replica of the others), a call runs only the missing
+    ones, and the report counts each row's own replicas."""
+    import shutil
+
+    from openmm_symprk.studies.fidelity.simulation.study import FidelityStudy
+
+    _, out, _ = quick
+    copy_ = str(tmp_path / "copy")
+    shutil.copytree(out, copy_, ignore=shutil.ignore_patterns(".lock"))
+    cfg = presets.quick()
+    more = cfg["rows"][5]
+    cfg["row_replicas"] = {more: 3, cfg["rows"][0]: 3}
+    study = FidelityStudy(cfg, copy_, workers=1, timing=False, progress=False, log=lambda *a: None)
+    study.store = study.open_store()
+    planned = study.plan()
+    assert len(planned) == len(cfg["rows"]) * 2 + 2
+    by_turn = sorted(planned, key=lambda run: -run.cost)  # the scheduler takes the costliest first
+    assert [run.meta["replica"] for run in by_turn] == sorted(run.meta["replica"] for run in planned)
+    assert {run.meta["row"] for run in planned if run.meta["replica"] == 2} == {label(more), label(cfg["rows"][0])}
+    logs = []
+    summary = run_study(cfg, copy_, workers=1, timing=False, progress=False, log=logs.append)
+    n = len(cfg["rows"]) * 2
+    assert any(f"reusing {n} finished runs" in line for line in logs), logs
+    counts = {r["label"]: r["replicas"] for r in summary["rows"]}
+    assert counts[label(more)] == 3 and all(c == 2 for lab, c in counts.items()
+                                             if lab not in (label(more), label(cfg["rows"][0])))
+
+
+@pytest.mark.parametrize("given, message", [({"verlet 9 fs": 3}, "row_replicas names 'verlet 9 fs', which is not among"),
+                                            ({"verlet 0.5 fs": 0}, r"row_replicas\['verlet 0.5 fs'\] must be an integer >= 1, got 0"),
+                                            ({"verlet 0.5 fs": 2.5}, "must be an integer >= 1, got 2.5")])
+def test_bad_per_row_replica_counts_are_refused_naming_the_row(given, message):
+    from openmm_symprk.studies.fidelity.simulation.study import check
+
+    cfg = presets.quick()
+    cfg["row_replicas"] = given
+    with pytest.raises(ValueError, match=message):
+        check(cfg)
+
+
+def test_rows_chosen_keep_their_counts_and_replicas_given_set_them_aside():
+    """--rows keeps the preset's per-row counts of the chosen rows; --replicas N gives every row N."""
+    from openmm_symprk.studies.fidelity.cli import choose_rows
+    from openmm_symprk.studies.fidelity.simulation.study import check, replica_counts
+
+    cfg = presets.frontier()
+    choose_rows(cfg, "langevin 2 fs friction 1/ps", None)
+    counts = replica_counts(cfg, check(cfg))
+    assert counts == {"verlet 0.5 fs": 12, "verlet 0.5 fs SVR 0.1 ps every 24": presets.FRONTIER_NVT_REPLICAS,
+                      "langevin 2 fs friction 1/ps": presets.FRONTIER_NVT_REPLICAS}
+    cfg = presets.frontier()
+    choose_rows(cfg, "deciding", 8)
+    cfg["replicas"] = 8
+    assert set(replica_counts(cfg, check(cfg)).values()) == {8}
+
+
 # -- the summary on synthetic replicas ---------------------------------------------------------------------------
 def _synthetic(cfg, rows, value, se=0.01, replicas=8, seed=3):
     """{label: [(arrays, info)]} whose every observable is value(row, replica) + noise of size se."""
@@ -207,6 +265,23 @@ def test_rows_are_paired_with_the_reference_replica_by_replica():
     assert far["vs_ref"]["pe"]["mean"] == pytest.approx(np.mean(d), rel=1e-12)
     summary = summarise(cfg, rows, grouped)
     assert summary["cheapest"]["NVE"]["label"] == "omelyan-2 4 fs" and summary["cheapest"]["NVT"] is None
+
+
+def test_what_pairing_bought_is_the_unpaired_over_the_paired_variance():
+    """The resolution table's pairing factor for PE: (SE_row^2 + SE_ref^2) / SE_paired^2. Replicas with large shared
+    offsets buy a factor near (offset/noise)^2; replicas without (each row its own noise) buy about 1."""
+    cfg = presets.quick()
+    rows = _rows(("verlet", 0.5), ("verlet", 3.0))
+    offsets = np.random.default_rng(1).normal(scale=0.3, size=16)
+    shared = summarise(cfg, rows, _synthetic(cfg, rows, lambda row, r, k: 2.0 + offsets[r], se=0.01, replicas=16))
+    alone = summarise(cfg, rows, _synthetic(cfg, rows, lambda row, r, k: 2.0, se=0.01, replicas=16))
+    for summary, low, high in ((shared, 100.0, None), (alone, 0.3, 3.0)):
+        res = {e["label"]: e for e in summary["rows"]}
+        far, ref = res["verlet 3 fs"], res["verlet 0.5 fs"]
+        gain = far["resolution"]["pe_pairing"]
+        expected = (far["values"]["pe"]["se"] ** 2 + ref["values"]["pe"]["se"] ** 2) / far["vs_ref"]["pe"]["se"] ** 2
+        assert gain == pytest.approx(expected, rel=1e-9)
+        assert gain > low and (high is None or gain < high), gain
 
 
 def test_the_extrapolated_reference_recovers_each_replicas_h_to_zero_limit():

@@ -68,13 +68,26 @@ def select_rows(cfg: dict, text: str) -> list:
     return [r for r, lab in zip(cfg["rows"], labels) if lab in keep]
 
 
+def choose_rows(cfg: dict, rows: str | None, replicas: int | None) -> None:
+    """Apply --rows (:func:`select_rows`; the preset's per-row replica counts, ``cfg["row_replicas"]``, kept for the
+    chosen rows) and --replicas (every row that many: the per-row counts set aside) to ``cfg``."""
+    from .rowspec import label
+
+    if rows:
+        cfg["rows"] = select_rows(cfg, rows)
+        chosen = {label(r) for r in cfg["rows"]}
+        if cfg.get("row_replicas"):
+            cfg["row_replicas"] = {k: n for k, n in cfg["row_replicas"].items() if label(k) in chosen}
+    if replicas is not None:
+        cfg.pop("row_replicas", None)
+
+
 def run(args):
     cfg = presets.quick() if args.quick else presets.PRESETS[args.preset]()
 
     def configure(cfg):
         if args.model:
             cfg["model"] = args.model
-        if args.rows:
-            cfg["rows"] = select_rows(cfg, args.rows)
+        choose_rows(cfg, args.rows, args.replicas)
 
     run_study(args, cfg, configure, "openmm_symprk.studies.fidelity.simulation", "openmm_symprk.studies.fidelity.report")

@@ -22,7 +22,7 @@ from ...core.replicas import BOX_STATE_KEYS, BOX_STATE_VERSION, water_box_replic
 from ..rowspec import check_row, label, to_row
 from ....support.errors import InputError
 
-__all__ = ["FidelityStudy", "run_study", "run_of", "temperature_view", "RUN_KEYS", "RUN_VERSION"]
+__all__ = ["FidelityStudy", "run_study", "run_of", "replica_counts", "temperature_view", "RUN_KEYS", "RUN_VERSION"]
 
 #: What a run depends on besides its row and replica (the observables are computed in the run: their settings too).
 RUN_KEYS = BOX_STATE_KEYS + ("model", "settle_ps", "omega_ps", "omega_fs", "omega_max_lag_ps", "length_ps",
@@ -70,6 +70,22 @@ def references(cfg: dict, rows: list) -> dict:
     return out
 
 
+def replica_counts(cfg: dict, rows: list) -> dict:
+    """{label: replicas} of the study's rows: ``cfg["row_replicas"]`` (labels written in any order of the row grammar)
+    where it names a row, ``cfg["replicas"]`` for the others; ValueError where it names a row the study does not have
+    or a count below 1."""
+    default = int(cfg["replicas"])
+    out = {lab: default for lab in rows}
+    for lab, n in (cfg.get("row_replicas") or {}).items():
+        lab = check_row(lab)
+        if not isinstance(n, int) or isinstance(n, bool) or n < 1:
+            raise InputError(f"row_replicas[{lab!r}] must be an integer >= 1, got {n!r}")
+        if lab not in out:
+            raise InputError(f"row_replicas names {lab!r}, which is not among the rows")
+        out[lab] = n
+    return out
+
+
 def work(shared: dict, row: dict, replica: int):
     """One run in whatever process executes it (the box is built once per process and settings)."""
     from .runs import run_row
@@ -94,6 +110,7 @@ def check(cfg: dict) -> list:
     dup = sorted({x for x in rows if rows.count(x) > 1})
     if dup:
         raise InputError(f"rows given twice: {', '.join(dup)}")
+    replica_counts(cfg, rows)
     return rows
 
 
@@ -117,13 +134,17 @@ class FidelityStudy(Study):
 
     def _plan(self) -> list:
         cfg = self.cfg
-        self.states = water_box_replicas(cfg, cfg["model"], self.out, self.log)
+        counts = replica_counts(cfg, self.rows)
+        most = max(counts.values())
+        self.states = water_box_replicas(dict(cfg, replicas=most), cfg["model"], self.out, self.log)
         self.box = water_box_scene(cfg, cfg["model"])
-        runs = []
-        for row in map(to_row, self.rows):
-            cost = row.evals_per_ps(True) * (cfg["settle_ps"] + cfg["omega_ps"] + cfg["length_ps"])
-            runs += [run_of(cfg, row.label, r, cost) for r in range(int(cfg["replicas"]))]
-        return runs
+        rows = [to_row(lab) for lab in self.rows]
+        costs = [row.evals_per_ps(True) * (cfg["settle_ps"] + cfg["omega_ps"] + cfg["length_ps"]) for row in rows]
+        # replica by replica (within one, the costliest row first): a study stopped part way leaves every row within
+        # one replica of the others, which the frontier's joint resampling of the replicas needs
+        turn = sum(costs)
+        return [run_of(cfg, row.label, r, cost + (most - r) * turn)
+                for r in range(most) for row, cost in zip(rows, costs) if r < counts[row.label]]
 
     def shared(self, runs) -> dict:
         x, v = self.states
