@@ -105,8 +105,9 @@ def families(rows, per: dict, reference: str, ensemble: str, observables) -> lis
         if lab == reference or r.ensemble != ensemble or lab not in per:
             continue
         groups.setdefault(family_of(lab), []).append(lab)
-    n = 1 + max((rep for lab in list(rows) + [reference] if lab in per for k in observables
-                 for rep in per[lab].get(k, {})), default=0)
+    # the replicas of this ensemble's rows (another ensemble's rows run at more replicas leave its resampling as is)
+    n = 1 + max((rep for lab in [lab for labels in groups.values() for lab in labels] + [reference] if lab in per
+                 for k in observables for rep in per[lab].get(k, {})), default=0)
     out = []
     for name, labels in groups.items():
         labels = sorted(labels, key=lambda lab: to_row(lab).step_fs)
