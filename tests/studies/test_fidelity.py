@@ -219,6 +219,7 @@ def test_rows_chosen_keep_their_counts_and_replicas_given_set_them_aside():
     counts = replica_counts(cfg, check(cfg))
     assert counts == {"verlet 0.5 fs": 12, "verlet 0.5 fs SVR 0.1 ps every 24": presets.FRONTIER_NVT_REPLICAS,
                       "langevin 2 fs friction 1/ps": presets.FRONTIER_NVT_REPLICAS}
+    assert presets.FRONTIER_NVT_REPLICAS >= presets.FRONTIER_HALF_FS_REPLICAS >= 12
     cfg = presets.frontier()
     choose_rows(cfg, "deciding", 8)
     cfg["replicas"] = 8
