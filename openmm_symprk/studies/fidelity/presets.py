@@ -215,6 +215,7 @@ def frontier_row_replicas() -> dict:
     return {lab: FRONTIER_HALF_FS_REPLICAS if lab.startswith("langevin 0.5 fs") else FRONTIER_NVT_REPLICAS
             for lab in FRONTIER_NVT_DECIDING}
 
+
 #: The resolution the frontier's rows aim at: a paired SE of PE of 0.015 kJ/mol per molecule (half the standard
 #: tolerance's 0.03, so that a bias at the tolerance is 2 SE out) and of D of 5 % (the standard tolerance).
 FRONTIER_TARGETS = {"D_rel": 0.05, "pe": 0.015}
