@@ -226,6 +226,20 @@ def test_rows_chosen_keep_their_counts_and_replicas_given_set_them_aside():
     assert set(replica_counts(cfg, check(cfg)).values()) == {8}
 
 
+def test_a_study_without_its_extra_says_so_before_building_anything(tmp_path, monkeypatch):
+    """Without tqdm (the studies extra) the study stops at once with the extra to install, before it builds replica
+    states or runs anything."""
+    import sys
+
+    from openmm_symprk.support import MissingDependencyError
+
+    monkeypatch.setitem(sys.modules, "tqdm", None)
+    out = tmp_path / "f"
+    with pytest.raises(MissingDependencyError, match=r"symprk fidelity \(progress bar\) needs tqdm.*openmm_symprk\[studies\]"):
+        run_study(presets.quick(), str(out), workers=1, progress=False)
+    assert not out.exists()
+
+
 # -- the summary on synthetic replicas ---------------------------------------------------------------------------
 def _synthetic(cfg, rows, value, se=0.01, replicas=8, seed=3):
     """{label: [(arrays, info)]} whose every observable is value(row, replica) + noise of size se."""

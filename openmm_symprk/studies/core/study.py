@@ -136,6 +136,7 @@ class Study:
             if missing:
                 self.log(f"report only: {missing} of {len(runs)} planned runs are not finished and are left out")
             return self.summarise(runs)
+        require("tqdm", "studies", f"{self.command} (progress bar)")  # before any work: states, runs
         os.makedirs(self.out, exist_ok=True)
         lock = FolderLock(self.out, self.command, self.locked_error)
         try:
