@@ -36,7 +36,7 @@ import numpy as np
 
 from ..support.errors import InputError
 
-__all__ = ["Family", "fit", "fit_c", "fits", "bootstrap", "equal_accuracy_step", "FrontierPoint", "frontier", "compare",
+__all__ = ["Family", "fit", "fit_c", "fits", "strata", "resample", "bootstrap", "equal_accuracy_step", "FrontierPoint", "frontier", "compare",
            "replicas_for_interval"]
 
 
@@ -164,15 +164,39 @@ def _weights(family: Family, obs: str) -> np.ndarray:
     return 1.0 / se ** 2
 
 
+def strata(families, observables) -> list:
+    """[(lo, hi), ...]: the replica indices cut where some row's replicas end (a row has replicas 0 .. count - 1, its
+    count being one past its last finite column), so that a row of any count holds whole strata only."""
+    families = list(families)
+    n = max(np.shape(f.bias[o])[1] for f in families for o in observables)
+    ends = {0, n}
+    for f in families:
+        for o in observables:
+            finite = np.isfinite(np.asarray(f.bias[o], dtype=float))
+            for row in finite:
+                if row.any():
+                    ends.add(int(np.flatnonzero(row)[-1]) + 1)
+    ends = sorted(ends)
+    return list(zip(ends[:-1], ends[1:]))
+
+
+def resample(bands, n_boot: int, rng) -> np.ndarray:
+    """(n_boot, n) replica indices drawn with replacement within each stratum of ``bands`` (:func:`strata`): a row
+    with fewer replicas than others gets exactly its own count in every resample, and the replicas rows share stay
+    paired.  One stratum: ``rng.integers(0, n, (n_boot, n))``."""
+    return np.hstack([rng.integers(lo, hi, size=(n_boot, hi - lo)) for lo, hi in bands])
+
+
 def bootstrap(families, observables, n_boot: int = 2000, seed: int = 1) -> dict:
     """{family name: {observable: (n_boot, 2) array of (a, c)}} (a = 0 but for the family's ``free`` observables):
     the replicas resampled with replacement, the same indices for every row of every family (they are paired through
-    the reference and the initial states); each fit keeps the weights of the full data (resampling them too would let
-    a resample with two equal replicas weigh a row infinitely)."""
+    the reference and the initial states), within each stratum of :func:`strata` (rows run at more replicas than
+    others); each fit keeps the weights of the full data (resampling them too would let a resample with two equal
+    replicas weigh a row infinitely)."""
     families = list(families)
     n = max(np.shape(f.bias[o])[1] for f in families for o in observables)
     rng = np.random.default_rng(seed)
-    picks = rng.integers(0, n, size=(n_boot, n))
+    picks = resample(strata(families, observables), n_boot, rng)
     out = {f.name: {obs: np.empty((n_boot, 2)) for obs in observables} for f in families}
     for obs in observables:
         padded = {f.name: np.pad(np.asarray(f.bias[obs], dtype=float),

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from openmm_symprk.stats.frontier import (Family, bootstrap, compare, equal_accuracy_step, fit, fit_c, fits, frontier,
-                                          replicas_for_interval)
+                                          replicas_for_interval, resample, strata)
 
 
 def _family(name, c, steps, n=12, noise=0.01, order=2, seed=0, cost=1.0, shared=None, cap=None):
@@ -76,6 +76,27 @@ def test_the_interval_covers_the_truth_about_as_often_as_it_says():
         safe_ok += fa.safe_step <= (eps / 0.002) ** (1 / p)
     assert 0.85 * runs <= covered <= runs, covered
     assert safe_ok >= 0.85 * runs, safe_ok
+
+
+def test_rows_with_fewer_replicas_keep_their_count_in_every_resample():
+    """A family whose long-step rows ran 20 replicas and whose short-step row 12 (and a failed replica inside one
+    row): the replicas are cut where a row's end, every resample gives the 12-replica row exactly 12 of its own, and
+    one stratum draws what a plain resample draws."""
+    b = np.random.default_rng(0).normal(0, 0.01, (3, 20))
+    b[0, 12:] = np.nan
+    b[1, 5] = np.nan  # a run that failed: its row still has 20 replicas
+    f = Family("f", (1.0, 2.0, 3.0), {"pe": b})
+    assert strata([f], ["pe"]) == [(0, 12), (12, 20)]
+    picks = resample(strata([f], ["pe"]), 500, np.random.default_rng(1))
+    assert picks.shape == (500, 20) and (np.sum(picks < 12, axis=1) == 12).all()
+    assert ((picks[:, 12:] >= 12) & (picks[:, 12:] < 20)).all()
+    whole = Family("g", (1.0, 2.0), {"pe": np.zeros((2, 12))})
+    assert strata([whole], ["pe"]) == [(0, 12)]
+    assert np.array_equal(resample([(0, 12)], 50, np.random.default_rng(2)),
+                          np.random.default_rng(2).integers(0, 12, size=(50, 12)))
+    # no resample leaves the short row without data
+    boot = bootstrap([f], ["pe"], n_boot=300)
+    assert np.isfinite(boot["f"]["pe"][:, 1]).all()
 
 
 def test_bad_families_are_refused():

@@ -13,7 +13,7 @@ from openmm_symprk.studies.fidelity import presets
 from openmm_symprk.cli import main as symprk
 from openmm_symprk.studies.fidelity.observables import OBSERVABLES
 from openmm_symprk.studies.fidelity.report import K_SE, summarise
-from openmm_symprk.studies.fidelity.rowspec import check_row, describe, label
+from openmm_symprk.studies.fidelity.rowspec import check_row, describe, label, to_row
 from openmm_symprk.studies.fidelity.simulation import run_of, run_study
 
 
@@ -187,14 +187,25 @@ def test_rows_given_more_replicas_run_replica_by_replica_and_report_their_own_co
     assert len(planned) == len(cfg["rows"]) * 2 + 2
     by_turn = sorted(planned, key=lambda run: -run.cost)  # the scheduler takes the costliest first
     assert [run.meta["replica"] for run in by_turn] == sorted(run.meta["replica"] for run in planned)
+    first = [to_row(run.meta["row"]).evals_per_ps(True) for run in by_turn if run.meta["replica"] == 0]
+    assert first == sorted(first, reverse=True)  # within a replica, the costliest row first
     assert {run.meta["row"] for run in planned if run.meta["replica"] == 2} == {label(more), label(cfg["rows"][0])}
     logs = []
     summary = run_study(cfg, copy_, workers=1, timing=False, progress=False, log=logs.append)
     n = len(cfg["rows"]) * 2
     assert any(f"reusing {n} finished runs" in line for line in logs), logs
     counts = {r["label"]: r["replicas"] for r in summary["rows"]}
-    assert counts[label(more)] == 3 and all(c == 2 for lab, c in counts.items()
-                                             if lab not in (label(more), label(cfg["rows"][0])))
+    assert counts[label(more)] == counts[label(cfg["rows"][0])] == 3
+    assert all(c == 2 for lab, c in counts.items() if lab not in (label(more), label(cfg["rows"][0])))
+    # a report of more replicas than were run leaves the missing ones out, and builds no replica state
+    states = glob.glob(os.path.join(copy_, "states", "*.npz"))
+    before = [os.path.getmtime(p) for p in states]
+    cfg["row_replicas"][more] = 5
+    logs = []
+    summary = run_study(cfg, copy_, workers=1, progress=False, log=logs.append, report_only=True)
+    assert any("2 of" in line and "not finished" in line for line in logs), logs
+    assert [os.path.getmtime(p) for p in states] == before
+    assert {r["label"]: r["replicas"] for r in summary["rows"]}[label(more)] == 3
 
 
 @pytest.mark.parametrize("given, message", [({"verlet 9 fs": 3}, "row_replicas names 'verlet 9 fs', which is not among"),
@@ -215,11 +226,16 @@ def test_rows_chosen_keep_their_counts_and_replicas_given_set_them_aside():
     from openmm_symprk.studies.fidelity.simulation.study import check, replica_counts
 
     cfg = presets.frontier()
+    cfg["row_replicas"].update({"verlet 0.5 fs SVR 0.1 ps every 24": 17, "langevin 2 fs friction 1/ps": 15,
+                                "langevin 3 fs friction 1/ps": 16})
     choose_rows(cfg, "langevin 2 fs friction 1/ps", None)
     counts = replica_counts(cfg, check(cfg))
-    assert counts == {"verlet 0.5 fs": 12, "verlet 0.5 fs SVR 0.1 ps every 24": presets.FRONTIER_NVT_REPLICAS,
-                      "langevin 2 fs friction 1/ps": presets.FRONTIER_NVT_REPLICAS}
-    assert presets.FRONTIER_NVT_REPLICAS >= presets.FRONTIER_HALF_FS_REPLICAS >= 12
+    assert counts == {"verlet 0.5 fs": 12, "verlet 0.5 fs SVR 0.1 ps every 24": 17, "langevin 2 fs friction 1/ps": 15}
+    # the preset: the NVT answer's rows at their committed counts, the reference at least as many as any of them
+    cfg = presets.frontier()
+    counts = replica_counts(cfg, check(cfg))
+    assert {lab for lab, n in counts.items() if n > cfg["replicas"]} <= set(presets.FRONTIER_NVT_DECIDING)
+    assert counts["verlet 0.5 fs SVR 0.1 ps every 24"] == max(counts.values()) == presets.FRONTIER_NVT_REPLICAS
     cfg = presets.frontier()
     choose_rows(cfg, "deciding", 8)
     cfg["replicas"] = 8

@@ -146,6 +146,8 @@ def frontier_summary(rows, per: dict, references: dict, tolerances: dict, timing
         ref_means = {k: float(np.mean([v for v, _ in per[reference][k].values()])) if per[reference].get(k) else None
                      for k in keys}
         boot = bootstrap([f for f, _ in fams], keys, n_boot=n_boot)
+        counts = {lab: c for f, labs in fams for lab, c in zip(labs, _replicas(f))}
+        counts[reference] = max(counts.values())
         wall = {f.name: _wall_per_step(labs, timings) for f, labs in fams}
         entry = {"reference": reference, "families": [], "levels": {},
                  "left_out": sorted(f.name for f, _ in found if all(f.name != g.name for g, _ in fams))}
@@ -187,14 +189,16 @@ def frontier_summary(rows, per: dict, references: dict, tolerances: dict, timing
                 b = dataclasses.replace(points[best_theirs],
                                         cost=_per_step(cost_of(best_theirs), points[best_theirs].step))
                 ratio, low, high = compare(a, b, cost_of(best_ours), cost_of(best_theirs))
-                n = min(_replicas(f) for f, _ in fams if f.name in (best_ours, best_theirs))
+                # the replicas the two families' rows have (the median: rows may have run at different counts)
+                n = int(np.median([counts[lab] for f, labs in fams if f.name in (best_ours, best_theirs)
+                                   for lab in labs]))
                 need = replicas_for_interval(n, ratio, low, high, WITHIN)
                 # the reference, the two families and those sharing a fitted part with them (a shared group's rows
-                # all fix its kappa)
+                # all fix its kappa), each brought from its own count to the replicas needed
                 groups = {f.shared[0] for f, _ in fams if f.name in (best_ours, best_theirs) and f.shared}
                 labels = [reference] + [lab for f, labs in fams if f.name in (best_ours, best_theirs)
                                         or (f.shared and f.shared[0] in groups) for lab in labs]
-                more = (need - n) * sum(run_seconds.get(lab, np.nan) for lab in labels) / 3600.0
+                more = sum(max(0.0, need - counts[lab]) * run_seconds.get(lab, np.nan) for lab in labels) / 3600.0
                 level_entry[f"ratio_{unit}"] = {"ours": best_ours, "theirs": best_theirs, "ratio": ratio,
                                                 "low": low, "high": high, "replicas": n, "replicas_needed": need,
                                                 "core_hours_more": more if np.isfinite(more) else None}
@@ -203,9 +207,10 @@ def frontier_summary(rows, per: dict, references: dict, tolerances: dict, timing
     return out
 
 
-def _replicas(family: Family) -> int:
-    """The fewest replicas any row of ``family`` has of any observable."""
-    return int(min(np.isfinite(np.asarray(b, dtype=float)).sum(axis=1).min() for b in family.bias.values()))
+def _replicas(family: Family) -> list:
+    """The replicas each row of ``family`` has (of the observable it has fewest of)."""
+    return [int(n) for n in np.min([np.isfinite(np.asarray(b, dtype=float)).sum(axis=1)
+                                    for b in family.bias.values()], axis=0)]
 
 
 def _per_step(cost: float, step: float) -> float:

@@ -136,7 +136,8 @@ class FidelityStudy(Study):
         cfg = self.cfg
         counts = replica_counts(cfg, self.rows)
         most = max(counts.values())
-        self.states = water_box_replicas(dict(cfg, replicas=most), cfg["model"], self.out, self.log)
+        if not self.report_only:  # a report reads the stored runs only: it neither needs nor builds states
+            self.states = water_box_replicas(dict(cfg, replicas=most), cfg["model"], self.out, self.log)
         self.box = water_box_scene(cfg, cfg["model"])
         rows = [to_row(lab) for lab in self.rows]
         costs = [row.evals_per_ps(True) * (cfg["settle_ps"] + cfg["omega_ps"] + cfg["length_ps"]) for row in rows]
