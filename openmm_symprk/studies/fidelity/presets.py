@@ -204,10 +204,10 @@ FRONTIER_NVT_DECIDING = [
 #: The replicas of :data:`FRONTIER_NVT_DECIDING` committed (the other rows have 12); a later measurement raises it and
 #: runs ``symprk fidelity --preset frontier --out docs/data/fidelity/frontier-spce --no-timing``, which runs only the
 #: missing replicas.
-FRONTIER_NVT_REPLICAS = 12
+FRONTIER_NVT_REPLICAS = 28
 #: LangevinMiddle at 0.5 fs is a third of the cost of a replica of those rows and carries little of the fitted c
 #: (h^2 = 0.25 fs^2 against 1-9 at 1-3 fs): its replicas stop here.
-FRONTIER_HALF_FS_REPLICAS = 12
+FRONTIER_HALF_FS_REPLICAS = 14
 
 
 def frontier_row_replicas() -> dict:
