@@ -36,8 +36,8 @@ import numpy as np
 
 from ..support.errors import InputError
 
-__all__ = ["Family", "fit", "fit_c", "fits", "strata", "resample", "bootstrap", "equal_accuracy_step", "FrontierPoint", "frontier", "compare",
-           "replicas_for_interval"]
+__all__ = ["Family", "fit", "fit_c", "fits", "strata", "resample", "bootstrap", "equal_accuracy_step", "FrontierPoint",
+           "frontier", "compare", "replicas_for_interval"]
 
 
 @dataclass(frozen=True)
@@ -194,9 +194,9 @@ def bootstrap(families, observables, n_boot: int = 2000, seed: int = 1) -> dict:
     others); each fit keeps the weights of the full data (resampling them too would let a resample with two equal
     replicas weigh a row infinitely)."""
     families = list(families)
-    n = max(np.shape(f.bias[o])[1] for f in families for o in observables)
-    rng = np.random.default_rng(seed)
-    picks = resample(strata(families, observables), n_boot, rng)
+    bands = strata(families, observables)
+    n = bands[-1][1]
+    picks = resample(bands, n_boot, np.random.default_rng(seed))
     out = {f.name: {obs: np.empty((n_boot, 2)) for obs in observables} for f in families}
     for obs in observables:
         padded = {f.name: np.pad(np.asarray(f.bias[obs], dtype=float),

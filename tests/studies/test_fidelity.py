@@ -208,9 +208,10 @@ def test_rows_given_more_replicas_run_replica_by_replica_and_report_their_own_co
     assert {r["label"]: r["replicas"] for r in summary["rows"]}[label(more)] == 3
 
 
-@pytest.mark.parametrize("given, message", [({"verlet 9 fs": 3}, "row_replicas names 'verlet 9 fs', which is not among"),
-                                            ({"verlet 0.5 fs": 0}, r"row_replicas\['verlet 0.5 fs'\] must be an integer >= 1, got 0"),
-                                            ({"verlet 0.5 fs": 2.5}, "must be an integer >= 1, got 2.5")])
+@pytest.mark.parametrize("given, message", [
+    ({"verlet 9 fs": 3}, "row_replicas names 'verlet 9 fs', which is not among"),
+    ({"verlet 0.5 fs": 0}, r"row_replicas\['verlet 0.5 fs'\] must be an integer >= 1, got 0"),
+    ({"verlet 0.5 fs": 2.5}, "must be an integer >= 1, got 2.5")])
 def test_bad_per_row_replica_counts_are_refused_naming_the_row(given, message):
     from openmm_symprk.studies.fidelity.simulation.study import check
 
@@ -251,7 +252,8 @@ def test_a_study_without_its_extra_says_so_before_building_anything(tmp_path, mo
 
     monkeypatch.setitem(sys.modules, "tqdm", None)
     out = tmp_path / "f"
-    with pytest.raises(MissingDependencyError, match=r"symprk fidelity \(progress bar\) needs tqdm.*openmm_symprk\[studies\]"):
+    expected = r"symprk fidelity \(progress bar\) needs tqdm.*openmm_symprk\[studies\]"
+    with pytest.raises(MissingDependencyError, match=expected):
         run_study(presets.quick(), str(out), workers=1, progress=False)
     assert not out.exists()
 
