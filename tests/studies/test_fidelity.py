@@ -695,15 +695,66 @@ def test_the_match_3se_preset_is_named_for_what_it_measures_and_reads_its_former
 
 def test_the_studys_lowered_rows_follow_it():
     """The fidelity study's rows with a lowered target carry T (1 - c_T h^2 <w^2>) at the water box's measured
-    <w^2> = 6.81e-3 fs^-2, to the label's 0.01 K."""
+    <w^2> (presets.MEAN_SQUARE_FREQUENCY_FS2), to the label's 0.01 K."""
     from openmm_symprk.methods.catalogue import get_method
     from openmm_symprk.methods.shadow import shadow_target
     from openmm_symprk.studies.core.rows import Row
     from openmm_symprk.studies.fidelity import presets
 
-    lowered = [Row.parse(lab) for lab in presets.FRONTIER_ROWS if " T " in lab]
-    assert len(lowered) >= 6
-    for row in lowered:
-        steps = get_method(row.method).splitting.steps
-        assert row.temperature == pytest.approx(300.0 * shadow_target(steps, "ends", row.step_fs ** 2 * 6.81e-3),
-                                                abs=0.011), row.label
+    lowered = [lab for lab in presets.FRONTIER_ROWS if " T " in lab]
+    assert len(lowered) >= 6 and sorted(lowered) == sorted(presets.LOWERED_ROWS["spce"])
+    assert set(presets.LOWERED_ROWS) == set(presets.MEAN_SQUARE_FREQUENCY_FS2) == {"spce", "tip3p"}
+    for model, labels in presets.LOWERED_ROWS.items():
+        for row in map(Row.parse, labels):
+            steps = get_method(row.method).splitting.steps
+            omega2 = presets.MEAN_SQUARE_FREQUENCY_FS2[model]
+            assert row.temperature == pytest.approx(300.0 * shadow_target(steps, "ends", row.step_fs ** 2 * omega2),
+                                                    abs=0.011), (model, row.label)
+    assert presets.MEAN_SQUARE_FREQUENCY_FS2["tip3p"] < presets.MEAN_SQUARE_FREQUENCY_FS2["spce"]
+
+
+@pytest.mark.parametrize("model, n", [("spce", 12), ("tip3p", 8)])
+def test_each_models_mean_square_frequency_is_its_committed_states(model, n):
+    """presets.MEAN_SQUARE_FREQUENCY_FS2, which sets each model's lowered targets, is <F.M^-1.F>/(N_f kT) of the
+    model's committed replica states (the first ``n``) to its four digits."""
+    import glob
+
+    import numpy as np
+
+    from openmm_symprk.studies.core.replicas import water_box_scene
+    from openmm_symprk.studies.fidelity import presets
+    from openmm_symprk.systems.frequencies import mean_square_frequency
+
+    (states,) = glob.glob(os.path.join(os.path.dirname(__file__), "..", "..", "docs", "data", "fidelity",
+                                       f"frontier-{model}", "states", f"{model}-*.npz"))
+    cfg = presets.frontier()
+    x = np.load(states)["x"][:n]
+    assert len(x) == n
+    omega2 = mean_square_frequency(water_box_scene(cfg, model).system, list(x), 300.0, platform="CPU")["all"]
+    assert omega2 * 1e-6 == pytest.approx(presets.MEAN_SQUARE_FREQUENCY_FS2[model], abs=5e-6)
+
+
+def test_a_model_gets_its_own_lowered_rows_and_refuses_anothers():
+    """--model (rowspec.for_model) swaps each row whose target is lowered for SPC/E for TIP3P's row of the same method,
+    step and event grid, in the rows, the deciding rows and the per-row replica counts, and leaves out the SPC/E side
+    rows TIP3P has none of; SPC/E's config is unchanged; a TIP3P study given SPC/E's lowered rows is refused with the
+    rows and the fix named."""
+    from openmm_symprk.studies.fidelity import presets
+    from openmm_symprk.studies.fidelity.rowspec import for_model
+    from openmm_symprk.studies.fidelity.simulation.study import check, replica_counts
+
+    assert for_model(presets.frontier(), "spce") == presets.frontier()
+    cfg = for_model(presets.frontier(), "tip3p")
+    rows = check(cfg)
+    spce, tip3p = set(presets.LOWERED_ROWS["spce"]), presets.LOWERED_ROWS["tip3p"]
+    assert cfg["model"] == "tip3p" and not spce & set(rows) and set(tip3p) <= set(rows)
+    assert len(rows) == len(presets.FRONTIER_ROWS) - 3
+    assert set(tip3p) <= set(cfg["deciding"]) and not spce & set(cfg["deciding"] + cfg["side"])
+    assert rows.index(tip3p[0]) == presets.FRONTIER_ROWS.index(presets.LOWERED_ROWS["spce"][0])
+    counts = replica_counts(cfg, rows)
+    assert all(counts[lab] == presets.FRONTIER_NVT_REPLICAS for lab in tip3p)
+    other = presets.frontier()
+    other["model"] = "tip3p"
+    with pytest.raises(ValueError, match=r"'omelyan-2 5 fs SVR 0.1 ps T 299.32 K'.*lowered for the spce box, not "
+                                         r"tip3p's; .*for_model\(cfg, 'tip3p'\)"):
+        check(other)

@@ -8,6 +8,7 @@ import sys
 
 from ..core.options import add_study_arguments, run_study
 from . import presets
+from .rowspec import for_model
 from ...support.errors import InputError
 
 
@@ -87,7 +88,7 @@ def run(args):
 
     def configure(cfg):
         if args.model:
-            cfg["model"] = args.model
+            for_model(cfg, args.model)
         choose_rows(cfg, args.rows, args.replicas)
 
     run_study(args, cfg, configure, "openmm_symprk.studies.fidelity.simulation", "openmm_symprk.studies.fidelity.report")

@@ -14,7 +14,8 @@ from __future__ import annotations
 
 __all__ = ["ROWS", "QUICK_ROWS", "REFERENCES", "NVT_TAU_PS", "DECIDING", "TOLERANCES", "EVENT_FS", "FRONTIER_ROWS",
            "FRONTIER_DECIDING", "FRONTIER_NVT_DECIDING", "FRONTIER_NVT_REPLICAS", "FRONTIER_HALF_FS_REPLICAS",
-           "FRONTIER_TARGETS", "SIDE_ROWS", "PRESETS", "full", "quick", "frontier"]
+           "FRONTIER_TARGETS", "SIDE_ROWS", "MEAN_SQUARE_FREQUENCY_FS2", "LOWERED_ROWS", "PRESETS", "full", "quick",
+           "frontier"]
 
 #: Collision time of the package's thermostat in the NVT reference and the new NVT rows (issue 26).
 NVT_TAU_PS = 0.1
@@ -151,7 +152,8 @@ FRONTIER_ROWS = [
     # fitted with the rest of its family as a + c h^2 (studies.fidelity.frontier.free_observables)
     "langevin 0.5 fs friction 0.1/ps", "langevin 0.5 fs friction 1/ps",
     # the thermostat's target lowered by the modified energy (below: T (1 - c_T h^2 <w^2>)), a family of its own on
-    # the omelyan-2 family's steps and event grid (studies.fidelity.frontier.family_of: "T lowered")
+    # the omelyan-2 family's steps and event grid (studies.fidelity.frontier.family_of: "T lowered"); the targets
+    # are SPC/E's (:data:`LOWERED_ROWS`: another model's run has its own, :func:`.rowspec.for_model`)
     "omelyan-2 3 fs SVR 0.1 ps every 4 T 299.76 K", "omelyan-2 4 fs SVR 0.1 ps every 3 T 299.57 K",
     "omelyan-2 5 fs SVR 0.1 ps T 299.32 K", "omelyan-2 6 fs SVR 0.1 ps every 2 T 299.02 K",
     "omelyan-2 7 fs SVR 0.1 ps T 298.67 K",
@@ -160,8 +162,8 @@ FRONTIER_ROWS = [
     "omelyan-2 6 fs SVR 0.1 ps", "omelyan-2 6 fs SVR 1 ps every 2", "omelyan-2 6 fs SVR 0.1 ps every 2 middle",
     "predescu-3 12 fs SVR 0.1 ps middle",
     # the thermostat's target lowered to the modified energy's kinetic temperature, T (1 - c_T h^2 <w^2>), with
-    # c_T of the method at the event point and <w^2> = <F.M^-1.F>/(N_f kT) of this box's replica states (6.81e-3
-    # fs^-2 per degree of freedom): the configurational temperature of the slow modes then sits at 300 K
+    # c_T of the method at the event point and <w^2> = <F.M^-1.F>/(N_f kT) of this box's replica states
+    # (:data:`MEAN_SQUARE_FREQUENCY_FS2`): the configurational temperature of the slow modes then sits at 300 K
     # (integrators.shadow.lowered_target; tests/studies/test_fidelity.py checks these labels against it)
     "predescu-3 12 fs SVR 0.1 ps T 298.38 K", "bcss-2 6 fs SVR 0.1 ps every 2 T 298.34 K",
     "verlet 3 fs SVR 0.1 ps every 4 T 296.93 K",
@@ -185,7 +187,29 @@ FRONTIER_DECIDING = [
     "omelyan-2 3 fs SVR 0.1 ps every 4", "omelyan-2 5 fs SVR 0.1 ps", "langevin 0.5 fs friction 0.1/ps",
     "langevin 0.5 fs friction 1/ps", "langevin 1 fs friction 1/ps", "langevin 2 fs friction 1/ps",
     "langevin 3 fs friction 1/ps",
+    # the package's cheapest accurate NVT configuration: omelyan-2 with the lowered target (SPC/E's targets; the
+    # model's own under --model, :func:`.rowspec.for_model`)
+    "omelyan-2 3 fs SVR 0.1 ps every 4 T 299.76 K", "omelyan-2 4 fs SVR 0.1 ps every 3 T 299.57 K",
+    "omelyan-2 5 fs SVR 0.1 ps T 299.32 K", "omelyan-2 6 fs SVR 0.1 ps every 2 T 299.02 K",
+    "omelyan-2 7 fs SVR 0.1 ps T 298.67 K",
 ]
+
+#: <w^2> = <F.M^-1.F>/(N_f kT) per degree of freedom (fs^-2) of each water model's frontier box, over its replica
+#: states (SPC/E's first 12, TIP3P's 8; :func:`openmm_symprk.systems.frequencies.mean_square_frequency`): what
+#: lowers each model's thermostat target, T (1 - c_T h^2 <w^2>) (:func:`openmm_symprk.integrators.lowered_target`).
+MEAN_SQUARE_FREQUENCY_FS2 = {"spce": 6.818e-3, "tip3p": 5.610e-3}
+#: The rows whose thermostat target is lowered for one water model's <w^2>: they hold for that model only.  A study
+#: of another model swaps each for its own row of the same method, step and thermostat (:func:`.rowspec.for_model`), or
+#: leaves it out where the model has none (SPC/E's side rows).
+LOWERED_ROWS = {
+    "spce": ["omelyan-2 3 fs SVR 0.1 ps every 4 T 299.76 K", "omelyan-2 4 fs SVR 0.1 ps every 3 T 299.57 K",
+             "omelyan-2 5 fs SVR 0.1 ps T 299.32 K", "omelyan-2 6 fs SVR 0.1 ps every 2 T 299.02 K",
+             "omelyan-2 7 fs SVR 0.1 ps T 298.67 K", "predescu-3 12 fs SVR 0.1 ps T 298.38 K",
+             "bcss-2 6 fs SVR 0.1 ps every 2 T 298.34 K", "verlet 3 fs SVR 0.1 ps every 4 T 296.93 K"],
+    "tip3p": ["omelyan-2 3 fs SVR 0.1 ps every 4 T 299.8 K", "omelyan-2 4 fs SVR 0.1 ps every 3 T 299.64 K",
+              "omelyan-2 5 fs SVR 0.1 ps T 299.44 K", "omelyan-2 6 fs SVR 0.1 ps every 2 T 299.2 K",
+              "omelyan-2 7 fs SVR 0.1 ps T 298.91 K"],
+}
 
 
 #: The rows that decide the NVT answer at the standard level (the NVT reference, the lowered-target omelyan-2 family
@@ -234,7 +258,8 @@ def frontier() -> dict:
     cfg.update(rows=list(FRONTIER_ROWS), replicas=12, run_version=3, equilibrator="svr",
                references={"NVE": "verlet 0.5 fs", "NVT": "verlet 0.5 fs SVR 0.1 ps every 24"},
                tolerances=TOLERANCES, deciding=list(FRONTIER_DECIDING), side=list(SIDE_ROWS),
-               targets=dict(FRONTIER_TARGETS), row_replicas=frontier_row_replicas())
+               targets=dict(FRONTIER_TARGETS), row_replicas=frontier_row_replicas(),
+               lowered_rows={m: list(labs) for m, labs in LOWERED_ROWS.items()})
     return cfg
 
 

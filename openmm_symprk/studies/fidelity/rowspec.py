@@ -4,14 +4,15 @@ runs' keys, as its canonical label (what :attr:`Row.label` writes back).
 
 :func:`check_row` validates a row and names what is wrong; :func:`label` names it; :func:`to_row` reads it;
 :func:`describe` gives its label, ensemble, force evaluations per step, whether it keeps the total momentum and
-whether it has a conserved effective energy.
+whether it has a conserved effective energy; :func:`for_model` swaps the rows that hold for one water model only
+(a thermostat target lowered for its box) for another model's; :func:`foreign_rows` finds those left behind.
 """
 from __future__ import annotations
 
 from ..core.rows import Row
 from ...support.errors import InputError
 
-__all__ = ["check_row", "describe", "label", "to_row", "is_verlet_limit"]
+__all__ = ["check_row", "describe", "label", "to_row", "is_verlet_limit", "for_model", "foreign_rows"]
 
 
 def to_row(row, temperature: float = 300.0) -> Row:
@@ -56,3 +57,38 @@ def describe(row) -> dict:
     return {"label": r.label, "ensemble": r.ensemble, "evals_per_step": r.evals_per_step(constraints=True),
             "keeps_momentum": r.keeps_momentum, "effective_energy": r.conserves_effective_energy,
             "family": "symprk" if r.is_ours else "openmm", "hmr": r.hmr_da is not None, "step_fs": r.step_fs}
+
+
+def _bare(lab: str) -> str:
+    """A lowered-target row's label without its target (the method, step and thermostat it shares with the same row
+    lowered for another water model)."""
+    return label(lab).rsplit(" T ", 1)[0]
+
+
+def foreign_rows(cfg: dict, rows: list) -> dict:
+    """{label: model} of the ``rows`` whose target is lowered for another water model than ``cfg["model"]``
+    (``cfg["lowered_rows"]``: {model: labels})."""
+    model = cfg.get("model", "spce")
+    return {label(lab): m for m, labs in (cfg.get("lowered_rows") or {}).items() if m != model for lab in labs
+            if label(lab) in set(rows)}
+
+
+def for_model(cfg: dict, model: str) -> dict:
+    """``cfg`` for water ``model``: ``cfg["model"]`` set, and each row of ``cfg["lowered_rows"]`` that belongs to
+    another model (its target lowered for that model's box) replaced, in the rows, the deciding and side rows and the
+    per-row replica counts, by the model's own row of the same method, step and thermostat, or left out where the model
+    has none.  A config without ``lowered_rows`` only gets the model."""
+    cfg["model"] = model
+    lowered = cfg.get("lowered_rows") or {}
+    own = {_bare(lab): label(lab) for lab in lowered.get(model, ())}
+    foreign = {label(lab) for m, labs in lowered.items() if m != model for lab in labs}
+
+    def swap(lab):
+        return own.get(_bare(lab)) if label(lab) in foreign else lab
+
+    for key in ("rows", "deciding", "side"):
+        if key in cfg:
+            cfg[key] = list(dict.fromkeys(new for new in map(swap, cfg[key]) if new is not None))
+    if cfg.get("row_replicas"):
+        cfg["row_replicas"] = {swap(lab): n for lab, n in cfg["row_replicas"].items() if swap(lab) is not None}
+    return cfg

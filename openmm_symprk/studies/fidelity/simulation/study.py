@@ -19,7 +19,7 @@ from ....systems.checks import ConservationWarning
 from ...core import Run, Study, write_json, write_text
 from ...core.options import check_settings
 from ...core.replicas import BOX_STATE_KEYS, BOX_STATE_VERSION, water_box_replicas, water_box_scene
-from ..rowspec import check_row, label, to_row
+from ..rowspec import check_row, foreign_rows, label, to_row
 from ....support.errors import InputError
 
 __all__ = ["FidelityStudy", "run_study", "run_of", "replica_counts", "temperature_view", "RUN_KEYS", "RUN_VERSION"]
@@ -106,6 +106,12 @@ def check(cfg: dict) -> list:
     rows = [check_row(r) for r in cfg["rows"]]
     if not rows:
         raise InputError("no rows")
+    foreign = foreign_rows(cfg, rows)
+    if foreign:
+        raise InputError(f"row(s) {', '.join(repr(lab) for lab in foreign)}: the thermostat's target is lowered for "
+                         f"the {'/'.join(sorted(set(foreign.values())))} box, not {cfg.get('model', 'spce')}'s; "
+                         f"openmm_symprk.studies.fidelity.rowspec.for_model(cfg, {cfg.get('model', 'spce')!r}) "
+                         f"swaps them for the model's own (what --model does)")
     references(cfg, rows)
     dup = sorted({x for x in rows if rows.count(x) > 1})
     if dup:
