@@ -725,8 +725,10 @@ def test_each_models_mean_square_frequency_is_its_committed_states(model, n):
     from openmm_symprk.studies.fidelity import presets
     from openmm_symprk.systems.frequencies import mean_square_frequency
 
-    (states,) = glob.glob(os.path.join(os.path.dirname(__file__), "..", "..", "docs", "data", "fidelity",
-                                       f"frontier-{model}", "states", f"{model}-*.npz"))
+    found = glob.glob(os.path.join(os.path.dirname(__file__), "..", "..", "docs", "data", "fidelity",
+                                   f"frontier-{model}", "states", f"{model}-*.npz"))
+    assert len(found) == 1, f"one committed states file of {model} expected, found {found}"
+    states = found[0]
     cfg = presets.frontier()
     x = np.load(states)["x"][:n]
     assert len(x) == n
@@ -753,8 +755,19 @@ def test_a_model_gets_its_own_lowered_rows_and_refuses_anothers():
     assert rows.index(tip3p[0]) == presets.FRONTIER_ROWS.index(presets.LOWERED_ROWS["spce"][0])
     counts = replica_counts(cfg, rows)
     assert all(counts[lab] == presets.FRONTIER_NVT_REPLICAS for lab in tip3p)
+    assert for_model(dict(cfg), "tip3p") == cfg  # twice is once
+    reordered = dict(presets.frontier(), rows=["verlet 0.5 fs", "verlet 0.5 fs SVR 0.1 ps every 24",
+                                               "omelyan-2 5 fs T 299.32 K SVR 0.1 ps", "verlet 2 fs"])
+    del reordered["row_replicas"]
+    assert for_model(reordered, "tip3p")["rows"][2:] == ["omelyan-2 5 fs SVR 0.1 ps T 299.44 K", "verlet 2 fs"]
+    plain = {"rows": ["verlet 2 fs", "verlet 2 fs"]}
+    assert for_model(plain, "tip3p") == {"rows": ["verlet 2 fs", "verlet 2 fs"], "model": "tip3p"}
+    assert set(presets.LOWERED_ROWS["spce"]) >= {lab for lab in presets.SIDE_ROWS + presets.FRONTIER_DECIDING
+                                                 + presets.FRONTIER_NVT_DECIDING if " T " in lab}
     other = presets.frontier()
     other["model"] = "tip3p"
-    with pytest.raises(ValueError, match=r"'omelyan-2 5 fs SVR 0.1 ps T 299.32 K'.*lowered for the spce box, not "
-                                         r"tip3p's; .*for_model\(cfg, 'tip3p'\)"):
+    with pytest.raises(ValueError, match=r"8 row\(s\) .* lowered for another water model's box, not tip3p's "
+                                         r"\(.*'omelyan-2 5 fs SVR 0.1 ps T 299.32 K': tip3p's is 'omelyan-2 5 fs SVR "
+                                         r"0.1 ps T 299.44 K'.*'verlet 3 fs SVR 0.1 ps every 4 T 296.93 K': none for "
+                                         r"tip3p\); .*for_model\(cfg, 'tip3p'\)"):
         check(other)

@@ -196,7 +196,7 @@ FRONTIER_DECIDING = [
 
 #: <w^2> = <F.M^-1.F>/(N_f kT) per degree of freedom (fs^-2) of each water model's frontier box, over its replica
 #: states (SPC/E's first 12, TIP3P's 8; :func:`openmm_symprk.systems.frequencies.mean_square_frequency`): what
-#: lowers each model's thermostat target, T (1 - c_T h^2 <w^2>) (:func:`openmm_symprk.integrators.lowered_target`).
+#: lowers each model's thermostat target, T (1 - c_T h^2 <w^2>) (:func:`openmm_symprk.integrators.shadow.lowered_target`).
 MEAN_SQUARE_FREQUENCY_FS2 = {"spce": 6.818e-3, "tip3p": 5.610e-3}
 #: The rows whose thermostat target is lowered for one water model's <w^2>: they hold for that model only.  A study
 #: of another model swaps each for its own row of the same method, step and thermostat (:func:`.rowspec.for_model`), or

@@ -5,14 +5,17 @@ runs' keys, as its canonical label (what :attr:`Row.label` writes back).
 :func:`check_row` validates a row and names what is wrong; :func:`label` names it; :func:`to_row` reads it;
 :func:`describe` gives its label, ensemble, force evaluations per step, whether it keeps the total momentum and
 whether it has a conserved effective energy; :func:`for_model` swaps the rows that hold for one water model only
-(a thermostat target lowered for its box) for another model's; :func:`foreign_rows` finds those left behind.
+(a thermostat target lowered for its box) for another model's (:func:`counterparts`); :func:`foreign_rows` finds
+those left behind.
 """
 from __future__ import annotations
+
+import dataclasses
 
 from ..core.rows import Row
 from ...support.errors import InputError
 
-__all__ = ["check_row", "describe", "label", "to_row", "is_verlet_limit", "for_model", "foreign_rows"]
+__all__ = ["check_row", "describe", "label", "to_row", "is_verlet_limit", "for_model", "foreign_rows", "counterparts"]
 
 
 def to_row(row, temperature: float = 300.0) -> Row:
@@ -59,36 +62,46 @@ def describe(row) -> dict:
             "family": "symprk" if r.is_ours else "openmm", "hmr": r.hmr_da is not None, "step_fs": r.step_fs}
 
 
-def _bare(lab: str) -> str:
-    """A lowered-target row's label without its target (the method, step and thermostat it shares with the same row
-    lowered for another water model)."""
-    return label(lab).rsplit(" T ", 1)[0]
+
+def _bare(lab: str, temperature: float) -> str:
+    """A lowered-target row's label at the study's ``temperature``: the method, step and thermostat it shares with the
+    same row lowered for another water model."""
+    row = to_row(lab, temperature)
+    return dataclasses.replace(row, temperature=float(temperature)).label
+
+
+def counterparts(cfg: dict, model: str) -> dict:
+    """{label: the same row lowered for ``model``, or None where ``model`` has none} of every row of
+    ``cfg["lowered_rows"]`` ({model: labels}) that belongs to another model."""
+    temperature = float(cfg.get("temperature", 300.0))
+    lowered = cfg.get("lowered_rows") or {}
+    own = {_bare(lab, temperature): label(lab) for lab in lowered.get(model, ())}
+    return {label(lab): own.get(_bare(lab, temperature)) for m, labs in lowered.items() if m != model for lab in labs}
 
 
 def foreign_rows(cfg: dict, rows: list) -> dict:
-    """{label: model} of the ``rows`` whose target is lowered for another water model than ``cfg["model"]``
-    (``cfg["lowered_rows"]``: {model: labels})."""
-    model = cfg.get("model", "spce")
-    return {label(lab): m for m, labs in (cfg.get("lowered_rows") or {}).items() if m != model for lab in labs
-            if label(lab) in set(rows)}
+    """{label: the model's own row or None} of the ``rows`` whose target is lowered for another water model than
+    ``cfg["model"]`` (:func:`counterparts`)."""
+    swap = counterparts(cfg, cfg.get("model", "spce"))
+    return {lab: swap[lab] for lab in map(label, rows) if lab in swap}
 
 
 def for_model(cfg: dict, model: str) -> dict:
     """``cfg`` for water ``model``: ``cfg["model"]`` set, and each row of ``cfg["lowered_rows"]`` that belongs to
     another model (its target lowered for that model's box) replaced, in the rows, the deciding and side rows and the
     per-row replica counts, by the model's own row of the same method, step and thermostat, or left out where the model
-    has none.  A config without ``lowered_rows`` only gets the model."""
+    has none (a preset's side rows measured in one model only).  A config without ``lowered_rows`` only gets the
+    model; the rows are otherwise kept as written (duplicates included, for :func:`..simulation.study.check` to
+    name)."""
     cfg["model"] = model
-    lowered = cfg.get("lowered_rows") or {}
-    own = {_bare(lab): label(lab) for lab in lowered.get(model, ())}
-    foreign = {label(lab) for m, labs in lowered.items() if m != model for lab in labs}
+    swap = counterparts(cfg, model)
 
-    def swap(lab):
-        return own.get(_bare(lab)) if label(lab) in foreign else lab
+    def new(lab):
+        return swap.get(label(lab), lab)
 
     for key in ("rows", "deciding", "side"):
         if key in cfg:
-            cfg[key] = list(dict.fromkeys(new for new in map(swap, cfg[key]) if new is not None))
+            cfg[key] = [new(lab) for lab in cfg[key] if new(lab) is not None]
     if cfg.get("row_replicas"):
-        cfg["row_replicas"] = {swap(lab): n for lab, n in cfg["row_replicas"].items() if swap(lab) is not None}
+        cfg["row_replicas"] = {new(lab): n for lab, n in cfg["row_replicas"].items() if new(lab) is not None}
     return cfg

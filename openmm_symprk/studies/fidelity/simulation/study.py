@@ -108,10 +108,13 @@ def check(cfg: dict) -> list:
         raise InputError("no rows")
     foreign = foreign_rows(cfg, rows)
     if foreign:
-        raise InputError(f"row(s) {', '.join(repr(lab) for lab in foreign)}: the thermostat's target is lowered for "
-                         f"the {'/'.join(sorted(set(foreign.values())))} box, not {cfg.get('model', 'spce')}'s; "
-                         f"openmm_symprk.studies.fidelity.rowspec.for_model(cfg, {cfg.get('model', 'spce')!r}) "
-                         f"swaps them for the model's own (what --model does)")
+        model = cfg.get("model", "spce")
+        named = "; ".join(f"{lab!r}: {model}'s is {own!r}" if own else f"{lab!r}: none for {model}"
+                          for lab, own in foreign.items())
+        raise InputError(f"{len(foreign)} row(s) with the thermostat's target lowered for another water model's box, "
+                         f"not {model}'s ({named}); "
+                         f"openmm_symprk.studies.fidelity.rowspec.for_model(cfg, {model!r}) makes that swap (what "
+                         f"--model does)")
     references(cfg, rows)
     dup = sorted({x for x in rows if rows.count(x) > 1})
     if dup:
