@@ -228,7 +228,7 @@ FRONTIER_NVT_DECIDING = [
 #: The replicas of :data:`FRONTIER_NVT_DECIDING` committed (the other rows have 12); a later measurement raises it and
 #: runs ``symprk fidelity --preset frontier --out docs/data/fidelity/frontier-spce --no-timing``, which runs only the
 #: missing replicas.
-FRONTIER_NVT_REPLICAS = 28
+FRONTIER_NVT_REPLICAS = 40
 #: LangevinMiddle at 0.5 fs is a third of the cost of a replica of those rows and carries little of the fitted c
 #: (h^2 = 0.25 fs^2 against 1-9 at 1-3 fs): its replicas stop here.
 FRONTIER_HALF_FS_REPLICAS = 14
