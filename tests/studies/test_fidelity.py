@@ -733,7 +733,7 @@ def test_each_models_mean_square_frequency_is_its_committed_states(model, n):
     x = np.load(states)["x"][:n]
     assert len(x) == n
     omega2 = mean_square_frequency(water_box_scene(cfg, model).system, list(x), 300.0, platform="CPU")["all"]
-    assert omega2 * 1e-6 == pytest.approx(presets.MEAN_SQUARE_FREQUENCY_FS2[model], abs=5e-6)
+    assert omega2 * 1e-6 == pytest.approx(presets.MEAN_SQUARE_FREQUENCY_FS2[model], abs=1e-6)
 
 
 def test_a_model_gets_its_own_lowered_rows_and_refuses_anothers():

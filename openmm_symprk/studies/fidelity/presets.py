@@ -117,6 +117,26 @@ TOLERANCES = {
 #: event at each end of an interval), with the same seed, so its draws are the NVT reference's event for event and a
 #: row pairs with the reference replica by replica as NVE rows do (common random numbers).
 EVENT_FS = 12.0
+#: <w^2> = <F.M^-1.F>/(N_f kT) per degree of freedom (fs^-2) of each water model's frontier box, over its replica
+#: states (SPC/E's first 12, TIP3P's 8; :func:`openmm_symprk.systems.frequencies.mean_square_frequency`): what
+#: lowers each model's thermostat target, T (1 - c_T h^2 <w^2>) (:func:`openmm_symprk.integrators.shadow.lowered_target`).
+MEAN_SQUARE_FREQUENCY_FS2 = {"spce": 6.818e-3, "tip3p": 5.610e-3}
+#: The rows whose thermostat target is lowered for one water model's <w^2>: they hold for that model only.  A study
+#: of another model swaps each for its own row of the same method, step and thermostat (:func:`.rowspec.for_model`), or
+#: leaves it out where the model has none (SPC/E's side rows).  The first five of each model are the omelyan-2
+#: family on the event grid (the package's cheapest accurate NVT configuration); SPC/E's are the frontier's rows.
+LOWERED_ROWS = {
+    "spce": ["omelyan-2 3 fs SVR 0.1 ps every 4 T 299.76 K", "omelyan-2 4 fs SVR 0.1 ps every 3 T 299.57 K",
+             "omelyan-2 5 fs SVR 0.1 ps T 299.32 K", "omelyan-2 6 fs SVR 0.1 ps every 2 T 299.02 K",
+             "omelyan-2 7 fs SVR 0.1 ps T 298.67 K", "predescu-3 12 fs SVR 0.1 ps T 298.38 K",
+             "bcss-2 6 fs SVR 0.1 ps every 2 T 298.34 K", "verlet 3 fs SVR 0.1 ps every 4 T 296.93 K"],
+    "tip3p": ["omelyan-2 3 fs SVR 0.1 ps every 4 T 299.8 K", "omelyan-2 4 fs SVR 0.1 ps every 3 T 299.64 K",
+              "omelyan-2 5 fs SVR 0.1 ps T 299.44 K", "omelyan-2 6 fs SVR 0.1 ps every 2 T 299.2 K",
+              "omelyan-2 7 fs SVR 0.1 ps T 298.91 K"],
+}
+#: SPC/E's lowered-target omelyan-2 family and its lowered side rows (other methods, one step each).
+_LOWERED_FAMILY, _LOWERED_SIDE = LOWERED_ROWS["spce"][:5], LOWERED_ROWS["spce"][5:]
+
 #: The frontier's rows: the references, then per family its steps up to where it stops paying.  NVE: OpenMM's
 #: VerletIntegrator (1-3 fs), omelyan-2, BCSS-2 and the three-stage Predescu scheme; NVT on the event grid:
 #: the package's thermostat on omelyan-2, BCSS-2 and Verlet (at the ends and in the middle), and OpenMM's
@@ -154,9 +174,7 @@ FRONTIER_ROWS = [
     # the thermostat's target lowered by the modified energy (below: T (1 - c_T h^2 <w^2>)), a family of its own on
     # the omelyan-2 family's steps and event grid (studies.fidelity.frontier.family_of: "T lowered"); the targets
     # are SPC/E's (:data:`LOWERED_ROWS`: another model's run has its own, :func:`.rowspec.for_model`)
-    "omelyan-2 3 fs SVR 0.1 ps every 4 T 299.76 K", "omelyan-2 4 fs SVR 0.1 ps every 3 T 299.57 K",
-    "omelyan-2 5 fs SVR 0.1 ps T 299.32 K", "omelyan-2 6 fs SVR 0.1 ps every 2 T 299.02 K",
-    "omelyan-2 7 fs SVR 0.1 ps T 298.67 K",
+    *_LOWERED_FAMILY,
 ] + [
     # tests of where the NVT rows' potential-energy bias comes from (:data:`SIDE_ROWS`: run and tabulated, not fitted)
     "omelyan-2 6 fs SVR 0.1 ps", "omelyan-2 6 fs SVR 1 ps every 2", "omelyan-2 6 fs SVR 0.1 ps every 2 middle",
@@ -165,15 +183,13 @@ FRONTIER_ROWS = [
     # c_T of the method at the event point and <w^2> = <F.M^-1.F>/(N_f kT) of this box's replica states
     # (:data:`MEAN_SQUARE_FREQUENCY_FS2`): the configurational temperature of the slow modes then sits at 300 K
     # (integrators.shadow.lowered_target; tests/studies/test_fidelity.py checks these labels against it)
-    "predescu-3 12 fs SVR 0.1 ps T 298.38 K", "bcss-2 6 fs SVR 0.1 ps every 2 T 298.34 K",
-    "verlet 3 fs SVR 0.1 ps every 4 T 296.93 K",
+    *_LOWERED_SIDE,
 ]
 #: Rows that test a hypothesis about the others (the thermostat's interval, collision time or placement at one
 #: step): run and tabulated like every row, left out of the frontier's families (each would sit beside a row of
 #: the same family and step, or form a family of one step).
 SIDE_ROWS = ["omelyan-2 6 fs SVR 0.1 ps", "omelyan-2 6 fs SVR 1 ps every 2", "omelyan-2 6 fs SVR 0.1 ps every 2 middle",
-             "predescu-3 12 fs SVR 0.1 ps middle", "predescu-3 12 fs SVR 0.1 ps T 298.38 K",
-             "bcss-2 6 fs SVR 0.1 ps every 2 T 298.34 K", "verlet 3 fs SVR 0.1 ps every 4 T 296.93 K"]
+             "predescu-3 12 fs SVR 0.1 ps middle", *_LOWERED_SIDE]
 #: The frontier's deciding rows (``--rows deciding``; what TIP3P runs, ``--model tip3p``): those that decide the
 #: answer in SPC/E (the references, OpenMM's families, omelyan-2 in both ensembles) and the placement question's rows.
 FRONTIER_DECIDING = [
@@ -189,37 +205,15 @@ FRONTIER_DECIDING = [
     "langevin 3 fs friction 1/ps",
     # the package's cheapest accurate NVT configuration: omelyan-2 with the lowered target (SPC/E's targets; the
     # model's own under --model, :func:`.rowspec.for_model`)
-    "omelyan-2 3 fs SVR 0.1 ps every 4 T 299.76 K", "omelyan-2 4 fs SVR 0.1 ps every 3 T 299.57 K",
-    "omelyan-2 5 fs SVR 0.1 ps T 299.32 K", "omelyan-2 6 fs SVR 0.1 ps every 2 T 299.02 K",
-    "omelyan-2 7 fs SVR 0.1 ps T 298.67 K",
+    *_LOWERED_FAMILY,
 ]
-
-#: <w^2> = <F.M^-1.F>/(N_f kT) per degree of freedom (fs^-2) of each water model's frontier box, over its replica
-#: states (SPC/E's first 12, TIP3P's 8; :func:`openmm_symprk.systems.frequencies.mean_square_frequency`): what
-#: lowers each model's thermostat target, T (1 - c_T h^2 <w^2>) (:func:`openmm_symprk.integrators.shadow.lowered_target`).
-MEAN_SQUARE_FREQUENCY_FS2 = {"spce": 6.818e-3, "tip3p": 5.610e-3}
-#: The rows whose thermostat target is lowered for one water model's <w^2>: they hold for that model only.  A study
-#: of another model swaps each for its own row of the same method, step and thermostat (:func:`.rowspec.for_model`), or
-#: leaves it out where the model has none (SPC/E's side rows).
-LOWERED_ROWS = {
-    "spce": ["omelyan-2 3 fs SVR 0.1 ps every 4 T 299.76 K", "omelyan-2 4 fs SVR 0.1 ps every 3 T 299.57 K",
-             "omelyan-2 5 fs SVR 0.1 ps T 299.32 K", "omelyan-2 6 fs SVR 0.1 ps every 2 T 299.02 K",
-             "omelyan-2 7 fs SVR 0.1 ps T 298.67 K", "predescu-3 12 fs SVR 0.1 ps T 298.38 K",
-             "bcss-2 6 fs SVR 0.1 ps every 2 T 298.34 K", "verlet 3 fs SVR 0.1 ps every 4 T 296.93 K"],
-    "tip3p": ["omelyan-2 3 fs SVR 0.1 ps every 4 T 299.8 K", "omelyan-2 4 fs SVR 0.1 ps every 3 T 299.64 K",
-              "omelyan-2 5 fs SVR 0.1 ps T 299.44 K", "omelyan-2 6 fs SVR 0.1 ps every 2 T 299.2 K",
-              "omelyan-2 7 fs SVR 0.1 ps T 298.91 K"],
-}
-
 
 #: The rows that decide the NVT answer at the standard level (the NVT reference, the lowered-target omelyan-2 family
 #: and LangevinMiddle at both frictions, which share the fitted friction part): run at more replicas than the others
 #: (:data:`FRONTIER_NVT_REPLICAS`), replica by replica, so that a run stopped part way leaves them balanced.
 FRONTIER_NVT_DECIDING = [
     "verlet 0.5 fs SVR 0.1 ps every 24",
-    "omelyan-2 3 fs SVR 0.1 ps every 4 T 299.76 K", "omelyan-2 4 fs SVR 0.1 ps every 3 T 299.57 K",
-    "omelyan-2 5 fs SVR 0.1 ps T 299.32 K", "omelyan-2 6 fs SVR 0.1 ps every 2 T 299.02 K",
-    "omelyan-2 7 fs SVR 0.1 ps T 298.67 K",
+    *_LOWERED_FAMILY,
     "langevin 0.5 fs friction 0.1/ps", "langevin 1 fs friction 0.1/ps", "langevin 2 fs friction 0.1/ps",
     "langevin 3 fs friction 0.1/ps",
     "langevin 0.5 fs friction 1/ps", "langevin 1 fs friction 1/ps", "langevin 2 fs friction 1/ps",

@@ -62,7 +62,6 @@ def describe(row) -> dict:
             "family": "symprk" if r.is_ours else "openmm", "hmr": r.hmr_da is not None, "step_fs": r.step_fs}
 
 
-
 def _bare(lab: str, temperature: float) -> str:
     """A lowered-target row's label at the study's ``temperature``: the method, step and thermostat it shares with the
     same row lowered for another water model."""
